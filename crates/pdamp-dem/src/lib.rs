@@ -1,0 +1,14 @@
+//! # pdamp-dem — the discrete element engine of pdamp
+//!
+//! Spherical particles in containers made of analytic walls and triangle meshes, verified contact
+//! laws (Hertz, Gonthier, Lankarani–Nikravesh, linear spring–dashpot, Hertz–Mindlin, regularized
+//! and spring–dashpot friction, rolling resistance, DMT adhesion), cell-grid + Verlet neighbour
+//! lists, velocity-Verlet and Gear predictor–corrector integration, and an energy ledger that
+//! closes. References: [D] = the dissertation on the particle-damper design toolchain (chapter 2),
+//! [P] = the DEM–FEM powder-damper paper (section 2.1). No file I/O lives here.
+
+pub mod contact;
+pub mod generate;
+pub mod material;
+pub mod math;
+pub mod walls;

@@ -1,0 +1,8 @@
+//! # pdamp-io — files in and out of pdamp
+//!
+//! Scenario files (TOML), meshes (STL), results (CSV, JSON) and ParaView output (VTK XML).
+//! Every output file is written atomically (write to a temporary file, then rename).
+
+pub mod atomic;
+pub mod stl;
+pub mod vtk;
