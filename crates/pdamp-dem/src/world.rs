@@ -1,0 +1,275 @@
+//! The simulation world: particles, materials, contact models, rigid bodies with walls, and the
+//! time loop state. `World::step` advances by one time step with the chosen integrator.
+
+use crate::body::RigidBody;
+use crate::contact::{ContactModel, PairProps};
+use crate::energy::{EnergyIncrements, EnergyLedger};
+use crate::forces::{PairOutput, PairState, WallSlot};
+use crate::integrate::{GearState, Integrator};
+use crate::interaction::InteractionTable;
+use crate::material::{Material, effective_mass, effective_radius};
+use crate::math::Vec3;
+use crate::neighbor::NeighborList;
+use crate::particles::ParticleSet;
+
+/// Counters of work done, for diagnostics and benchmarks.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Counters {
+    /// Accepted time steps.
+    pub steps: u64,
+    /// Rejected time steps (Gear step control).
+    pub rejected_steps: u64,
+    /// Force evaluations.
+    pub force_evaluations: u64,
+    /// Neighbour-list builds.
+    pub neighbor_builds: u64,
+}
+
+/// A DEM simulation.
+#[derive(Debug, Clone)]
+pub struct World {
+    /// The particles.
+    pub particles: ParticleSet,
+    /// Material table (particles and walls refer to it by index).
+    pub materials: Vec<Material>,
+    /// Contact model per material pair.
+    pub interactions: InteractionTable,
+    /// Rigid bodies carrying walls.
+    pub bodies: Vec<RigidBody>,
+    /// Gravitational acceleration, m/s².
+    pub gravity_m_s2: Vec3,
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// Current time step, s (changes under Gear step control).
+    pub dt_s: f64,
+    /// Time integration scheme.
+    pub integrator: Integrator,
+    /// Energy balance.
+    pub ledger: EnergyLedger,
+    /// Work counters.
+    pub counters: Counters,
+    pub(crate) neighbors: NeighborList,
+    pub(crate) pair_state: Vec<PairState>,
+    pub(crate) pair_output: Vec<PairOutput>,
+    pub(crate) wall_slots: Vec<Vec<WallSlot>>,
+    pub(crate) scratch_force: Vec<Vec3>,
+    pub(crate) scratch_torque: Vec<Vec3>,
+    pub(crate) gear: Option<GearState>,
+    pub(crate) initialized: bool,
+}
+
+impl World {
+    /// A world with the given materials; every material pair uses `default_model` until
+    /// [`World::set_contact_model`] says otherwise.
+    pub fn new(materials: Vec<Material>, default_model: ContactModel, dt_s: f64) -> Self {
+        let interactions = InteractionTable::new(&materials, default_model);
+        Self {
+            particles: ParticleSet::default(),
+            materials,
+            interactions,
+            bodies: Vec::new(),
+            gravity_m_s2: Vec3::new(0.0, 0.0, -9.81),
+            time_s: 0.0,
+            dt_s,
+            integrator: Integrator::VelocityVerlet,
+            ledger: EnergyLedger::default(),
+            counters: Counters::default(),
+            neighbors: NeighborList::new(0.0),
+            pair_state: Vec::new(),
+            pair_output: Vec::new(),
+            wall_slots: Vec::new(),
+            scratch_force: Vec::new(),
+            scratch_torque: Vec::new(),
+            gear: None,
+            initialized: false,
+        }
+    }
+
+    /// Uses `model` for contacts between materials `a` and `b`.
+    pub fn set_contact_model(&mut self, a: u16, b: u16, model: ContactModel) {
+        self.interactions.set(a, b, model);
+        self.initialized = false;
+    }
+
+    /// Adds a particle at rest and returns its index.
+    pub fn add_particle(&mut self, position: Vec3, radius_m: f64, material: u16) -> usize {
+        let rho = self.materials[material as usize].density_kg_m3;
+        self.initialized = false;
+        self.particles.push(position, radius_m, rho, material)
+    }
+
+    /// Adds a rigid body and returns its index.
+    pub fn add_body(&mut self, body: RigidBody) -> usize {
+        self.bodies.push(body);
+        self.initialized = false;
+        self.bodies.len() - 1
+    }
+
+    /// Number of particle–particle pairs in the neighbour list.
+    pub fn num_neighbor_pairs(&self) -> usize {
+        self.neighbors.num_pairs()
+    }
+
+    /// Number of touching particle–particle contacts.
+    pub fn num_pp_contacts(&self) -> usize {
+        self.pair_state.iter().filter(|s| s.active).count()
+    }
+
+    /// Number of touching particle–wall contacts.
+    pub fn num_pw_contacts(&self) -> usize {
+        self.wall_slots.iter().map(|s| s.len()).sum()
+    }
+
+    /// Largest overlap relative to the smaller radius over all particle–particle contacts.
+    pub fn max_relative_overlap(&self) -> f64 {
+        let p = &self.particles;
+        (0..self.neighbors.num_pairs())
+            .map(|k| {
+                let (i, j) = (self.neighbors.first[k] as usize, self.neighbors.second[k] as usize);
+                let ov = p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm();
+                ov / p.radius[i].min(p.radius[j])
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Default Verlet skin: 0.2 × the smallest radius (kept under the dissertation's
+    /// $d_v^{max} = 0.8\,\min r_i$ [D Eq. 2.10]).
+    pub fn default_skin(&self) -> f64 {
+        0.2 * self.particles.min_radius()
+    }
+
+    /// Sets the neighbour-list skin (m).
+    pub fn set_skin(&mut self, skin_m: f64) {
+        self.neighbors.skin_m = skin_m;
+        self.neighbors.builds = 0;
+    }
+
+    /// Smallest Hertz contact time over the particle materials at `impact_velocity_m_s` for
+    /// the smallest particle (eq. 4.8 or the law's own estimate), s. Used to check the time step.
+    pub fn min_contact_time_s(&self, impact_velocity_m_s: f64) -> f64 {
+        let p = &self.particles;
+        if p.is_empty() {
+            return f64::INFINITY;
+        }
+        let mut t = f64::INFINITY;
+        let mut mats: Vec<u16> = p.material.clone();
+        mats.sort_unstable();
+        mats.dedup();
+        let (mut imin, mut rmin) = (0, f64::INFINITY);
+        for i in 0..p.len() {
+            if p.radius[i] < rmin {
+                rmin = p.radius[i];
+                imin = i;
+            }
+        }
+        let m = p.mass[imin];
+        for &a in &mats {
+            let mut partners: Vec<u16> = mats.clone();
+            for b in &self.bodies {
+                partners.extend(b.walls.iter().map(|w| w.material));
+            }
+            for &b in &partners {
+                let (model, el) = self.interactions.get(a, b);
+                let props = PairProps {
+                    e_eff_pa: el.e_eff_pa,
+                    g_eff_pa: el.g_eff_pa,
+                    poisson_mean: el.poisson_mean,
+                    r_eff_m: effective_radius(rmin, rmin),
+                    m_eff_kg: effective_mass(m, m),
+                };
+                t = t.min(model.contact_time_estimate_s(&props, impact_velocity_m_s));
+            }
+        }
+        t
+    }
+
+    /// Prepares neighbour lists and evaluates the initial forces (called by the first step).
+    pub fn initialize(&mut self) {
+        let n = self.particles.len();
+        if self.neighbors.skin_m <= 0.0 {
+            self.neighbors.skin_m = self.default_skin();
+        }
+        self.neighbors.extra_range_m = self
+            .interactions
+            .models()
+            .iter()
+            .map(|m| {
+                let r = self.particles.max_radius();
+                let props = PairProps {
+                    e_eff_pa: 1.0,
+                    g_eff_pa: 1.0,
+                    poisson_mean: 0.3,
+                    r_eff_m: r,
+                    m_eff_kg: 1.0,
+                };
+                m.max_interaction_gap_m(&props)
+            })
+            .fold(0.0, f64::max);
+        self.wall_slots.resize(n, Vec::new());
+        self.neighbors.builds = 0;
+        self.update_neighbors();
+        for b in self.bodies.iter_mut() {
+            let s = b.prescribed_state(self.time_s);
+            b.state = s;
+            b.previous = s;
+        }
+        let inc = self.evaluate_forces(0.0);
+        self.counters.force_evaluations += 1;
+        self.ledger.elastic_j = inc.elastic_j;
+        self.refresh_state_energies();
+        self.ledger.reset();
+        self.initialized = true;
+    }
+
+    /// Rebuilds the neighbour list when the displacement criterion asks for it.
+    pub(crate) fn update_neighbors(&mut self) {
+        if self.neighbors.needs_rebuild(&self.particles.position) {
+            self.neighbors
+                .rebuild(&self.particles.position, &self.particles.radius, &mut self.pair_state);
+            self.counters.neighbor_builds += 1;
+        }
+    }
+
+    /// Recomputes kinetic and potential energy in the ledger from the state.
+    pub(crate) fn refresh_state_energies(&mut self) {
+        self.ledger.kinetic_j = self.particles.kinetic_energy();
+        self.ledger.potential_j = self.particles.potential_energy(&self.gravity_m_s2);
+    }
+
+    /// Advances by one time step (or one accepted step under Gear step control).
+    pub fn step(&mut self) {
+        if !self.initialized {
+            self.initialize();
+        }
+        let inc: EnergyIncrements = match self.integrator.clone() {
+            Integrator::VelocityVerlet => self.step_velocity_verlet(),
+            Integrator::Gear(params) => self.step_gear(&params),
+        };
+        self.ledger.add(&inc);
+        self.refresh_state_energies();
+        self.counters.steps += 1;
+    }
+
+    /// Steps until `time_s` reaches `t_end_s` (the last step is shortened to land on it).
+    pub fn run_until(&mut self, t_end_s: f64, mut observer: impl FnMut(&World)) {
+        while self.time_s < t_end_s - 1e-12 * t_end_s.abs().max(1e-300) {
+            let dt_nominal = self.dt_s;
+            let remaining = t_end_s - self.time_s;
+            if remaining < dt_nominal {
+                self.dt_s = remaining;
+                self.step();
+                if matches!(self.integrator, Integrator::VelocityVerlet) {
+                    self.dt_s = dt_nominal;
+                }
+            } else {
+                self.step();
+            }
+            observer(self);
+        }
+    }
+
+    /// Total contact force and torque the particles exert on body `b`, N and N·m.
+    pub fn body_load(&self, b: usize) -> (Vec3, Vec3) {
+        (self.bodies[b].contact_force_n, self.bodies[b].contact_torque_nm)
+    }
+}
