@@ -1,3 +1,215 @@
-fn main() {
-    println!("Hello, world!");
+//! `pdamp` — particle damper simulation and design from the command line.
+//!
+//! A thin layer: every command parses its arguments, calls one library function and reports.
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use pdamp_dem::contact::NormalLaw;
+use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
+use pdamp_dem::Material;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(name = "pdamp", version, about = "Particle damper simulation and design toolkit")]
+struct Cli {
+    /// Worker threads (default: all cores).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a DEM scenario from a TOML file; writes summary.json, energy.csv and VTK files.
+    Run {
+        /// Scenario file (TOML); `builtin:shaken-box` runs the built-in example.
+        scenario: String,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Print the built-in example scenario as TOML.
+    Example {
+        /// Number of particles.
+        #[arg(long, default_value_t = 2000)]
+        particles: usize,
+        /// Shaking duration, s.
+        #[arg(long, default_value_t = 0.5)]
+        duration_s: f64,
+    },
+    /// Single head-on impact; prints measured and Hertz-theory values as JSON.
+    Impact {
+        /// Impact partner.
+        #[arg(long, value_enum, default_value_t = PartnerArg::Wall)]
+        partner: PartnerArg,
+        /// Sphere radius, m.
+        #[arg(long)]
+        radius_m: f64,
+        /// Young's modulus, Pa.
+        #[arg(long)]
+        youngs_modulus_pa: f64,
+        /// Poisson's ratio.
+        #[arg(long)]
+        poisson_ratio: f64,
+        /// Density, kg/m³.
+        #[arg(long)]
+        density_kg_m3: f64,
+        /// Normal contact law.
+        #[arg(long, value_enum, default_value_t = LawArg::Hertz)]
+        law: LawArg,
+        /// Coefficient of restitution (dissipative laws).
+        #[arg(long, default_value_t = 1.0)]
+        restitution: f64,
+        /// Normal stiffness for the linear law, N/m (default: Hertz secant stiffness at max overlap).
+        #[arg(long)]
+        stiffness_n_m: Option<f64>,
+        /// Impact velocity, m/s.
+        #[arg(long)]
+        velocity_m_s: f64,
+    },
+    /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
+    Bench {
+        /// Number of particles.
+        #[arg(long, default_value_t = 8000)]
+        particles: usize,
+        /// Timed steps.
+        #[arg(long, default_value_t = 2000)]
+        steps: u64,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PartnerArg {
+    Wall,
+    Sphere,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum LawArg {
+    Hertz,
+    Gonthier,
+    LankaraniNikravesh,
+    Linear,
+    HertzMindlin,
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    let threads = cli.threads.unwrap_or(0);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .context("cannot start the thread pool")?;
+    match cli.command {
+        Command::Run { scenario, out } => cmd_run(&scenario, &out),
+        Command::Example { particles, duration_s } => {
+            print!("{}", pdamp_io::examples::shaken_box(particles, duration_s).to_toml());
+            Ok(())
+        }
+        Command::Impact {
+            partner,
+            radius_m,
+            youngs_modulus_pa,
+            poisson_ratio,
+            density_kg_m3,
+            law,
+            restitution,
+            stiffness_n_m,
+            velocity_m_s,
+        } => {
+            let material = Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio);
+            material.validate().map_err(anyhow::Error::msg)?;
+            if !(radius_m > 0.0 && velocity_m_s > 0.0) {
+                bail!("--radius-m and --velocity-m-s must be > 0");
+            }
+            let partner = match partner {
+                PartnerArg::Wall => Partner::Wall,
+                PartnerArg::Sphere => Partner::Sphere,
+            };
+            let normal = match law {
+                LawArg::Hertz => NormalLaw::Hertz,
+                LawArg::Gonthier => NormalLaw::Gonthier {
+                    restitution,
+                    min_impact_velocity_m_s: 1e-3,
+                },
+                LawArg::LankaraniNikravesh => NormalLaw::LankaraniNikravesh {
+                    restitution,
+                    min_impact_velocity_m_s: 1e-3,
+                },
+                LawArg::HertzMindlin => NormalLaw::HertzMindlin {
+                    restitution,
+                    clip_attractive: false,
+                },
+                LawArg::Linear => {
+                    let k = stiffness_n_m.unwrap_or_else(|| {
+                        pdamp_dem::impact::hertz_equivalent_linear_stiffness(partner, radius_m, &material, velocity_m_s)
+                    });
+                    NormalLaw::Linear {
+                        stiffness_n_m: k,
+                        restitution,
+                        clip_attractive: false,
+                    }
+                }
+            };
+            let model = pdamp_dem::ContactModel {
+                normal: normal.clone(),
+                friction: Default::default(),
+                rolling: None,
+                adhesion: None,
+            };
+            model.validate().map_err(anyhow::Error::msg)?;
+            let r = head_on_impact(&ImpactSetup {
+                partner,
+                radius_m,
+                material,
+                normal,
+                velocity_m_s,
+                steps_per_contact: 2000.0,
+            });
+            println!("{}", serde_json::to_string_pretty(&r)?);
+            Ok(())
+        }
+        Command::Bench { particles, steps } => {
+            let r = pdamp_io::bench::shaken_box_bench(particles, steps)?;
+            println!(
+                "{}",
+                serde_json::json!({
+                    "particles": r.particles,
+                    "steps": r.steps,
+                    "threads": rayon::current_num_threads(),
+                    "wall_time_s": r.wall_time_s,
+                    "particle_steps_per_s": r.particle_steps_per_s,
+                    "neighbor_builds": r.neighbor_builds,
+                    "contacts_pp": r.contacts_pp,
+                })
+            );
+            Ok(())
+        }
+    }
+}
+
+fn cmd_run(scenario: &str, out: &PathBuf) -> Result<()> {
+    let (sc, base) = if scenario == "builtin:shaken-box" {
+        (pdamp_io::examples::shaken_box(2000, 0.5), PathBuf::from("."))
+    } else {
+        let path = PathBuf::from(scenario);
+        let sc = pdamp_io::scenario::Scenario::load(&path)?;
+        let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+        (sc, base)
+    };
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let summary = pdamp_io::run::run_scenario(&sc, &base, out, |phase, f| {
+        bar.set_message(phase.to_string());
+        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+    })
+    .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    Ok(())
 }

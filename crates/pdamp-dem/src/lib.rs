@@ -30,3 +30,4 @@ pub use math::Vec3;
 pub use particles::ParticleSet;
 pub use walls::Geometry;
 pub use world::World;
+pub mod impact;

@@ -268,6 +268,14 @@ impl World {
         }
     }
 
+    /// Sets the clock back to zero and re-initialises (forces, body poses, ledger) while keeping
+    /// particles and contact history: used after settling.
+    pub fn restart_clock(&mut self) {
+        self.time_s = 0.0;
+        self.gear = None;
+        self.initialize();
+    }
+
     /// Total contact force and torque the particles exert on body `b`, N and N·m.
     pub fn body_load(&self, b: usize) -> (Vec3, Vec3) {
         (self.bodies[b].contact_force_n, self.bodies[b].contact_torque_nm)

@@ -6,3 +6,7 @@
 pub mod atomic;
 pub mod stl;
 pub mod vtk;
+pub mod scenario;
+pub mod examples;
+pub mod run;
+pub mod bench;

@@ -1,0 +1,153 @@
+//! A single head-on impact of a sphere on an identical sphere or on a rigid flat wall, simulated
+//! with the full DEM pipeline and compared with Hertz impact theory
+//! (contact time [D Eq. 4.8], maximum overlap [D Eq. 2.80]).
+
+use crate::body::{BodyState, Motion, RigidBody};
+use crate::contact::hertz;
+use crate::contact::{ContactModel, FrictionLaw, NormalLaw};
+use crate::material::{Material, effective_mass, effective_modulus, effective_radius};
+use crate::math::Vec3;
+use crate::walls::{Geometry, Plane};
+use crate::world::World;
+use serde::Serialize;
+
+/// The impact partner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Partner {
+    /// A rigid, immovable flat wall of the same material.
+    Wall,
+    /// An identical sphere (both move towards each other with half the impact velocity).
+    Sphere,
+}
+
+/// Set-up of a head-on impact.
+#[derive(Debug, Clone)]
+pub struct ImpactSetup {
+    /// Partner of the sphere.
+    pub partner: Partner,
+    /// Sphere radius, m.
+    pub radius_m: f64,
+    /// Material of sphere (and partner).
+    pub material: Material,
+    /// Normal contact law.
+    pub normal: NormalLaw,
+    /// Relative normal impact velocity, m/s.
+    pub velocity_m_s: f64,
+    /// Time steps per Hertz contact time (resolution), default 2000.
+    pub steps_per_contact: f64,
+}
+
+/// Measured and theoretical quantities of the impact.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ImpactResult {
+    /// Coefficient of restitution: relative normal velocity after / before.
+    pub restitution: f64,
+    /// Duration of positive overlap, s.
+    pub contact_time_s: f64,
+    /// Largest normal contact force, N.
+    pub max_force_n: f64,
+    /// Largest overlap, m.
+    pub max_overlap_m: f64,
+    /// Hertz contact time [D Eq. 4.8], s.
+    pub hertz_contact_time_s: f64,
+    /// Hertz maximum overlap [D Eq. 2.80], m.
+    pub hertz_max_overlap_m: f64,
+    /// Hertz maximum force $k_n \delta_{max}^{3/2}$, N.
+    pub hertz_max_force_n: f64,
+}
+
+/// Runs the impact and measures restitution, contact time, peak force and peak overlap.
+pub fn head_on_impact(setup: &ImpactSetup) -> ImpactResult {
+    let r = setup.radius_m;
+    let v = setup.velocity_m_s;
+    let mat = setup.material.clone();
+    let m = 4.0 / 3.0 * std::f64::consts::PI * mat.density_kg_m3 * r.powi(3);
+    let (r_eff, m_eff) = match setup.partner {
+        Partner::Wall => (r, m),
+        Partner::Sphere => (effective_radius(r, r), effective_mass(m, m)),
+    };
+    let e_eff = effective_modulus(&mat, &mat);
+    let k_n = hertz::hertz_stiffness(e_eff, r_eff);
+    let t_h = hertz::hertz_contact_time(e_eff, r_eff, m_eff, v);
+    let d_h = hertz::hertz_max_overlap(k_n, m_eff, v);
+    let model = ContactModel {
+        normal: setup.normal.clone(),
+        friction: FrictionLaw::Frictionless,
+        rolling: None,
+        adhesion: None,
+    };
+    let dt = t_h / setup.steps_per_contact.max(50.0);
+    let mut w = World::new(vec![mat], model, dt);
+    w.gravity_m_s2 = Vec3::zeros();
+    let gap0 = 2.0 * v * dt; // touch after about two steps
+    match setup.partner {
+        Partner::Wall => {
+            w.add_particle(Vec3::new(0.0, 0.0, r + gap0), r, 0);
+            w.particles.velocity[0] = Vec3::new(0.0, 0.0, -v);
+            w.add_body(
+                RigidBody::new("wall", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+                    "wall",
+                    Geometry::Plane(Plane::new(Vec3::zeros(), Vec3::z(), false)),
+                    0,
+                ),
+            );
+        }
+        Partner::Sphere => {
+            w.add_particle(Vec3::new(0.0, 0.0, r + 0.5 * gap0), r, 0);
+            w.add_particle(Vec3::new(0.0, 0.0, -r - 0.5 * gap0), r, 0);
+            w.particles.velocity[0] = Vec3::new(0.0, 0.0, -0.5 * v);
+            w.particles.velocity[1] = Vec3::new(0.0, 0.0, 0.5 * v);
+        }
+    }
+    w.set_skin(0.5 * r);
+    let overlap = |w: &World| match setup.partner {
+        Partner::Wall => r - w.particles.position[0].z,
+        Partner::Sphere => 2.0 * r - (w.particles.position[0].z - w.particles.position[1].z),
+    };
+    let rel_vel = |w: &World| match setup.partner {
+        Partner::Wall => w.particles.velocity[0].z,
+        Partner::Sphere => w.particles.velocity[0].z - w.particles.velocity[1].z,
+    };
+    let (mut t_start, mut t_end) = (f64::NAN, f64::NAN);
+    let (mut max_f, mut max_d) = (0.0f64, 0.0f64);
+    let mut prev = (w.time_s, overlap(&w));
+    let limit = 20.0 * t_h + 10.0 * dt;
+    while w.time_s < limit {
+        w.step();
+        let d = overlap(&w);
+        if d > 0.0 && prev.1 <= 0.0 && t_start.is_nan() {
+            t_start = prev.0 + (w.time_s - prev.0) * (-prev.1) / (d - prev.1);
+        }
+        if d <= 0.0 && prev.1 > 0.0 && !t_start.is_nan() {
+            t_end = prev.0 + (w.time_s - prev.0) * prev.1 / (prev.1 - d);
+        }
+        max_d = max_d.max(d);
+        max_f = max_f.max(w.particles.force[0].z.abs());
+        prev = (w.time_s, d);
+        if !t_end.is_nan() && w.time_s > t_end + 2.0 * dt {
+            break;
+        }
+    }
+    ImpactResult {
+        restitution: rel_vel(&w) / v,
+        contact_time_s: t_end - t_start,
+        max_force_n: max_f,
+        max_overlap_m: max_d,
+        hertz_contact_time_s: t_h,
+        hertz_max_overlap_m: d_h,
+        hertz_max_force_n: k_n * d_h.powf(1.5),
+    }
+}
+
+/// Secant stiffness $F_{max}/\delta_{max}$ of the Hertz impact at `velocity_m_s`, N/m: a linear
+/// spring of this stiffness gives a comparable contact time and overlap.
+pub fn hertz_equivalent_linear_stiffness(partner: Partner, radius_m: f64, material: &Material, velocity_m_s: f64) -> f64 {
+    let m = 4.0 / 3.0 * std::f64::consts::PI * material.density_kg_m3 * radius_m.powi(3);
+    let (r_eff, m_eff) = match partner {
+        Partner::Wall => (radius_m, m),
+        Partner::Sphere => (effective_radius(radius_m, radius_m), effective_mass(m, m)),
+    };
+    let k_n = hertz::hertz_stiffness(effective_modulus(material, material), r_eff);
+    let d = hertz::hertz_max_overlap(k_n, m_eff, velocity_m_s);
+    k_n * d.sqrt()
+}

@@ -1,0 +1,92 @@
+//! Built-in scenarios: the shaken-box benchmark (DEM-core issue) used by `pdamp bench`, by the
+//! default example and by tests.
+
+use crate::scenario::*;
+use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
+use pdamp_dem::generate::{Region, SizeDistribution};
+use pdamp_dem::walls::BoxInside;
+use pdamp_dem::{HarmonicTranslation, Integrator, Material, Vec3};
+
+/// Side length of the square base of the shaken box for `n` particles, m: 40 mm up to
+/// n = 8 000 and 40·√(n/8 000) mm above, so the bed height stays about the same.
+pub fn shaken_box_side_m(n: usize) -> f64 {
+    0.040 * (n as f64 / 8000.0).sqrt().max(1.0)
+}
+
+/// The shaken-box benchmark: a closed box 40 mm high, `n` steel spheres of radius 1 mm
+/// (ρ = 7 800 kg/m³, E softened to 2 GPa, ν = 0.3) in hexagonal close packing, Hertz–Mindlin
+/// with restitution 0.6 and friction 0.3, settled under gravity, then the box moves as
+/// x = X sin(2π f t) with f = 20 Hz and X = 2 mm for `duration_s`.
+pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
+    let side = shaken_box_side_m(n);
+    let h = 0.040;
+    Scenario {
+        title: format!("shaken box, {n} spheres"),
+        simulation: SimulationSpec {
+            duration_s,
+            time_step_s: 2e-6,
+            integrator: Integrator::VelocityVerlet,
+            gravity_m_s2: [0.0, 0.0, -9.81],
+            seed: 1,
+            skin_m: Some(0.2e-3),
+            max_time_step_ratio: 0.1,
+            check_impact_velocity_m_s: 1.0,
+        },
+        output: OutputSpec {
+            energy_interval_s: 1e-3,
+            vtk_interval_s: 0.05,
+        },
+        materials: vec![Material::new("steel", 7800.0, 2e9, 0.3)],
+        contact: ContactSpec {
+            default: ContactModel {
+                normal: NormalLaw::HertzMindlin {
+                    restitution: 0.6,
+                    clip_attractive: false,
+                },
+                friction: FrictionLaw::Mindlin {
+                    friction_coefficient: 0.3,
+                },
+                rolling: None,
+                adhesion: None,
+            },
+            pairs: vec![],
+        },
+        bodies: vec![BodySpec {
+            name: "box".into(),
+            position_m: [0.0, 0.0, 0.0],
+            motion: MotionSpec::Harmonic(HarmonicTranslation {
+                direction: [1.0, 0.0, 0.0],
+                amplitude_m: 0.002,
+                frequency_hz: 20.0,
+                phase_rad: 0.0,
+            }),
+            walls: vec![WallSpec {
+                name: "container".into(),
+                material: "steel".into(),
+                geometry: GeometrySpec::BoxInside(BoxInside::new(
+                    Vec3::new(0.0, 0.0, 0.5 * h),
+                    Vec3::new(0.5 * side, 0.5 * side, 0.5 * h),
+                )),
+            }],
+        }],
+        particles: vec![ParticleGroupSpec {
+            material: "steel".into(),
+            count: n,
+            size: SizeDistribution::Monodisperse { radius_m: 1e-3 },
+            placement: PlacementSpec {
+                method: PlacementMethod::Tight,
+                region: Region::Box {
+                    min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
+                    max_m: Vec3::new(0.5 * side, 0.5 * side, h),
+                },
+                gap_m: 2e-5,
+                layer_height_m: None,
+            },
+            initial_velocity_m_s: [0.0; 3],
+        }],
+        settle: Some(SettleSpec {
+            max_duration_s: 0.05,
+            kinetic_energy_per_particle_j: 0.0,
+        }),
+    }
+}

@@ -1,0 +1,294 @@
+//! Running a scenario to files: settling, the main run, `energy.csv`, VTK snapshots with a
+//! `.pvd` series, and `summary.json`.
+
+use crate::csv::CsvWriter;
+use crate::scenario::Scenario;
+use crate::vtk::{PointField, PvdSeries, write_mesh_vtp, write_particles_vtp};
+use pdamp_dem::{Geometry, Motion, Vec3, World};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Column names of `energy.csv` (SI units in every name).
+pub const ENERGY_COLUMNS: [&str; 11] = [
+    "time_s",
+    "kinetic_j",
+    "potential_j",
+    "elastic_j",
+    "wall_work_j",
+    "dissipated_normal_j",
+    "dissipated_tangential_j",
+    "dissipated_normal_pp_j",
+    "dissipated_normal_pw_j",
+    "dissipated_tangential_pp_j",
+    "dissipated_tangential_pw_j",
+];
+
+/// What a run reports in `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunSummary {
+    /// pdamp version that produced the file.
+    pub pdamp_version: String,
+    /// Scenario title.
+    pub title: String,
+    /// Random seed.
+    pub seed: u64,
+    /// Number of particles.
+    pub particles: usize,
+    /// Simulated time of the main run, s.
+    pub simulated_time_s: f64,
+    /// Settling time before the main run, s.
+    pub settling_time_s: f64,
+    /// Accepted time steps (main run).
+    pub steps: u64,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// Particle time steps per wall-clock second.
+    pub particle_steps_per_s: f64,
+    /// Final energy ledger.
+    pub energy: pdamp_dem::EnergyLedger,
+    /// Total dissipated energy, J.
+    pub dissipated_j: f64,
+    /// Balance residual W_wall − (ΔE_kin + ΔE_pot + ΔE_el + D), J.
+    pub energy_closure_error_j: f64,
+    /// Residual relative to the wall work (or to the largest energy term).
+    pub energy_closure_relative: f64,
+    /// Largest particle–particle overlap relative to the smaller radius at the end.
+    pub max_relative_overlap: f64,
+    /// Mean particle–particle and particle–wall contacts at the end.
+    pub contacts_pp: usize,
+    /// Particle–wall contacts at the end.
+    pub contacts_pw: usize,
+    /// Height of the bed: twice the mean particle height above the lowest particle bottom, m.
+    pub bed_height_m: f64,
+}
+
+/// Twice the mean height of the particle centres above the lowest particle bottom, measured
+/// against gravity: a robust packing-height measure, m.
+pub fn bed_height_m(world: &World) -> f64 {
+    let p = &world.particles;
+    if p.is_empty() {
+        return 0.0;
+    }
+    let up = -world.gravity_m_s2;
+    let up = if up.norm() > 0.0 { up.normalize() } else { Vec3::z() };
+    let lo = (0..p.len()).map(|i| up.dot(&p.position[i]) - p.radius[i]).fold(f64::INFINITY, f64::min);
+    let mean = (0..p.len()).map(|i| up.dot(&p.position[i]) - lo).sum::<f64>() / p.len() as f64;
+    2.0 * mean
+}
+
+/// Lets settling run with all bodies held at their reference pose, then restarts the clock at
+/// zero (bodies get their motion back). Ends early below `ke_per_particle_j`.
+pub fn settle(world: &mut World, max_duration_s: f64, ke_per_particle_j: f64, mut tick: impl FnMut(f64)) -> f64 {
+    let motions: Vec<Motion> = world.bodies.iter().map(|b| b.motion.clone()).collect();
+    for b in world.bodies.iter_mut() {
+        if !matches!(b.motion, Motion::Driven) {
+            b.motion = Motion::Fixed;
+        }
+    }
+    let n = world.particles.len().max(1) as f64;
+    let check_every = 200u64;
+    while world.time_s < max_duration_s {
+        world.step();
+        if world.counters.steps % check_every == 0 {
+            tick(world.time_s / max_duration_s);
+            if world.ledger.kinetic_j / n < ke_per_particle_j {
+                break;
+            }
+        }
+    }
+    let t = world.time_s;
+    for (b, m) in world.bodies.iter_mut().zip(motions) {
+        b.motion = m;
+    }
+    world.restart_clock();
+    t
+}
+
+/// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
+pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> std::io::Result<PathBuf> {
+    let p = &world.particles;
+    let name = format!("particles_{index:06}.vtp");
+    let speed: Vec<f64> = p.velocity.iter().map(|v| v.norm()).collect();
+    let mat: Vec<u32> = p.material.iter().map(|&m| m as u32).collect();
+    let ids: Vec<u32> = p.id.clone();
+    write_particles_vtp(
+        &dir.join(&name),
+        &p.position,
+        &p.radius,
+        &[
+            ("velocity_m_s", PointField::Vector(&p.velocity)),
+            ("angular_velocity_rad_s", PointField::Vector(&p.angular_velocity)),
+            ("speed_m_s", PointField::Scalar(&speed)),
+            ("material", PointField::Int(&mat)),
+            ("id", PointField::Int(&ids)),
+        ],
+    )?;
+    for (bi, b) in world.bodies.iter().enumerate() {
+        for (wi, w) in b.walls.iter().enumerate() {
+            if let Some((verts, tris)) = wall_surface(&w.geometry) {
+                let world_verts: Vec<Vec3> = verts.iter().map(|v| b.state.point_to_world(v)).collect();
+                write_mesh_vtp(&dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")), &world_verts, &tris)?;
+            }
+        }
+    }
+    Ok(PathBuf::from(name))
+}
+
+/// A triangulated surface of a wall for display (boxes, cylinders, meshes; planes are skipped).
+pub fn wall_surface(g: &Geometry) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
+    match g {
+        Geometry::Mesh(m) => Some((m.vertices().to_vec(), m.faces().to_vec())),
+        Geometry::BoxInside(b) => {
+            let m = pdamp_dem::walls::TriMesh::box_inside(b.center_m, b.half_extents_m);
+            Some((m.vertices().to_vec(), m.faces().to_vec()))
+        }
+        Geometry::CylinderInside(c) => Some(cylinder_surface(c.base_center_m, c.axis, c.radius_m, c.length_m)),
+        Geometry::CylinderOutside(c) => Some(cylinder_surface(c.base_center_m, c.axis, c.radius_m, c.length_m)),
+        Geometry::Plane(_) => None,
+    }
+}
+
+fn cylinder_surface(base: Vec3, axis: Vec3, r: f64, l: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let a = axis.normalize();
+    let t = if a.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+    let u = a.cross(&t).normalize();
+    let v = a.cross(&u);
+    let k = 48;
+    let mut verts = Vec::new();
+    let mut tris = Vec::new();
+    for s in 0..k {
+        let ph = 2.0 * std::f64::consts::PI * s as f64 / k as f64;
+        let d = (u * ph.cos() + v * ph.sin()) * r;
+        verts.push(base + d);
+        verts.push(base + d + a * l);
+    }
+    verts.push(base);
+    verts.push(base + a * l);
+    let (cb, ct) = (2 * k as u32, 2 * k as u32 + 1);
+    for s in 0..k as u32 {
+        let n = (s + 1) % k as u32;
+        tris.push([2 * s, 2 * n, 2 * s + 1]);
+        tris.push([2 * n, 2 * n + 1, 2 * s + 1]);
+        tris.push([cb, 2 * n, 2 * s]);
+        tris.push([ct, 2 * s + 1, 2 * n + 1]);
+    }
+    (verts, tris)
+}
+
+fn ledger_row(w: &World) -> Vec<f64> {
+    let l = &w.ledger;
+    vec![
+        w.time_s,
+        l.kinetic_j,
+        l.potential_j,
+        l.elastic_j,
+        l.wall_work_j,
+        l.dissipated_normal_j(),
+        l.dissipated_tangential_j(),
+        l.dissipated_normal_pp_j,
+        l.dissipated_normal_pw_j,
+        l.dissipated_tangential_pp_j,
+        l.dissipated_tangential_pw_j,
+    ]
+}
+
+/// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
+/// `progress(phase, fraction)` is called regularly.
+pub fn run_scenario(
+    scenario: &Scenario,
+    base_dir: &Path,
+    out_dir: &Path,
+    mut progress: impl FnMut(&str, f64),
+) -> Result<RunSummary, String> {
+    let io = |e: std::io::Error| format!("output: {e}");
+    let mut world = scenario.build_world(base_dir)?;
+    std::fs::create_dir_all(out_dir).map_err(io)?;
+    crate::atomic::write_atomic(&out_dir.join("scenario.toml"), scenario.to_toml().as_bytes()).map_err(io)?;
+    let settle_t = match &scenario.settle {
+        Some(s) => settle(&mut world, s.max_duration_s, s.kinetic_energy_per_particle_j, |f| progress("settling", f)),
+        None => 0.0,
+    };
+    world.initialize();
+    let vtk_dir = out_dir.join("vtk");
+    let vtk_every = scenario.output.vtk_interval_s;
+    let mut series = if vtk_every > 0.0 {
+        std::fs::create_dir_all(&vtk_dir).map_err(io)?;
+        Some(PvdSeries::new(out_dir.join("particles.pvd"), "vtk"))
+    } else {
+        None
+    };
+    let mut csv = CsvWriter::create(&out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(io)?;
+    csv.write_row(&ledger_row(&world)).map_err(io)?;
+    let mut snap = 0usize;
+    if let Some(s) = series.as_mut() {
+        let f = write_snapshot(&world, &vtk_dir, snap).map_err(io)?;
+        s.add(world.time_s, &f).map_err(io)?;
+        snap += 1;
+    }
+    let t_end = scenario.simulation.duration_s;
+    let e_every = scenario.output.energy_interval_s;
+    let (mut next_e, mut next_v) = (e_every, vtk_every);
+    let start = std::time::Instant::now();
+    let steps0 = world.counters.steps;
+    let mut err: Option<String> = None;
+    world.run_until(t_end, |w| {
+        if err.is_some() {
+            return;
+        }
+        if w.time_s >= next_e - 1e-12 {
+            if let Err(e) = csv.write_row(&ledger_row(w)) {
+                err = Some(format!("output: {e}"));
+            }
+            next_e += e_every;
+            progress("running", w.time_s / t_end);
+        }
+        if let Some(s) = series.as_mut() {
+            if w.time_s >= next_v - 1e-12 {
+                match write_snapshot(w, &vtk_dir, snap) {
+                    Ok(f) => {
+                        let _ = s.add(w.time_s, &f);
+                    }
+                    Err(e) => err = Some(format!("output: {e}")),
+                }
+                snap += 1;
+                next_v += vtk_every;
+            }
+        }
+    });
+    if let Some(e) = err {
+        return Err(e);
+    }
+    csv.flush().map_err(io)?;
+    let wall = start.elapsed().as_secs_f64();
+    let steps = world.counters.steps - steps0;
+    let l = world.ledger;
+    let scale = l
+        .wall_work_j
+        .abs()
+        .max((l.kinetic_j - l.initial_kinetic_j).abs())
+        .max((l.potential_j - l.initial_potential_j).abs())
+        .max(l.dissipated_j().abs())
+        .max(1e-300);
+    let summary = RunSummary {
+        pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+        title: scenario.title.clone(),
+        seed: scenario.simulation.seed,
+        particles: world.particles.len(),
+        simulated_time_s: world.time_s,
+        settling_time_s: settle_t,
+        steps,
+        wall_time_s: wall,
+        particle_steps_per_s: steps as f64 * world.particles.len() as f64 / wall.max(1e-12),
+        energy: l,
+        dissipated_j: l.dissipated_j(),
+        energy_closure_error_j: l.closure_error_j(),
+        energy_closure_relative: l.closure_error_j() / scale,
+        max_relative_overlap: world.max_relative_overlap(),
+        contacts_pp: world.num_pp_contacts(),
+        contacts_pw: world.num_pw_contacts(),
+        bed_height_m: bed_height_m(&world),
+    };
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    crate::atomic::write_atomic(&out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
+    Ok(summary)
+}
