@@ -1,0 +1,85 @@
+//! Shared set-ups of the verification tests.
+#![allow(dead_code)]
+
+use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
+use pdamp_dem::generate::{Region, random_insertion, tight_packing};
+use pdamp_dem::walls::{BoxInside, Geometry, TriMesh};
+use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
+use rand::{RngExt, SeedableRng};
+
+/// Soft steel-like material used in the bulk tests.
+pub fn soft_steel() -> Material {
+    Material::new("steel", 7800.0, 2e9, 0.3)
+}
+
+/// A world with particles of radius `r` randomly inserted in a closed box of `side` × `side` ×
+/// `height` (the box's floor at z = 0), with the given container geometry (analytic or mesh).
+pub fn box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, dt: f64, mesh: bool, seed: u64) -> World {
+    let mut w = World::new(vec![soft_steel()], model, dt);
+    let c = Vec3::new(0.0, 0.0, 0.5 * height);
+    let h = Vec3::new(0.5 * side, 0.5 * side, 0.5 * height);
+    let geometry = if mesh {
+        Geometry::Mesh(TriMesh::box_inside(c, h))
+    } else {
+        Geometry::BoxInside(BoxInside::new(c, h))
+    };
+    w.add_body(RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall("box", geometry, 0));
+    let region = Region::Box {
+        min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
+        max_m: Vec3::new(0.5 * side, 0.5 * side, height),
+    };
+    let radii = vec![r; n];
+    let pos = random_insertion(&region, &radii, seed, 10_000, None).expect("insertion");
+    for x in pos {
+        w.add_particle(x, r, 0);
+    }
+    w
+}
+
+/// Random velocities of magnitude up to `vmax` (deterministic).
+pub fn randomize_velocities(w: &mut World, vmax: f64, seed: u64) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    for v in w.particles.velocity.iter_mut() {
+        *v = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5) * (2.0 * vmax);
+    }
+}
+
+/// Hertz–Mindlin with friction, the LIGGGHTS-style default model.
+pub fn hertz_mindlin(e: f64, mu: f64) -> ContactModel {
+    ContactModel {
+        normal: NormalLaw::HertzMindlin {
+            restitution: e,
+            clip_attractive: false,
+        },
+        friction: FrictionLaw::Mindlin { friction_coefficient: mu },
+        rolling: None,
+        adhesion: None,
+    }
+}
+
+/// Particles in hexagonal close packing in a box region above the floor.
+pub fn tight_box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, dt: f64) -> World {
+    let mut w = World::new(vec![soft_steel()], model, dt);
+    let c = Vec3::new(0.0, 0.0, 0.5 * height);
+    let h = Vec3::new(0.5 * side, 0.5 * side, 0.5 * height);
+    w.add_body(RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+        "box",
+        Geometry::BoxInside(BoxInside::new(c, h)),
+        0,
+    ));
+    let region = Region::Box {
+        min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
+        max_m: Vec3::new(0.5 * side, 0.5 * side, height),
+    };
+    let pos = tight_packing(&region, &vec![r; n], 0.02 * r, &Vec3::z()).expect("packing");
+    for x in pos {
+        w.add_particle(x, r, 0);
+    }
+    w
+}
+
+/// Twice the mean centre height above the floor (z = 0): the packing height measure, m.
+pub fn bed_height(w: &World) -> f64 {
+    let p = &w.particles;
+    2.0 * p.position.iter().map(|x| x.z).sum::<f64>() / p.len() as f64
+}
