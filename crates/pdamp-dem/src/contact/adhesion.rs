@@ -34,7 +34,7 @@ impl DmtAdhesion {
     #[inline]
     pub(crate) fn force_and_potential(&self, p: &PairProps, overlap_m: f64) -> (f64, f64) {
         let fs0 = self.pull_off_force_n(p);
-        if !(fs0 > 0.0) {
+        if fs0.is_nan() || fs0 <= 0.0 {
             return (0.0, 0.0);
         }
         let ar6 = self.hamaker_constant_j * p.r_eff_m / 6.0;
