@@ -935,3 +935,84 @@ fn validation_messages_name_the_field() {
     m.adhesion = Some(dmt());
     assert!(m.validate().is_ok());
 }
+
+#[test]
+fn gap_range_gives_only_adhesion_and_degenerate_inputs_do_not_panic() {
+    let p = steel_pair(10e-6, false);
+    let mut m = model(NormalLaw::HertzMindlin {
+        restitution: 0.5,
+        clip_attractive: false,
+    });
+    m.friction = FrictionLaw::Mindlin {
+        friction_coefficient: 0.3,
+    };
+    m.rolling = Some(RollingResistance {
+        coefficient: 0.1,
+        regularization_s: 1.0,
+    });
+    m.adhesion = Some(dmt());
+    let g0 = dmt().saturation_gap_m(&p);
+    let mut h = ContactHistory {
+        spring_m: Vec3::new(1e-9, 0.0, 0.0),
+        impact_velocity_m_s: 0.2,
+    };
+    let mut k = tangential_kin(-2.0 * g0, Vec3::new(0.1, 0.0, 0.0), 1e-8);
+    k.relative_angular_velocity_rad_s = Vec3::new(0.0, 5.0, 0.0);
+    k.overlap_rate_m_s = 0.3;
+    let f = m.evaluate(&p, &k, &mut h);
+    assert_eq!(h, ContactHistory::default());
+    assert!(f.normal_elastic_n < 0.0);
+    assert_eq!(f.normal_dissipative_n, 0.0);
+    assert_eq!(f.tangential_n, Vec3::zeros());
+    assert_eq!(f.rolling_torque_nm, Vec3::zeros());
+    assert_eq!(f.tangential_energy_j, 0.0);
+    // Zero velocities, zero time step, zero overlap: finite results for every law combination.
+    for normal in all_normal_laws() {
+        for friction in [
+            FrictionLaw::Frictionless,
+            FrictionLaw::RegularizedSliding {
+                friction_coefficient: 0.3,
+                regularization_s_m: 10.0,
+            },
+            FrictionLaw::CoulombSpring {
+                friction_coefficient: 0.3,
+                stiffness_ratio: None,
+                damping_ratio: 1.0,
+            },
+            FrictionLaw::Mindlin {
+                friction_coefficient: 0.3,
+            },
+        ] {
+            let m = ContactModel {
+                normal: normal.clone(),
+                friction,
+                rolling: m.rolling.clone(),
+                adhesion: None,
+            };
+            for (d, v) in [(0.0, 0.0), (1e-12, 0.0), (1e-9, -1.0), (1e-6, 0.0)] {
+                let mut h = ContactHistory::default();
+                let f = m.evaluate(
+                    &p,
+                    &ContactKinematics {
+                        dt_s: 0.0,
+                        ..kin(d, v)
+                    },
+                    &mut h,
+                );
+                let all = [
+                    f.normal_elastic_n,
+                    f.normal_dissipative_n,
+                    f.normal_energy_j,
+                    f.tangential_energy_j,
+                ];
+                assert!(all.iter().all(|x| x.is_finite()), "{:?}: {f:?}", m.normal);
+                assert!(
+                    f.tangential_n
+                        .iter()
+                        .chain(f.rolling_torque_nm.iter())
+                        .all(|x| x.is_finite())
+                );
+            }
+        }
+    }
+}
