@@ -11,10 +11,13 @@
 use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
+mod adhesion;
 mod friction;
 pub mod hertz;
 mod model;
 mod normal;
+#[cfg(test)]
+mod tests;
 
 pub use model::*;
 
