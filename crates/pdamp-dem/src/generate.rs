@@ -117,12 +117,13 @@ impl SizeDistribution {
                 if let Some(r) = max_radius_m {
                     positive("max_radius_m", r)?;
                 }
-                if let (Some(lo), Some(hi)) = (min_radius_m, max_radius_m)
-                    && lo >= hi
-                {
-                    return Err(format!(
-                        "size distribution: min_radius_m ({lo}) must be below max_radius_m ({hi})"
-                    ));
+                match (min_radius_m, max_radius_m) {
+                    (Some(lo), Some(hi)) if lo >= hi => {
+                        return Err(format!(
+                            "size distribution: min_radius_m ({lo}) must be below max_radius_m ({hi})"
+                        ));
+                    }
+                    _ => {}
                 }
                 let r50 = 0.5 * median_diameter_m;
                 if sigma == 0.0 {

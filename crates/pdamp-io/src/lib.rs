@@ -4,5 +4,6 @@
 //! Every output file is written atomically (write to a temporary file, then rename).
 
 pub mod atomic;
+pub mod csv;
 pub mod stl;
 pub mod vtk;
