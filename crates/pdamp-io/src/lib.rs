@@ -4,6 +4,7 @@
 //! Every output file is written atomically (write to a temporary file, then rename).
 
 pub mod atomic;
+pub mod csv;
 pub mod stl;
 pub mod vtk;
 pub mod scenario;
