@@ -105,7 +105,7 @@ pub fn settle(world: &mut World, max_duration_s: f64, ke_per_particle_j: f64, mu
 }
 
 /// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
-pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> std::io::Result<PathBuf> {
+pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> Result<PathBuf, crate::vtk::VtkError> {
     let p = &world.particles;
     let name = format!("particles_{index:06}.vtp");
     let speed: Vec<f64> = p.velocity.iter().map(|v| v.norm()).collect();
@@ -131,7 +131,7 @@ pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> std::io::Resul
             }
         }
     }
-    Ok(PathBuf::from(name))
+    Ok(PathBuf::from("vtk").join(name))
 }
 
 /// A triangulated surface of a wall for display (boxes, cylinders, meshes; planes are skipped).
@@ -213,16 +213,17 @@ pub fn run_scenario(
     let vtk_every = scenario.output.vtk_interval_s;
     let mut series = if vtk_every > 0.0 {
         std::fs::create_dir_all(&vtk_dir).map_err(io)?;
-        Some(PvdSeries::new(out_dir.join("particles.pvd"), "vtk"))
+        Some(PvdSeries::new(out_dir.join("particles.pvd")))
     } else {
         None
     };
-    let mut csv = CsvWriter::create(&out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(io)?;
-    csv.write_row(&ledger_row(&world)).map_err(io)?;
+    let csvio = |e: crate::csv::CsvError| format!("output: {e}");
+    let mut csv = CsvWriter::create(out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(csvio)?;
+    csv.write_row(&ledger_row(&world)).map_err(csvio)?;
     let mut snap = 0usize;
     if let Some(s) = series.as_mut() {
-        let f = write_snapshot(&world, &vtk_dir, snap).map_err(io)?;
-        s.add(world.time_s, &f).map_err(io)?;
+        let f = write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
+        s.add(world.time_s, f.to_string_lossy()).map_err(|e| e.to_string())?;
         snap += 1;
     }
     let t_end = scenario.simulation.duration_s;
@@ -246,7 +247,7 @@ pub fn run_scenario(
             if w.time_s >= next_v - 1e-12 {
                 match write_snapshot(w, &vtk_dir, snap) {
                     Ok(f) => {
-                        let _ = s.add(w.time_s, &f);
+                        let _ = s.add(w.time_s, f.to_string_lossy());
                     }
                     Err(e) => err = Some(format!("output: {e}")),
                 }
@@ -258,7 +259,7 @@ pub fn run_scenario(
     if let Some(e) = err {
         return Err(e);
     }
-    csv.flush().map_err(io)?;
+    csv.flush().map_err(csvio)?;
     let wall = start.elapsed().as_secs_f64();
     let steps = world.counters.steps - steps0;
     let l = world.ledger;
