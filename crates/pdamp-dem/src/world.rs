@@ -120,6 +120,11 @@ impl World {
         self.wall_slots.iter().map(|s| s.len()).sum()
     }
 
+    /// Number of wall contacts of particle `i` at the last evaluation.
+    pub fn num_wall_contacts_of(&self, i: usize) -> usize {
+        self.wall_slots.get(i).map_or(0, |s| s.len())
+    }
+
     /// Largest overlap relative to the smaller radius over all particle–particle contacts.
     pub fn max_relative_overlap(&self) -> f64 {
         let p = &self.particles;
