@@ -43,7 +43,7 @@ fn walls_mesh_welding_cube_topology() {
     assert_eq!(m.num_triangles(), 12);
     // Every edge of a closed mesh has exactly two triangles.
     for e in 0..m.num_edges() {
-        assert_eq!(m.edge_tri_start[e + 1] - m.edge_tri_start[e], 2);
+        assert_eq!(m.d.edge_tri_start[e + 1] - m.d.edge_tri_start[e], 2);
     }
     // Near-duplicates within 1e-9 of the diagonal are welded too (1e-12 relative jitter).
     let mut rng = ChaCha8Rng::seed_from_u64(7);
