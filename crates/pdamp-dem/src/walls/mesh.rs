@@ -16,10 +16,13 @@
 //!
 //! Triangles are **one-sided**: a triangle produces a face contact only for a sphere centre in
 //! front of it or behind it by less than the radius ($-r < s$, $s$ the signed distance to the
-//! triangle plane), then with the plane overlap $r - s$ of [D Eq. 2.17–2.18]; edge and vertex
-//! contacts require the centre to be on the front side ($s \ge 0$) of at least one triangle that
-//! contains the edge or vertex. Centres further behind are ignored (a tunnelled particle is not
-//! pulled back through the wall).
+//! triangle plane), then with the plane overlap $r - s$ of [D Eq. 2.17–2.18], so a penetrating
+//! particle is pushed back to the front. An edge or vertex contact requires the centre to be on
+//! the front side ($s \ge 0$) of at least one triangle containing the edge or vertex, or to lie
+//! (within the tolerance band) straight above/below it in the plane of such a triangle with
+//! $s > -r$ (then it is that plane's contact, see below). Centres further behind are ignored (a
+//! tunnelled particle is not pulled back through the wall, and a particle that escaped behind a
+//! concave container edge is not pushed further out).
 //!
 //! # Contact detection without double counting
 //!
@@ -50,9 +53,17 @@
 //! continuous when sliding across; a sphere over a fine mesh does not collect extra contacts
 //! from edges of triangles it merely overlaps; at convex edges and corners the contact switches
 //! face → edge → face (or vertex) continuously with the normal from the closest point; at concave
-//! edges every face within reach acts (as for the analytic containers). The tolerance band
-//! $\tau$ only changes which feature id is reported, never the overlap; inside the band an edge
-//! contact's normal deviates by at most $\sim\tau h/d$ from the face normal.
+//! edges every face within reach acts (as for the analytic containers).
+//!
+//! The tolerance band $\tau$ makes the classification robust against rounding (without it a
+//! centre exactly above a shared edge could be "inside" both triangles): an edge or vertex
+//! contact whose centre projects into the closed band of an adjacent triangle ($-\tau \le$
+//! barycentric coordinates) uses that triangle's plane — normal $\mathbf n_l$ and overlap
+//! $r - s$ — instead of the closest point computed from the edge, so on coplanar triangles the
+//! overlap and normal are identical to the face contacts (to rounding), only the feature id
+//! differs. Inside the band this deviates from the exact closest point by at most
+//! $\sim\tau h/s$ in the normal ($h$ the triangle height). The band's corner at an obtuse
+//! triangle vertex can leave a sliver of relative area $O(\tau^2)$ without contact.
 //!
 //! Feature ids: faces `0..F`, edges `F..F+E`, vertices `F+E..F+E+V`. Curvature radius ∞
 //! [D Eq. 2.73] for all of them.
@@ -609,14 +620,12 @@ impl TriMesh {
                 return None;
             }
             let sd = self.signed(tri as usize, x);
-            if sd >= 0.0 {
-                front = true;
-                if b >= -FEATURE_TOL && snap.is_none() {
-                    snap = Some((tri as usize, sd));
-                }
+            front |= sd >= 0.0;
+            if snap.is_none() && b >= -FEATURE_TOL && sd > -r {
+                snap = Some((tri as usize, sd));
             }
         }
-        if !front {
+        if !front && snap.is_none() {
             return None;
         }
         Some(match snap {
@@ -691,14 +700,15 @@ impl TriMesh {
         let mut snap = None;
         for &t in ts {
             let sd = self.signed(t as usize, x);
-            if sd >= 0.0 {
-                front = true;
-                if snap.is_none() && (0..3).all(|i| self.bary(t as usize, i, x) >= -FEATURE_TOL) {
-                    snap = Some((t as usize, sd));
-                }
+            front |= sd >= 0.0;
+            if snap.is_none()
+                && sd > -r
+                && (0..3).all(|i| self.bary(t as usize, i, x) >= -FEATURE_TOL)
+            {
+                snap = Some((t as usize, sd));
             }
         }
-        if !front {
+        if !front && snap.is_none() {
             return None;
         }
         Some(match snap {

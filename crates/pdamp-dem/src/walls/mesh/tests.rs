@@ -250,6 +250,19 @@ fn walls_mesh_coplanar_sliding_is_constant() {
     assert_eq!(cs.len(), 1);
     assert!((cs[0].overlap_m - (r + 0.1)).abs() < TOL);
     assert!((cs[0].normal - n).norm() < TOL);
+    // Behind by less than r exactly under the interior vertex and a shared edge: still the
+    // plane contact (continuous with the face contacts around).
+    for local in [
+        Vec3::new(1.0, 1.0, -0.1),
+        Vec3::new(1.0, 0.6, -0.1),
+        Vec3::new(0.5, 0.5, -0.1),
+    ] {
+        let x = rot * local + shift;
+        let cs = contacts(&m, &x, r, 0.0);
+        assert_eq!(cs.len(), 1, "{local:?}: {cs:?}");
+        assert!((cs[0].overlap_m - (r + 0.1)).abs() < TOL);
+        assert!((cs[0].normal - n).norm() < TOL);
+    }
     // Further behind than r: nothing.
     let x = rot * Vec3::new(0.6, 0.3, -0.31) + shift;
     assert!(contacts(&m, &x, r, 0.0).is_empty());
