@@ -68,9 +68,10 @@ fn default_true() -> bool {
 
 impl CylSpec {
     fn check(&self) -> Result<Vec3, String> {
-        if !self.base_center_m.iter().all(|c| c.is_finite())
-            || !(self.radius_m.is_finite() && self.radius_m > 0.0)
-            || !(self.length_m.is_finite() && self.length_m > 0.0)
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !(self.base_center_m.iter().all(|c| c.is_finite())
+            && positive(self.radius_m)
+            && positive(self.length_m))
         {
             return Err(format!(
                 "cylinder needs a finite base centre and positive radius/length, got {:?}, {}, {}",

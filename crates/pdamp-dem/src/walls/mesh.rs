@@ -16,10 +16,13 @@
 //!
 //! Triangles are **one-sided**: a triangle produces a face contact only for a sphere centre in
 //! front of it or behind it by less than the radius ($-r < s$, $s$ the signed distance to the
-//! triangle plane), then with the plane overlap $r - s$ of [D Eq. 2.17–2.18]; edge and vertex
-//! contacts require the centre to be on the front side ($s \ge 0$) of at least one triangle that
-//! contains the edge or vertex. Centres further behind are ignored (a tunnelled particle is not
-//! pulled back through the wall).
+//! triangle plane), then with the plane overlap $r - s$ of [D Eq. 2.17–2.18], so a penetrating
+//! particle is pushed back to the front. An edge or vertex contact requires the centre to be on
+//! the front side ($s \ge 0$) of at least one triangle containing the edge or vertex, or to lie
+//! (within the tolerance band) straight above/below it in the plane of such a triangle with
+//! $s > -r$ (then it is that plane's contact, see below). Centres further behind are ignored (a
+//! tunnelled particle is not pulled back through the wall, and a particle that escaped behind a
+//! concave container edge is not pushed further out).
 //!
 //! # Contact detection without double counting
 //!
@@ -50,9 +53,17 @@
 //! continuous when sliding across; a sphere over a fine mesh does not collect extra contacts
 //! from edges of triangles it merely overlaps; at convex edges and corners the contact switches
 //! face → edge → face (or vertex) continuously with the normal from the closest point; at concave
-//! edges every face within reach acts (as for the analytic containers). The tolerance band
-//! $\tau$ only changes which feature id is reported, never the overlap; inside the band an edge
-//! contact's normal deviates by at most $\sim\tau h/d$ from the face normal.
+//! edges every face within reach acts (as for the analytic containers).
+//!
+//! The tolerance band $\tau$ makes the classification robust against rounding (without it a
+//! centre exactly above a shared edge could be "inside" both triangles): an edge or vertex
+//! contact whose centre projects into the closed band of an adjacent triangle ($-\tau \le$
+//! barycentric coordinates) uses that triangle's plane — normal $\mathbf n_l$ and overlap
+//! $r - s$ — instead of the closest point computed from the edge, so on coplanar triangles the
+//! overlap and normal are identical to the face contacts (to rounding), only the feature id
+//! differs. Inside the band this deviates from the exact closest point by at most
+//! $\sim\tau h/s$ in the normal ($h$ the triangle height). The band's corner at an obtuse
+//! triangle vertex can leave a sliver of relative area $O(\tau^2)$ without contact.
 //!
 //! Feature ids: faces `0..F`, edges `F..F+E`, vertices `F+E..F+E+V`. Curvature radius ∞
 //! [D Eq. 2.73] for all of them.
@@ -68,6 +79,7 @@ use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// Tolerance of the barycentric / edge-parameter feature classification (dimensionless).
 const FEATURE_TOL: f64 = 1e-12;
@@ -164,6 +176,12 @@ struct TriMeshData {
 pub struct TriMesh {
     vertices: Vec<Vec3>,
     faces: Vec<[u32; 3]>,
+    /// Derived data (shared between clones; rebuilt when the geometry changes).
+    d: Arc<Derived>,
+}
+
+/// Topology, per-triangle data and the grid of a [`TriMesh`].
+struct Derived {
     tris: Vec<Tri>,
     edges: Vec<Edge>,
     /// CSR: triangles (with local edge index) adjacent to each edge.
@@ -183,8 +201,8 @@ impl std::fmt::Debug for TriMesh {
         f.debug_struct("TriMesh")
             .field("vertices", &self.vertices.len())
             .field("triangles", &self.faces.len())
-            .field("edges", &self.edges.len())
-            .field("bounding_box", &self.bbox)
+            .field("edges", &self.d.edges.len())
+            .field("bounding_box", &self.d.bbox)
             .finish()
     }
 }
@@ -346,7 +364,11 @@ impl TriMesh {
                 .max((p[2] - p[1]).norm_squared())
                 .max((p[0] - p[2]).norm_squared());
             let area2 = c.norm();
-            if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(area2 > 1e-14 * lmax2) {
+            if f[0] == f[1]
+                || f[1] == f[2]
+                || f[0] == f[2]
+                || area2.partial_cmp(&(1e-14 * lmax2)) != Some(std::cmp::Ordering::Greater)
+            {
                 return Err(MeshError::Degenerate { triangle: t });
             }
             let n = c / area2;
@@ -384,16 +406,18 @@ impl TriMesh {
         Ok(TriMesh {
             vertices,
             faces,
-            tris,
-            edges,
-            edge_tri_start,
-            edge_tris,
-            vert_edge_start,
-            vert_edges,
-            vert_tri_start,
-            vert_tris,
-            bbox,
-            grid,
+            d: Arc::new(Derived {
+                tris,
+                edges,
+                edge_tri_start,
+                edge_tris,
+                vert_edge_start,
+                vert_edges,
+                vert_tri_start,
+                vert_tris,
+                bbox,
+                grid,
+            }),
         })
     }
 
@@ -465,7 +489,7 @@ impl TriMesh {
 
     /// Number of distinct edges `E`.
     pub fn num_edges(&self) -> usize {
-        self.edges.len()
+        self.d.edges.len()
     }
 
     /// Number of welded vertices `V`.
@@ -475,23 +499,23 @@ impl TriMesh {
 
     /// Unit normal of triangle `t` [D Eq. 2.42].
     pub fn triangle_normal(&self, t: usize) -> Vec3 {
-        self.tris[t].n
+        self.d.tris[t].n
     }
 
     /// Global edge ids of triangle `t` (local edges v0v1, v1v2, v2v0); the edge's feature id
     /// is `num_triangles() + id`.
     pub fn triangle_edges(&self, t: usize) -> [u32; 3] {
-        self.tris[t].e
+        self.d.tris[t].e
     }
 
     /// Vertex ids `(a, b)` (a < b) of edge `e`.
     pub fn edge_vertices(&self, e: usize) -> (u32, u32) {
-        (self.edges[e].a, self.edges[e].b)
+        (self.d.edges[e].a, self.d.edges[e].b)
     }
 
     /// Axis-aligned bounding box `(min, max)` of the vertices (always `Some`).
     pub fn bounding_box(&self) -> Option<(Vec3, Vec3)> {
-        Some(self.bbox)
+        Some(self.d.bbox)
     }
 
     /// Barycentric coordinate of the vertex opposite local edge `i` of triangle `t` at `x`
@@ -499,20 +523,20 @@ impl TriMesh {
     #[inline]
     fn bary(&self, t: usize, i: usize, x: &Vec3) -> f64 {
         let v = self.vertices[self.faces[t][i] as usize];
-        (x - v).dot(&self.tris[t].g[i])
+        (x - v).dot(&self.d.tris[t].g[i])
     }
 
     /// Signed distance of `x` in front of triangle `t`'s plane [D Eq. 2.17].
     #[inline]
     fn signed(&self, t: usize, x: &Vec3) -> f64 {
         let v = self.vertices[self.faces[t][0] as usize];
-        (x - v).dot(&self.tris[t].n)
+        (x - v).dot(&self.d.tris[t].n)
     }
 
     /// Canonical edge parameter of `x` on edge `e` (0 at `a`, 1 at `b`).
     #[inline]
     fn edge_t(&self, e: usize, x: &Vec3) -> f64 {
-        let ed = &self.edges[e];
+        let ed = &self.d.edges[e];
         let a = self.vertices[ed.a as usize];
         let d = self.vertices[ed.b as usize] - a;
         (x - a).dot(&d) * ed.inv_len2
@@ -523,7 +547,7 @@ impl TriMesh {
     /// Does not allocate once the thread-local scratch and `out` are warm.
     pub fn sphere_contacts(&self, x: &Vec3, r: f64, margin: f64, out: &mut Vec<WallContact>) {
         let reach = r + margin;
-        if !(reach > 0.0) || !x.iter().all(|c| c.is_finite()) {
+        if reach.is_nan() || reach <= 0.0 || !x.iter().all(|c| c.is_finite()) {
             return;
         }
         SCRATCH.with(|s| {
@@ -532,11 +556,11 @@ impl TriMesh {
             s.tris.clear();
             s.edges.clear();
             s.verts.clear();
-            self.grid.query(x, reach, &mut s.tris);
+            self.d.grid.query(x, reach, &mut s.tris);
             s.tris.sort_unstable();
             s.tris.dedup();
             let nf = self.faces.len() as u32;
-            let ne = self.edges.len() as u32;
+            let ne = self.d.edges.len() as u32;
             for &t in &s.tris {
                 let t = t as usize;
                 let sd = self.signed(t, x);
@@ -545,19 +569,12 @@ impl TriMesh {
                 }
                 let b = [self.bary(t, 0, x), self.bary(t, 1, x), self.bary(t, 2, x)];
                 if b.iter().all(|&bi| bi > FEATURE_TOL) {
-                    let n = self.tris[t].n;
-                    out.push(WallContact {
-                        overlap_m: r - sd,
-                        normal: n,
-                        point: x - n * sd,
-                        curvature_radius_m: f64::INFINITY,
-                        feature: t as u32,
-                    });
+                    out.push(self.plane_contact(t, x, r, sd));
                     continue;
                 }
-                for i in 0..3 {
-                    if b[i] <= FEATURE_TOL {
-                        let e = self.tris[t].e[i];
+                for (i, &bi) in b.iter().enumerate() {
+                    if bi <= FEATURE_TOL {
+                        let e = self.d.tris[t].e[i];
                         if !s.edges.contains(&e) {
                             s.edges.push(e);
                         }
@@ -593,8 +610,8 @@ impl TriMesh {
         if !(t > FEATURE_TOL && t < 1.0 - FEATURE_TOL) {
             return None;
         }
-        let adj =
-            &self.edge_tris[self.edge_tri_start[e] as usize..self.edge_tri_start[e + 1] as usize];
+        let adj = &self.d.edge_tris
+            [self.d.edge_tri_start[e] as usize..self.d.edge_tri_start[e + 1] as usize];
         let mut front = false;
         let mut snap = None;
         for &(tri, i) in adj {
@@ -603,14 +620,12 @@ impl TriMesh {
                 return None;
             }
             let sd = self.signed(tri as usize, x);
-            if sd >= 0.0 {
-                front = true;
-                if b >= -FEATURE_TOL && snap.is_none() {
-                    snap = Some((tri as usize, sd));
-                }
+            front |= sd >= 0.0;
+            if snap.is_none() && b >= -FEATURE_TOL && sd > -r {
+                snap = Some((tri as usize, sd));
             }
         }
-        if !front {
+        if !front && snap.is_none() {
             return None;
         }
         Some(match snap {
@@ -619,7 +634,7 @@ impl TriMesh {
             Some((tri, sd)) => self.plane_contact(tri, x, r, sd),
             None => {
                 // x - q with q on the edge, measured from the nearer end point (accuracy).
-                let ed = &self.edges[e];
+                let ed = &self.d.edges[e];
                 let (pa, pb) = (self.vertices[ed.a as usize], self.vertices[ed.b as usize]);
                 let d = pb - pa;
                 let v = if t <= 0.5 {
@@ -631,7 +646,7 @@ impl TriMesh {
                 let normal = if dist > 0.0 {
                     v / dist
                 } else {
-                    self.tris[adj[0].0 as usize].n
+                    self.d.tris[adj[0].0 as usize].n
                 };
                 WallContact {
                     overlap_m: r - dist,
@@ -648,7 +663,7 @@ impl TriMesh {
     /// Face-type contact with the plane of triangle `t` at signed distance `sd`.
     #[inline]
     fn plane_contact(&self, t: usize, x: &Vec3, r: f64, sd: f64) -> WallContact {
-        let n = self.tris[t].n;
+        let n = self.d.tris[t].n;
         WallContact {
             overlap_m: r - sd,
             normal: n,
@@ -666,11 +681,11 @@ impl TriMesh {
         if d >= reach {
             return None;
         }
-        let es = &self.vert_edges
-            [self.vert_edge_start[vi] as usize..self.vert_edge_start[vi + 1] as usize];
+        let es = &self.d.vert_edges
+            [self.d.vert_edge_start[vi] as usize..self.d.vert_edge_start[vi + 1] as usize];
         for &e in es {
             let t = self.edge_t(e as usize, x);
-            let behind = if self.edges[e as usize].a as usize == vi {
+            let behind = if self.d.edges[e as usize].a as usize == vi {
                 t <= FEATURE_TOL
             } else {
                 t >= 1.0 - FEATURE_TOL
@@ -679,20 +694,21 @@ impl TriMesh {
                 return None;
             }
         }
-        let ts =
-            &self.vert_tris[self.vert_tri_start[vi] as usize..self.vert_tri_start[vi + 1] as usize];
+        let ts = &self.d.vert_tris
+            [self.d.vert_tri_start[vi] as usize..self.d.vert_tri_start[vi + 1] as usize];
         let mut front = false;
         let mut snap = None;
         for &t in ts {
             let sd = self.signed(t as usize, x);
-            if sd >= 0.0 {
-                front = true;
-                if snap.is_none() && (0..3).all(|i| self.bary(t as usize, i, x) >= -FEATURE_TOL) {
-                    snap = Some((t as usize, sd));
-                }
+            front |= sd >= 0.0;
+            if snap.is_none()
+                && sd > -r
+                && (0..3).all(|i| self.bary(t as usize, i, x) >= -FEATURE_TOL)
+            {
+                snap = Some((t as usize, sd));
             }
         }
-        if !front {
+        if !front && snap.is_none() {
             return None;
         }
         Some(match snap {
@@ -704,7 +720,7 @@ impl TriMesh {
                 normal: if d > 0.0 {
                     v / d
                 } else {
-                    self.tris[ts[0] as usize].n
+                    self.d.tris[ts[0] as usize].n
                 },
                 point: p,
                 curvature_radius_m: f64::INFINITY,

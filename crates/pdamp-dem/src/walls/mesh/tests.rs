@@ -43,7 +43,7 @@ fn walls_mesh_welding_cube_topology() {
     assert_eq!(m.num_triangles(), 12);
     // Every edge of a closed mesh has exactly two triangles.
     for e in 0..m.num_edges() {
-        assert_eq!(m.edge_tri_start[e + 1] - m.edge_tri_start[e], 2);
+        assert_eq!(m.d.edge_tri_start[e + 1] - m.d.edge_tri_start[e], 2);
     }
     // Near-duplicates within 1e-9 of the diagonal are welded too (1e-12 relative jitter).
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -250,6 +250,19 @@ fn walls_mesh_coplanar_sliding_is_constant() {
     assert_eq!(cs.len(), 1);
     assert!((cs[0].overlap_m - (r + 0.1)).abs() < TOL);
     assert!((cs[0].normal - n).norm() < TOL);
+    // Behind by less than r exactly under the interior vertex and a shared edge: still the
+    // plane contact (continuous with the face contacts around).
+    for local in [
+        Vec3::new(1.0, 1.0, -0.1),
+        Vec3::new(1.0, 0.6, -0.1),
+        Vec3::new(0.5, 0.5, -0.1),
+    ] {
+        let x = rot * local + shift;
+        let cs = contacts(&m, &x, r, 0.0);
+        assert_eq!(cs.len(), 1, "{local:?}: {cs:?}");
+        assert!((cs[0].overlap_m - (r + 0.1)).abs() < TOL);
+        assert!((cs[0].normal - n).norm() < TOL);
+    }
     // Further behind than r: nothing.
     let x = rot * Vec3::new(0.6, 0.3, -0.31) + shift;
     assert!(contacts(&m, &x, r, 0.0).is_empty());
