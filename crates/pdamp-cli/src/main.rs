@@ -5,13 +5,17 @@
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use pdamp_dem::Material;
 use pdamp_dem::contact::NormalLaw;
 use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
-use pdamp_dem::Material;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "pdamp", version, about = "Particle damper simulation and design toolkit")]
+#[command(
+    name = "pdamp",
+    version,
+    about = "Particle damper simulation and design toolkit"
+)]
 struct Cli {
     /// Worker threads (default: all cores).
     #[arg(long, global = true)]
@@ -104,8 +108,14 @@ fn main() -> Result<()> {
         .context("cannot start the thread pool")?;
     match cli.command {
         Command::Run { scenario, out } => cmd_run(&scenario, &out),
-        Command::Example { particles, duration_s } => {
-            print!("{}", pdamp_io::examples::shaken_box(particles, duration_s).to_toml());
+        Command::Example {
+            particles,
+            duration_s,
+        } => {
+            print!(
+                "{}",
+                pdamp_io::examples::shaken_box(particles, duration_s).to_toml()
+            );
             Ok(())
         }
         Command::Impact {
@@ -119,7 +129,8 @@ fn main() -> Result<()> {
             stiffness_n_m,
             velocity_m_s,
         } => {
-            let material = Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio);
+            let material =
+                Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio);
             material.validate().map_err(anyhow::Error::msg)?;
             if !(radius_m > 0.0 && velocity_m_s > 0.0) {
                 bail!("--radius-m and --velocity-m-s must be > 0");
@@ -144,7 +155,12 @@ fn main() -> Result<()> {
                 },
                 LawArg::Linear => {
                     let k = stiffness_n_m.unwrap_or_else(|| {
-                        pdamp_dem::impact::hertz_equivalent_linear_stiffness(partner, radius_m, &material, velocity_m_s)
+                        pdamp_dem::impact::hertz_equivalent_linear_stiffness(
+                            partner,
+                            radius_m,
+                            &material,
+                            velocity_m_s,
+                        )
                     });
                     NormalLaw::Linear {
                         stiffness_n_m: k,
@@ -172,7 +188,8 @@ fn main() -> Result<()> {
             Ok(())
         }
         Command::Bench { particles, steps } => {
-            let r = pdamp_io::bench::shaken_box_bench(particles, steps)?;
+            let r =
+                pdamp_io::bench::shaken_box_bench(particles, steps).map_err(anyhow::Error::msg)?;
             println!(
                 "{}",
                 serde_json::json!({
@@ -192,7 +209,10 @@ fn main() -> Result<()> {
 
 fn cmd_run(scenario: &str, out: &PathBuf) -> Result<()> {
     let (sc, base) = if scenario == "builtin:shaken-box" {
-        (pdamp_io::examples::shaken_box(2000, 0.5), PathBuf::from("."))
+        (
+            pdamp_io::examples::shaken_box(2000, 0.5),
+            PathBuf::from("."),
+        )
     } else {
         let path = PathBuf::from(scenario);
         let sc = pdamp_io::scenario::Scenario::load(&path)?;
@@ -201,8 +221,10 @@ fn cmd_run(scenario: &str, out: &PathBuf) -> Result<()> {
     };
     let bar = ProgressBar::new(1000);
     bar.set_style(
-        ProgressStyle::with_template("{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let summary = pdamp_io::run::run_scenario(&sc, &base, out, |phase, f| {
         bar.set_message(phase.to_string());

@@ -40,7 +40,8 @@ impl BodyState {
     /// World → body frame for a point.
     #[inline]
     pub fn to_body(&self, p: &Vec3) -> Vec3 {
-        self.orientation.inverse_transform_vector(&(p - self.position_m))
+        self.orientation
+            .inverse_transform_vector(&(p - self.position_m))
     }
 
     /// Body → world frame for a point.

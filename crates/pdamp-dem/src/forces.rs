@@ -6,8 +6,8 @@ use crate::contact::{ContactForce, ContactHistory, ContactKinematics, PairProps}
 use crate::energy::EnergyIncrements;
 use crate::material::{effective_mass, effective_radius};
 use crate::math::{Vec3, tangential_part};
-use crate::world::World;
 use crate::walls::WallContact;
+use crate::world::World;
 use rayon::prelude::*;
 
 /// State of one contact carried from step to step: the law's history plus the forces and stored
@@ -64,7 +64,16 @@ pub struct PairOutput {
 
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
 #[inline]
-fn account(st: &mut PairState, f: &ContactForce, fn_vec: Vec3, ft: Vec3, v_rel: &Vec3, w_rel: &Vec3, dt: f64, active: bool) -> (f64, f64) {
+fn account(
+    st: &mut PairState,
+    f: &ContactForce,
+    fn_vec: Vec3,
+    ft: Vec3,
+    v_rel: &Vec3,
+    w_rel: &Vec3,
+    dt: f64,
+    active: bool,
+) -> (f64, f64) {
     let w_n = -0.5 * (st.normal_force_prev + fn_vec).dot(v_rel) * dt;
     let w_t = -0.5 * (st.tangential_force_prev + ft).dot(v_rel) * dt
         - 0.5 * (st.rolling_torque_prev + f.rolling_torque_nm).dot(w_rel) * dt;
@@ -133,7 +142,8 @@ impl World {
                     let n = if dist > 0.0 { d / dist } else { Vec3::z() };
                     let rb_i = p.radius[i] - 0.5 * overlap.max(0.0);
                     let rb_j = p.radius[j] - 0.5 * overlap.max(0.0);
-                    let v_rel = p.velocity[i] - p.velocity[j] + p.angular_velocity[i].cross(&(-rb_i * n))
+                    let v_rel = p.velocity[i] - p.velocity[j]
+                        + p.angular_velocity[i].cross(&(-rb_i * n))
                         - p.angular_velocity[j].cross(&(rb_j * n));
                     let w_rel = p.angular_velocity[i] - p.angular_velocity[j];
                     let f = if touching {
@@ -182,10 +192,20 @@ impl World {
             .zip(wall_slots.par_chunks_mut(CHUNK))
             .enumerate()
             .map_init(
-                || (Vec::<WallContact>::with_capacity(16), Vec::<WallSlot>::with_capacity(16)),
+                || {
+                    (
+                        Vec::<WallContact>::with_capacity(16),
+                        Vec::<WallSlot>::with_capacity(16),
+                    )
+                },
                 |(contacts, fresh), (c, ((fs, ts), slots))| {
                     let mut inc = EnergyIncrements::default();
-                    for (k, ((f_out, t_out), slot_list)) in fs.iter_mut().zip(ts.iter_mut()).zip(slots.iter_mut()).enumerate() {
+                    for (k, ((f_out, t_out), slot_list)) in fs
+                        .iter_mut()
+                        .zip(ts.iter_mut())
+                        .zip(slots.iter_mut())
+                        .enumerate()
+                    {
                         let i = c * CHUNK + k;
                         let mut f = g * p.mass[i] + p.external_force[i];
                         let mut t = Vec3::zeros();
@@ -195,12 +215,27 @@ impl World {
                             f += o.force;
                             t += o.torque_first;
                         }
-                        for &q in &nl.col_pairs[nl.col_start[i] as usize..nl.col_start[i + 1] as usize] {
+                        for &q in
+                            &nl.col_pairs[nl.col_start[i] as usize..nl.col_start[i + 1] as usize]
+                        {
                             let o = &outs[q as usize];
                             f -= o.force;
                             t += o.torque_second;
                         }
-                        wall_contacts_of(i, p, interactions, bodies_ref, &body_step, dt, slot_list, contacts, fresh, &mut f, &mut t, &mut inc);
+                        wall_contacts_of(
+                            i,
+                            p,
+                            interactions,
+                            bodies_ref,
+                            &body_step,
+                            dt,
+                            slot_list,
+                            contacts,
+                            fresh,
+                            &mut f,
+                            &mut t,
+                            &mut inc,
+                        );
                         *f_out = f;
                         *t_out = t;
                     }
@@ -223,7 +258,8 @@ impl World {
             for s in slots {
                 let b = &mut self.bodies[s.body as usize];
                 b.contact_force_n -= s.force;
-                b.contact_torque_nm += (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
+                b.contact_torque_nm +=
+                    (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
             }
         }
 
@@ -286,7 +322,11 @@ fn wall_contacts_of(
                 let mut best: Option<(usize, f64)> = None;
                 for (k, s) in slots.iter().enumerate() {
                     if s.body as usize == bi && s.wall as usize == wi && s.state.active {
-                        let score = if s.feature == c.feature { 2.0 } else { s.normal.dot(&normal) };
+                        let score = if s.feature == c.feature {
+                            2.0
+                        } else {
+                            s.normal.dot(&normal)
+                        };
                         if score > 0.9 && best.is_none_or(|(_, b)| score > b) {
                             best = Some((k, score));
                         }
@@ -328,8 +368,14 @@ fn wall_contacts_of(
                 let fn_vec = normal * f.normal_total_n();
                 let ft = f.tangential_n;
                 let f_total = fn_vec + ft;
-                inc.wall_work_j += 0.5 * (s.state.normal_force_prev + s.state.tangential_force_prev + f_total).dot(&v_wall) * dt
-                    + 0.5 * (s.state.rolling_torque_prev + f.rolling_torque_nm).dot(&bs.angular_velocity_rad_s) * dt;
+                inc.wall_work_j += 0.5
+                    * (s.state.normal_force_prev + s.state.tangential_force_prev + f_total)
+                        .dot(&v_wall)
+                    * dt
+                    + 0.5
+                        * (s.state.rolling_torque_prev + f.rolling_torque_nm)
+                            .dot(&bs.angular_velocity_rad_s)
+                        * dt;
                 let (dn, dtan) = account(&mut s.state, &f, fn_vec, ft, &v_rel, &w_rel, dt, true);
                 inc.dissipated_normal_pw_j += dn;
                 inc.dissipated_tangential_pw_j += dtan;
@@ -349,9 +395,19 @@ fn wall_contacts_of(
         let v_rel = p.velocity[i] + p.angular_velocity[i].cross(&(-rb * s.normal)) - v_wall;
         let w_rel = p.angular_velocity[i] - bs.angular_velocity_rad_s;
         let f = ContactForce::default();
-        inc.wall_work_j += 0.5 * (s.state.normal_force_prev + s.state.tangential_force_prev).dot(&v_wall) * dt
-            + 0.5 * s.state.rolling_torque_prev.dot(&bs.angular_velocity_rad_s) * dt;
-        let (dn, dtan) = account(&mut s.state, &f, Vec3::zeros(), Vec3::zeros(), &v_rel, &w_rel, dt, false);
+        inc.wall_work_j +=
+            0.5 * (s.state.normal_force_prev + s.state.tangential_force_prev).dot(&v_wall) * dt
+                + 0.5 * s.state.rolling_torque_prev.dot(&bs.angular_velocity_rad_s) * dt;
+        let (dn, dtan) = account(
+            &mut s.state,
+            &f,
+            Vec3::zeros(),
+            Vec3::zeros(),
+            &v_rel,
+            &w_rel,
+            dt,
+            false,
+        );
         inc.dissipated_normal_pw_j += dn;
         inc.dissipated_tangential_pw_j += dtan;
     }

@@ -141,7 +141,12 @@ pub fn head_on_impact(setup: &ImpactSetup) -> ImpactResult {
 
 /// Secant stiffness $F_{max}/\delta_{max}$ of the Hertz impact at `velocity_m_s`, N/m: a linear
 /// spring of this stiffness gives a comparable contact time and overlap.
-pub fn hertz_equivalent_linear_stiffness(partner: Partner, radius_m: f64, material: &Material, velocity_m_s: f64) -> f64 {
+pub fn hertz_equivalent_linear_stiffness(
+    partner: Partner,
+    radius_m: f64,
+    material: &Material,
+    velocity_m_s: f64,
+) -> f64 {
     let m = 4.0 / 3.0 * std::f64::consts::PI * material.density_kg_m3 * radius_m.powi(3);
     let (r_eff, m_eff) = match partner {
         Partner::Wall => (radius_m, m),

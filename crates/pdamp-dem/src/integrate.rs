@@ -128,11 +128,25 @@ impl World {
             for i in 0..n {
                 let a = p.force[i] / p.mass[i];
                 let al = p.torque[i] * p.inv_inertia[i];
-                g.trans.push([p.position[i], p.velocity[i], a, Vec3::zeros(), Vec3::zeros()]);
-                g.rot.push([Vec3::zeros(), p.angular_velocity[i], al, Vec3::zeros(), Vec3::zeros()]);
+                g.trans.push([
+                    p.position[i],
+                    p.velocity[i],
+                    a,
+                    Vec3::zeros(),
+                    Vec3::zeros(),
+                ]);
+                g.rot.push([
+                    Vec3::zeros(),
+                    p.angular_velocity[i],
+                    al,
+                    Vec3::zeros(),
+                    Vec3::zeros(),
+                ]);
             }
             // Δt_max = π / max ω_con [D Tab. 2.3]; ω_con from the contact time: t_c ≈ π/ω_con.
-            g.dt_max_s = params.dt_max_s.unwrap_or_else(|| std::f64::consts::PI / self.max_contact_frequency());
+            g.dt_max_s = params
+                .dt_max_s
+                .unwrap_or_else(|| std::f64::consts::PI / self.max_contact_frequency());
             self.gear = Some(g);
         }
         let mut gear = self.gear.take().unwrap();
@@ -181,7 +195,13 @@ impl World {
                 // Corrector [D Eq. 2.100–2.103].
                 let p = &self.particles;
                 let c = GEAR5;
-                let k = [c[0] * dt * dt / 2.0, c[1] * dt / 2.0, c[2], c[3] * 3.0 / dt, c[4] * 12.0 / (dt * dt)];
+                let k = [
+                    c[0] * dt * dt / 2.0,
+                    c[1] * dt / 2.0,
+                    c[2],
+                    c[3] * 3.0 / dt,
+                    c[4] * 12.0 / (dt * dt),
+                ];
                 let err = tr
                     .par_iter_mut()
                     .zip(ro.par_iter_mut())
@@ -195,8 +215,11 @@ impl World {
                             t[l] += da * k[l];
                             r[l] += dal * k[l];
                         }
-                        let e1 = da.norm() / (params.tolerance_abs + params.tolerance_rel * a.norm());
-                        let e2 = dal.norm() * p.radius[i] / (params.tolerance_abs + params.tolerance_rel * al.norm() * p.radius[i]);
+                        let e1 =
+                            da.norm() / (params.tolerance_abs + params.tolerance_rel * a.norm());
+                        let e2 = dal.norm() * p.radius[i]
+                            / (params.tolerance_abs
+                                + params.tolerance_rel * al.norm() * p.radius[i]);
                         e1.max(e2)
                     })
                     .reduce(|| 0.0, f64::max);
@@ -218,7 +241,9 @@ impl World {
                 gear.rot = ro;
                 gear.last_corrections = corrections;
                 // Step-size controller [D Eq. 2.105/2.106].
-                let f = params.safety_factor * (params.max_corrections as f64 / (2.0 * corrections as f64)).powf(1.0 / p_order);
+                let f = params.safety_factor
+                    * (params.max_corrections as f64 / (2.0 * corrections as f64))
+                        .powf(1.0 / p_order);
                 self.dt_s = (self.dt_s * f).clamp(params.dt_min_s, gear.dt_max_s);
                 self.gear = Some(gear);
                 return inc;

@@ -7,18 +7,18 @@
 //! closes. References: [D] = the dissertation on the particle-damper design toolchain (chapter 2),
 //! [P] = the DEM–FEM powder-damper paper (section 2.1). No file I/O lives here.
 
-pub mod contact;
-pub mod generate;
-pub mod material;
-pub mod math;
-pub mod walls;
 pub mod body;
+pub mod contact;
 pub mod energy;
 mod forces;
+pub mod generate;
 pub mod integrate;
 pub mod interaction;
+pub mod material;
+pub mod math;
 pub mod neighbor;
 pub mod particles;
+pub mod walls;
 pub mod world;
 
 pub use body::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, Wall};

@@ -36,7 +36,10 @@ impl Material {
     /// Checks ranges; returns a message naming the offending field.
     pub fn validate(&self) -> Result<(), String> {
         if !(self.density_kg_m3.is_finite() && self.density_kg_m3 > 0.0) {
-            return Err(format!("material '{}': density_kg_m3 must be > 0, got {}", self.name, self.density_kg_m3));
+            return Err(format!(
+                "material '{}': density_kg_m3 must be > 0, got {}",
+                self.name, self.density_kg_m3
+            ));
         }
         if !(self.youngs_modulus_pa.is_finite() && self.youngs_modulus_pa > 0.0) {
             return Err(format!(
@@ -63,16 +66,26 @@ pub fn effective_modulus(a: &Material, b: &Material) -> f64 {
 /// Effective shear modulus $1/\bar G = 2(2-\nu_1)(1+\nu_1)/E_1 + 2(2-\nu_2)(1+\nu_2)/E_2$
 /// (Mindlin; as used by LIGGGHTS' Hertz/history model), in Pa.
 pub fn effective_shear_modulus(a: &Material, b: &Material) -> f64 {
-    let c = |m: &Material| 2.0 * (2.0 - m.poisson_ratio) * (1.0 + m.poisson_ratio) / m.youngs_modulus_pa;
+    let c = |m: &Material| {
+        2.0 * (2.0 - m.poisson_ratio) * (1.0 + m.poisson_ratio) / m.youngs_modulus_pa
+    };
     1.0 / (c(a) + c(b))
 }
 
 /// Effective radius $1/\bar R = 1/r_1 + 1/r_2$ [D Eq. 2.72], in m. `r2 = f64::INFINITY` for planes.
 pub fn effective_radius(r1: f64, r2: f64) -> f64 {
-    if r2.is_infinite() { r1 } else { 1.0 / (1.0 / r1 + 1.0 / r2) }
+    if r2.is_infinite() {
+        r1
+    } else {
+        1.0 / (1.0 / r1 + 1.0 / r2)
+    }
 }
 
 /// Effective mass $1/\bar M = 1/M_1 + 1/M_2$ [D Eq. 2.81], in kg. `m2 = f64::INFINITY` for walls.
 pub fn effective_mass(m1: f64, m2: f64) -> f64 {
-    if m2.is_infinite() { m1 } else { m1 * m2 / (m1 + m2) }
+    if m2.is_infinite() {
+        m1
+    } else {
+        m1 * m2 / (m1 + m2)
+    }
 }

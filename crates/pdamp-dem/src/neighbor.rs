@@ -60,7 +60,15 @@ impl NeighborList {
             .map(|(x, x0)| (x - x0).norm_squared())
             .fold(
                 || (0.0f64, 0.0f64),
-                |(a, b), d| if d > a { (d, a) } else if d > b { (a, d) } else { (a, b) },
+                |(a, b), d| {
+                    if d > a {
+                        (d, a)
+                    } else if d > b {
+                        (a, d)
+                    } else {
+                        (a, b)
+                    }
+                },
             )
             .reduce(
                 || (0.0, 0.0),
@@ -75,7 +83,12 @@ impl NeighborList {
 
     /// Rebuilds the list with a cell grid and remaps the per-pair `state` so that the history of
     /// pairs present before and after is kept; new pairs start from `S::default()`.
-    pub fn rebuild<S: Copy + Default + Send + Sync>(&mut self, position: &[Vec3], radius: &[f64], state: &mut Vec<S>) {
+    pub fn rebuild<S: Copy + Default + Send + Sync>(
+        &mut self,
+        position: &[Vec3],
+        radius: &[f64],
+        state: &mut Vec<S>,
+    ) {
         let n = position.len();
         let old_row_start = std::mem::take(&mut self.row_start);
         let old_second = std::mem::take(&mut self.second);
@@ -242,7 +255,9 @@ impl CellGrid {
     /// Calls `f(j)` for every particle in the 27 cells around `x`.
     #[inline]
     fn for_each_near(&self, x: &Vec3, mut f: impl FnMut(usize)) {
-        let c = [0, 1, 2].map(|k| (((x[k] - self.origin[k]) * self.inv_cell) as isize).clamp(0, self.dims[k] as isize - 1));
+        let c = [0, 1, 2].map(|k| {
+            (((x[k] - self.origin[k]) * self.inv_cell) as isize).clamp(0, self.dims[k] as isize - 1)
+        });
         for dz in -1..=1isize {
             let z = c[2] + dz;
             if z < 0 || z >= self.dims[2] as isize {
@@ -256,7 +271,10 @@ impl CellGrid {
                 let row = self.dims[0] * (y as usize + self.dims[1] * z as usize);
                 let x0 = (c[0] - 1).max(0) as usize;
                 let x1 = ((c[0] + 1) as usize).min(self.dims[0] - 1);
-                let (s, e) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
+                let (s, e) = (
+                    self.start[row + x0] as usize,
+                    self.start[row + x1 + 1] as usize,
+                );
                 for &j in &self.items[s..e] {
                     f(j as usize);
                 }
@@ -275,9 +293,17 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let n = 2000;
         let pos: Vec<Vec3> = (0..n)
-            .map(|_| Vec3::new(rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>()) * 0.05)
+            .map(|_| {
+                Vec3::new(
+                    rng.random::<f64>(),
+                    rng.random::<f64>(),
+                    rng.random::<f64>(),
+                ) * 0.05
+            })
             .collect();
-        let rad: Vec<f64> = (0..n).map(|_| 0.0005 + 0.0005 * rng.random::<f64>()).collect();
+        let rad: Vec<f64> = (0..n)
+            .map(|_| 0.0005 + 0.0005 * rng.random::<f64>())
+            .collect();
         let mut list = NeighborList::new(0.0002);
         let mut state: Vec<u64> = Vec::new();
         list.rebuild(&pos, &rad, &mut state);
@@ -290,7 +316,12 @@ mod tests {
                 }
             }
         }
-        let got: Vec<(u32, u32)> = list.first.iter().cloned().zip(list.second.iter().cloned()).collect();
+        let got: Vec<(u32, u32)> = list
+            .first
+            .iter()
+            .cloned()
+            .zip(list.second.iter().cloned())
+            .collect();
         assert_eq!(got, brute);
         // Mark every pair with a key, move particles a little, rebuild: surviving pairs keep it.
         for (p, s) in state.iter_mut().enumerate() {

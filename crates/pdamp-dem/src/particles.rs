@@ -43,7 +43,13 @@ impl ParticleSet {
     }
 
     /// Adds a particle at rest; `density_kg_m3` gives its mass. Returns its index.
-    pub fn push(&mut self, position: Vec3, radius: f64, density_kg_m3: f64, material: u16) -> usize {
+    pub fn push(
+        &mut self,
+        position: Vec3,
+        radius: f64,
+        density_kg_m3: f64,
+        material: u16,
+    ) -> usize {
         let mass = 4.0 / 3.0 * std::f64::consts::PI * density_kg_m3 * radius.powi(3);
         let inertia = 0.4 * mass * radius * radius;
         let idx = self.len();
@@ -93,12 +99,17 @@ impl ParticleSet {
 
     /// Potential energy in the gravity field `g` (zero at the origin), J: $-\sum m_i\, g\cdot x_i$.
     pub fn potential_energy(&self, gravity: &Vec3) -> f64 {
-        -(0..self.len()).map(|i| self.mass[i] * gravity.dot(&self.position[i])).sum::<f64>()
+        -(0..self.len())
+            .map(|i| self.mass[i] * gravity.dot(&self.position[i]))
+            .sum::<f64>()
     }
 
     /// Centre of mass, m.
     pub fn center_of_mass(&self) -> Vec3 {
         let m = self.total_mass();
-        (0..self.len()).map(|i| self.position[i] * self.mass[i]).sum::<Vec3>() / m
+        (0..self.len())
+            .map(|i| self.position[i] * self.mass[i])
+            .sum::<Vec3>()
+            / m
     }
 }

@@ -130,7 +130,10 @@ impl World {
         let p = &self.particles;
         (0..self.neighbors.num_pairs())
             .map(|k| {
-                let (i, j) = (self.neighbors.first[k] as usize, self.neighbors.second[k] as usize);
+                let (i, j) = (
+                    self.neighbors.first[k] as usize,
+                    self.neighbors.second[k] as usize,
+                );
                 let ov = p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm();
                 ov / p.radius[i].min(p.radius[j])
             })
@@ -229,8 +232,11 @@ impl World {
     /// Rebuilds the neighbour list when the displacement criterion asks for it.
     pub(crate) fn update_neighbors(&mut self) {
         if self.neighbors.needs_rebuild(&self.particles.position) {
-            self.neighbors
-                .rebuild(&self.particles.position, &self.particles.radius, &mut self.pair_state);
+            self.neighbors.rebuild(
+                &self.particles.position,
+                &self.particles.radius,
+                &mut self.pair_state,
+            );
             self.counters.neighbor_builds += 1;
         }
     }
@@ -283,6 +289,9 @@ impl World {
 
     /// Total contact force and torque the particles exert on body `b`, N and N·m.
     pub fn body_load(&self, b: usize) -> (Vec3, Vec3) {
-        (self.bodies[b].contact_force_n, self.bodies[b].contact_torque_nm)
+        (
+            self.bodies[b].contact_force_n,
+            self.bodies[b].contact_torque_nm,
+        )
     }
 }

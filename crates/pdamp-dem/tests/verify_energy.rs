@@ -32,7 +32,10 @@ fn elastic_gas_conserves_energy() {
         }
     }
     worst = worst.max((w.ledger.total_mechanical_j() / e0 - 1.0).abs());
-    eprintln!("elastic gas: largest relative energy error {worst:.2e}, contacts built {}", w.counters.neighbor_builds);
+    eprintln!(
+        "elastic gas: largest relative energy error {worst:.2e}, contacts built {}",
+        w.counters.neighbor_builds
+    );
     assert!(worst < 1e-4, "relative energy error {worst:.3e}");
     // The ledger sees no dissipation beyond integration noise.
     assert!(w.ledger.dissipated_j().abs() < 1e-4 * e0);
@@ -55,9 +58,18 @@ fn shaken_bed_ledger_closes() {
     w.restart_clock();
     w.run_until(0.1, |_| {});
     let l = w.ledger;
-    eprintln!("shaken bed ledger: {l:?}\nclosure error {:.3e} J of wall work {:.3e} J", l.closure_error_j(), l.wall_work_j);
+    eprintln!(
+        "shaken bed ledger: {l:?}\nclosure error {:.3e} J of wall work {:.3e} J",
+        l.closure_error_j(),
+        l.wall_work_j
+    );
     assert!(l.wall_work_j > 0.0);
     assert!(l.dissipated_normal_pp_j > 0.0 && l.dissipated_normal_pw_j > 0.0);
     assert!(l.dissipated_tangential_pp_j > 0.0 && l.dissipated_tangential_pw_j > 0.0);
-    assert!(l.closure_error_j().abs() < 1e-3 * l.wall_work_j, "closure {:.3e} vs wall work {:.3e}", l.closure_error_j(), l.wall_work_j);
+    assert!(
+        l.closure_error_j().abs() < 1e-3 * l.wall_work_j,
+        "closure {:.3e} vs wall work {:.3e}",
+        l.closure_error_j(),
+        l.wall_work_j
+    );
 }

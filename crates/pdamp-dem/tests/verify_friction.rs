@@ -23,11 +23,13 @@ fn incline_acceleration(theta_deg: f64, friction: FrictionLaw) -> (f64, f64) {
     let r = 5e-3;
     let mut w = World::new(vec![Material::new("steel", 7800.0, 2e9, 0.3)], model, 2e-6);
     w.gravity_m_s2 = Vec3::new(G * th.sin(), 0.0, -G * th.cos());
-    w.add_body(RigidBody::new("incline", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
-        "plane",
-        Geometry::Plane(Plane::new(Vec3::zeros(), Vec3::z(), false)),
-        0,
-    ));
+    w.add_body(
+        RigidBody::new("incline", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+            "plane",
+            Geometry::Plane(Plane::new(Vec3::zeros(), Vec3::z(), false)),
+            0,
+        ),
+    );
     w.add_particle(Vec3::new(0.0, 0.0, r), r, 0);
     w.run_until(0.02, |_| {});
     let (v0, w0) = (w.particles.velocity[0].x, w.particles.angular_velocity[0].y);
@@ -41,7 +43,9 @@ fn incline_acceleration(theta_deg: f64, friction: FrictionLaw) -> (f64, f64) {
 #[test]
 fn rolling_without_slip_below_slip_angle() {
     for friction in [
-        FrictionLaw::Mindlin { friction_coefficient: 0.3 },
+        FrictionLaw::Mindlin {
+            friction_coefficient: 0.3,
+        },
         FrictionLaw::CoulombSpring {
             friction_coefficient: 0.3,
             stiffness_ratio: None,
@@ -50,9 +54,17 @@ fn rolling_without_slip_below_slip_angle() {
     ] {
         let (a, a_roll) = incline_acceleration(20.0, friction.clone());
         let expect = 5.0 / 7.0 * G * 20f64.to_radians().sin();
-        eprintln!("{friction:?}: a = {a:.5} m/s², 5/7 g sinθ = {expect:.5}, rolling a = {a_roll:.5}");
-        assert!((a / expect - 1.0).abs() < 0.01, "{friction:?}: a = {a}, expected {expect}");
-        assert!((a_roll / a - 1.0).abs() < 0.01, "no slip: ω̇ r = {a_roll} vs a = {a}");
+        eprintln!(
+            "{friction:?}: a = {a:.5} m/s², 5/7 g sinθ = {expect:.5}, rolling a = {a_roll:.5}"
+        );
+        assert!(
+            (a / expect - 1.0).abs() < 0.01,
+            "{friction:?}: a = {a}, expected {expect}"
+        );
+        assert!(
+            (a_roll / a - 1.0).abs() < 0.01,
+            "no slip: ω̇ r = {a_roll} vs a = {a}"
+        );
     }
 }
 
@@ -62,7 +74,9 @@ fn sliding_above_slip_angle() {
     let th = 60f64.to_radians();
     let expect = G * (th.sin() - mu * th.cos());
     for friction in [
-        FrictionLaw::Mindlin { friction_coefficient: mu },
+        FrictionLaw::Mindlin {
+            friction_coefficient: mu,
+        },
         FrictionLaw::CoulombSpring {
             friction_coefficient: mu,
             stiffness_ratio: None,
@@ -75,6 +89,9 @@ fn sliding_above_slip_angle() {
     ] {
         let (a, _) = incline_acceleration(60.0, friction.clone());
         eprintln!("{friction:?}: a = {a:.5} m/s², g(sinθ − μ cosθ) = {expect:.5}");
-        assert!((a / expect - 1.0).abs() < 0.01, "{friction:?}: a = {a}, expected {expect}");
+        assert!(
+            (a / expect - 1.0).abs() < 0.01,
+            "{friction:?}: a = {a}, expected {expect}"
+        );
     }
 }

@@ -45,5 +45,8 @@ fn gear_and_verlet_settle_to_same_height() {
         );
         heights.push(bed_height(&w));
     }
-    assert!((heights[1] / heights[0] - 1.0).abs() < 0.01, "heights {heights:?}");
+    assert!(
+        (heights[1] / heights[0] - 1.0).abs() < 0.01,
+        "heights {heights:?}"
+    );
 }

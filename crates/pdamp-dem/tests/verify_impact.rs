@@ -4,7 +4,7 @@
 
 use pdamp_dem::Material;
 use pdamp_dem::contact::NormalLaw;
-use pdamp_dem::impact::{ImpactSetup, Partner, hertz_equivalent_linear_stiffness, head_on_impact};
+use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact, hertz_equivalent_linear_stiffness};
 
 const VELOCITIES: [f64; 4] = [0.01, 0.1, 1.0, 5.0];
 const RADII: [f64; 3] = [0.5e-3, 5e-3, 15e-3];
@@ -48,10 +48,29 @@ fn elastic_contact_time_and_overlap_match_hertz() {
                     let ed = (res.max_overlap_m / res.hertz_max_overlap_m - 1.0).abs();
                     let ef = (res.max_force_n / res.hertz_max_force_n - 1.0).abs();
                     worst = worst.max(et).max(ed);
-                    assert!(et < 0.02, "{law:?} {partner:?} r={r} v={v}: contact time {:.4e} vs Hertz {:.4e}", res.contact_time_s, res.hertz_contact_time_s);
-                    assert!(ed < 0.02, "{law:?} {partner:?} r={r} v={v}: overlap {:.4e} vs Hertz {:.4e}", res.max_overlap_m, res.hertz_max_overlap_m);
-                    assert!(ef < 0.02, "{law:?} {partner:?} r={r} v={v}: force {:.4e} vs Hertz {:.4e}", res.max_force_n, res.hertz_max_force_n);
-                    assert!((res.restitution - 1.0).abs() < 0.01, "{law:?}: elastic restitution {}", res.restitution);
+                    assert!(
+                        et < 0.02,
+                        "{law:?} {partner:?} r={r} v={v}: contact time {:.4e} vs Hertz {:.4e}",
+                        res.contact_time_s,
+                        res.hertz_contact_time_s
+                    );
+                    assert!(
+                        ed < 0.02,
+                        "{law:?} {partner:?} r={r} v={v}: overlap {:.4e} vs Hertz {:.4e}",
+                        res.max_overlap_m,
+                        res.hertz_max_overlap_m
+                    );
+                    assert!(
+                        ef < 0.02,
+                        "{law:?} {partner:?} r={r} v={v}: force {:.4e} vs Hertz {:.4e}",
+                        res.max_force_n,
+                        res.hertz_max_force_n
+                    );
+                    assert!(
+                        (res.restitution - 1.0).abs() < 0.01,
+                        "{law:?}: elastic restitution {}",
+                        res.restitution
+                    );
                 }
             }
         }
@@ -64,7 +83,11 @@ fn elastic_contact_time_and_overlap_match_hertz() {
 fn steel_sphere_30mm_at_1m_s() {
     let res = head_on_impact(&setup(Partner::Wall, 15e-3, 1.0, NormalLaw::Hertz));
     // Hertz theory for E = 210 GPa, ν = 0.3, ρ = 7850 kg/m³: t ≈ 103.8 µs, F_max ≈ 3.9 kN.
-    assert!((res.hertz_contact_time_s - 103.8e-6).abs() < 0.5e-6, "{}", res.hertz_contact_time_s);
+    assert!(
+        (res.hertz_contact_time_s - 103.8e-6).abs() < 0.5e-6,
+        "{}",
+        res.hertz_contact_time_s
+    );
     assert!((res.contact_time_s / res.hertz_contact_time_s - 1.0).abs() < 0.01);
     assert!((res.max_force_n / res.hertz_max_force_n - 1.0).abs() < 0.01);
 }
@@ -85,7 +108,11 @@ fn restitution_gonthier_and_linear() {
                             min_impact_velocity_m_s: 1e-3,
                         },
                     ));
-                    assert!((g.restitution / eps - 1.0).abs() < 0.02, "Gonthier eps={eps} {partner:?} v={v} r={r}: got {}", g.restitution);
+                    assert!(
+                        (g.restitution / eps - 1.0).abs() < 0.02,
+                        "Gonthier eps={eps} {partner:?} v={v} r={r}: got {}",
+                        g.restitution
+                    );
                     let k = hertz_equivalent_linear_stiffness(partner, r, &steel(), v);
                     let l = head_on_impact(&setup(
                         partner,
@@ -97,7 +124,11 @@ fn restitution_gonthier_and_linear() {
                             clip_attractive: false,
                         },
                     ));
-                    assert!((l.restitution / eps - 1.0).abs() < 0.02, "linear eps={eps} {partner:?} v={v} r={r}: got {}", l.restitution);
+                    assert!(
+                        (l.restitution / eps - 1.0).abs() < 0.02,
+                        "linear eps={eps} {partner:?} v={v} r={r}: got {}",
+                        l.restitution
+                    );
                 }
             }
         }
@@ -118,7 +149,11 @@ fn restitution_hertz_mindlin() {
                     clip_attractive: false,
                 },
             ));
-            assert!((res.restitution / eps - 1.0).abs() < 0.02, "eps={eps} v={v}: {}", res.restitution);
+            assert!(
+                (res.restitution / eps - 1.0).abs() < 0.02,
+                "eps={eps} v={v}: {}",
+                res.restitution
+            );
         }
     }
 }

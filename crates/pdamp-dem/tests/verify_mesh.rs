@@ -12,7 +12,9 @@ fn model() -> ContactModel {
             restitution: 0.7,
             min_impact_velocity_m_s: 1e-3,
         },
-        friction: FrictionLaw::Mindlin { friction_coefficient: 0.3 },
+        friction: FrictionLaw::Mindlin {
+            friction_coefficient: 0.3,
+        },
         rolling: None,
         adhesion: None,
     }
@@ -46,7 +48,9 @@ fn mesh_box_trajectories_match_analytic_box() {
         a.step();
         b.step();
         wall_hits += a.num_pw_contacts();
-        multi_hits += (0..a.particles.len()).filter(|&i| a.num_wall_contacts_of(i) >= 2).count();
+        multi_hits += (0..a.particles.len())
+            .filter(|&i| a.num_wall_contacts_of(i) >= 2)
+            .count();
         assert_eq!(a.num_pw_contacts(), b.num_pw_contacts());
         for i in 0..a.particles.len() {
             worst = worst.max((a.particles.position[i] - b.particles.position[i]).norm());
@@ -65,11 +69,23 @@ fn settled_bed_height_mesh_vs_analytic() {
     let heights: Vec<f64> = [false, true]
         .iter()
         .map(|&mesh| {
-            let mut w = box_world(400, 1e-3, 0.02, 0.04, hertz_mindlin(0.5, 0.3), 2e-6, mesh, 9);
+            let mut w = box_world(
+                400,
+                1e-3,
+                0.02,
+                0.04,
+                hertz_mindlin(0.5, 0.3),
+                2e-6,
+                mesh,
+                9,
+            );
             w.run_until(0.15, |_| {});
             bed_height(&w)
         })
         .collect();
-    eprintln!("bed height analytic {:.5e} m, mesh {:.5e} m", heights[0], heights[1]);
+    eprintln!(
+        "bed height analytic {:.5e} m, mesh {:.5e} m",
+        heights[0], heights[1]
+    );
     assert!((heights[1] / heights[0] - 1.0).abs() < 0.01);
 }

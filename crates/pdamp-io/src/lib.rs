@@ -4,10 +4,10 @@
 //! Every output file is written atomically (write to a temporary file, then rename).
 
 pub mod atomic;
+pub mod bench;
 pub mod csv;
-pub mod stl;
-pub mod vtk;
-pub mod scenario;
 pub mod examples;
 pub mod run;
-pub mod bench;
+pub mod scenario;
+pub mod stl;
+pub mod vtk;

@@ -70,15 +70,29 @@ pub fn bed_height_m(world: &World) -> f64 {
         return 0.0;
     }
     let up = -world.gravity_m_s2;
-    let up = if up.norm() > 0.0 { up.normalize() } else { Vec3::z() };
-    let lo = (0..p.len()).map(|i| up.dot(&p.position[i]) - p.radius[i]).fold(f64::INFINITY, f64::min);
-    let mean = (0..p.len()).map(|i| up.dot(&p.position[i]) - lo).sum::<f64>() / p.len() as f64;
+    let up = if up.norm() > 0.0 {
+        up.normalize()
+    } else {
+        Vec3::z()
+    };
+    let lo = (0..p.len())
+        .map(|i| up.dot(&p.position[i]) - p.radius[i])
+        .fold(f64::INFINITY, f64::min);
+    let mean = (0..p.len())
+        .map(|i| up.dot(&p.position[i]) - lo)
+        .sum::<f64>()
+        / p.len() as f64;
     2.0 * mean
 }
 
 /// Lets settling run with all bodies held at their reference pose, then restarts the clock at
 /// zero (bodies get their motion back). Ends early below `ke_per_particle_j`.
-pub fn settle(world: &mut World, max_duration_s: f64, ke_per_particle_j: f64, mut tick: impl FnMut(f64)) -> f64 {
+pub fn settle(
+    world: &mut World,
+    max_duration_s: f64,
+    ke_per_particle_j: f64,
+    mut tick: impl FnMut(f64),
+) -> f64 {
     let motions: Vec<Motion> = world.bodies.iter().map(|b| b.motion.clone()).collect();
     for b in world.bodies.iter_mut() {
         if !matches!(b.motion, Motion::Driven) {
@@ -105,7 +119,11 @@ pub fn settle(world: &mut World, max_duration_s: f64, ke_per_particle_j: f64, mu
 }
 
 /// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
-pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> Result<PathBuf, crate::vtk::VtkError> {
+pub fn write_snapshot(
+    world: &World,
+    dir: &Path,
+    index: usize,
+) -> Result<PathBuf, crate::vtk::VtkError> {
     let p = &world.particles;
     let name = format!("particles_{index:06}.vtp");
     let speed: Vec<f64> = p.velocity.iter().map(|v| v.norm()).collect();
@@ -117,7 +135,10 @@ pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> Result<PathBuf
         &p.radius,
         &[
             ("velocity_m_s", PointField::Vector(&p.velocity)),
-            ("angular_velocity_rad_s", PointField::Vector(&p.angular_velocity)),
+            (
+                "angular_velocity_rad_s",
+                PointField::Vector(&p.angular_velocity),
+            ),
             ("speed_m_s", PointField::Scalar(&speed)),
             ("material", PointField::Int(&mat)),
             ("id", PointField::Int(&ids)),
@@ -126,8 +147,13 @@ pub fn write_snapshot(world: &World, dir: &Path, index: usize) -> Result<PathBuf
     for (bi, b) in world.bodies.iter().enumerate() {
         for (wi, w) in b.walls.iter().enumerate() {
             if let Some((verts, tris)) = wall_surface(&w.geometry) {
-                let world_verts: Vec<Vec3> = verts.iter().map(|v| b.state.point_to_world(v)).collect();
-                write_mesh_vtp(&dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")), &world_verts, &tris)?;
+                let world_verts: Vec<Vec3> =
+                    verts.iter().map(|v| b.state.point_to_world(v)).collect();
+                write_mesh_vtp(
+                    &dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")),
+                    &world_verts,
+                    &tris,
+                )?;
             }
         }
     }
@@ -142,15 +168,29 @@ pub fn wall_surface(g: &Geometry) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
             let m = pdamp_dem::walls::TriMesh::box_inside(b.center_m, b.half_extents_m);
             Some((m.vertices().to_vec(), m.faces().to_vec()))
         }
-        Geometry::CylinderInside(c) => Some(cylinder_surface(c.base_center_m, c.axis, c.radius_m, c.length_m)),
-        Geometry::CylinderOutside(c) => Some(cylinder_surface(c.base_center_m, c.axis, c.radius_m, c.length_m)),
+        Geometry::CylinderInside(c) => Some(cylinder_surface(
+            c.base_center_m,
+            c.axis,
+            c.radius_m,
+            c.length_m,
+        )),
+        Geometry::CylinderOutside(c) => Some(cylinder_surface(
+            c.base_center_m,
+            c.axis,
+            c.radius_m,
+            c.length_m,
+        )),
         Geometry::Plane(_) => None,
     }
 }
 
 fn cylinder_surface(base: Vec3, axis: Vec3, r: f64, l: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let a = axis.normalize();
-    let t = if a.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+    let t = if a.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
     let u = a.cross(&t).normalize();
     let v = a.cross(&u);
     let k = 48;
@@ -203,9 +243,18 @@ pub fn run_scenario(
     let io = |e: std::io::Error| format!("output: {e}");
     let mut world = scenario.build_world(base_dir)?;
     std::fs::create_dir_all(out_dir).map_err(io)?;
-    crate::atomic::write_atomic(&out_dir.join("scenario.toml"), scenario.to_toml().as_bytes()).map_err(io)?;
+    crate::atomic::write_atomic(
+        &out_dir.join("scenario.toml"),
+        scenario.to_toml().as_bytes(),
+    )
+    .map_err(io)?;
     let settle_t = match &scenario.settle {
-        Some(s) => settle(&mut world, s.max_duration_s, s.kinetic_energy_per_particle_j, |f| progress("settling", f)),
+        Some(s) => settle(
+            &mut world,
+            s.max_duration_s,
+            s.kinetic_energy_per_particle_j,
+            |f| progress("settling", f),
+        ),
         None => 0.0,
     };
     world.initialize();
@@ -223,7 +272,8 @@ pub fn run_scenario(
     let mut snap = 0usize;
     if let Some(s) = series.as_mut() {
         let f = write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
-        s.add(world.time_s, f.to_string_lossy()).map_err(|e| e.to_string())?;
+        s.add(world.time_s, f.to_string_lossy())
+            .map_err(|e| e.to_string())?;
         snap += 1;
     }
     let t_end = scenario.simulation.duration_s;

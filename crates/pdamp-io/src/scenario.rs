@@ -4,9 +4,13 @@
 //! Loading validates everything up front; every error names the key that is wrong.
 
 use pdamp_dem::contact::ContactModel;
-use pdamp_dem::generate::{Layering, Region, SizeDistribution, grid_packing, random_insertion, tight_packing};
+use pdamp_dem::generate::{
+    Layering, Region, SizeDistribution, grid_packing, random_insertion, tight_packing,
+};
 use pdamp_dem::walls::{BoxInside, CylinderInside, CylinderOutside, Geometry, Plane};
-use pdamp_dem::{BodyState, HarmonicTranslation, Integrator, Material, Motion, RigidBody, Vec3, World};
+use pdamp_dem::{
+    BodyState, HarmonicTranslation, Integrator, Material, Motion, RigidBody, Vec3, World,
+};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -329,7 +333,10 @@ impl Scenario {
             .map(|i| i as u16)
             .ok_or_else(|| {
                 let known: Vec<&str> = self.materials.iter().map(|m| m.name.as_str()).collect();
-                format!("{key}: unknown material '{name}' (defined: {})", known.join(", "))
+                format!(
+                    "{key}: unknown material '{name}' (defined: {})",
+                    known.join(", ")
+                )
             })
     }
 
@@ -337,10 +344,16 @@ impl Scenario {
     pub fn validate(&self) -> Result<(), String> {
         let s = &self.simulation;
         if !(s.duration_s.is_finite() && s.duration_s >= 0.0) {
-            return Err(format!("simulation.duration_s must be >= 0, got {}", s.duration_s));
+            return Err(format!(
+                "simulation.duration_s must be >= 0, got {}",
+                s.duration_s
+            ));
         }
         if !(s.time_step_s.is_finite() && s.time_step_s > 0.0) {
-            return Err(format!("simulation.time_step_s must be > 0, got {}", s.time_step_s));
+            return Err(format!(
+                "simulation.time_step_s must be > 0, got {}",
+                s.time_step_s
+            ));
         }
         if self.materials.is_empty() {
             return Err("materials: at least one [[materials]] entry is needed".into());
@@ -348,14 +361,22 @@ impl Scenario {
         for (k, m) in self.materials.iter().enumerate() {
             m.validate().map_err(|e| format!("materials[{k}]: {e}"))?;
             if self.materials[..k].iter().any(|o| o.name == m.name) {
-                return Err(format!("materials[{k}].name: duplicate material name '{}'", m.name));
+                return Err(format!(
+                    "materials[{k}].name: duplicate material name '{}'",
+                    m.name
+                ));
             }
         }
-        self.contact.default.validate().map_err(|e| format!("contact.{e}"))?;
+        self.contact
+            .default
+            .validate()
+            .map_err(|e| format!("contact.{e}"))?;
         for (k, p) in self.contact.pairs.iter().enumerate() {
             self.material_index(&p.materials[0], &format!("contact.pairs[{k}].materials"))?;
             self.material_index(&p.materials[1], &format!("contact.pairs[{k}].materials"))?;
-            p.model.validate().map_err(|e| format!("contact.pairs[{k}].{e}"))?;
+            p.model
+                .validate()
+                .map_err(|e| format!("contact.pairs[{k}].{e}"))?;
         }
         for (b, body) in self.bodies.iter().enumerate() {
             for (w, wall) in body.walls.iter().enumerate() {
@@ -366,14 +387,21 @@ impl Scenario {
                     return Err(format!("bodies[{b}].motion.direction must not be zero"));
                 }
                 if !(h.frequency_hz > 0.0 && h.amplitude_m >= 0.0) {
-                    return Err(format!("bodies[{b}].motion: frequency_hz must be > 0 and amplitude_m >= 0"));
+                    return Err(format!(
+                        "bodies[{b}].motion: frequency_hz must be > 0 and amplitude_m >= 0"
+                    ));
                 }
             }
         }
         for (g, grp) in self.particles.iter().enumerate() {
             self.material_index(&grp.material, &format!("particles[{g}].material"))?;
-            grp.size.validate().map_err(|e| format!("particles[{g}].size: {e}"))?;
-            grp.placement.region.validate().map_err(|e| format!("particles[{g}].placement.region: {e}"))?;
+            grp.size
+                .validate()
+                .map_err(|e| format!("particles[{g}].size: {e}"))?;
+            grp.placement
+                .region
+                .validate()
+                .map_err(|e| format!("particles[{g}].placement.region: {e}"))?;
         }
         Ok(())
     }
@@ -397,7 +425,11 @@ impl Scenario {
                 MotionSpec::Harmonic(h) => Motion::Prescribed(Arc::new(h.clone())),
                 MotionSpec::Driven => Motion::Driven,
             };
-            let mut body = RigidBody::new(&b.name, BodyState::at_rest(Vec3::from(b.position_m)), motion);
+            let mut body = RigidBody::new(
+                &b.name,
+                BodyState::at_rest(Vec3::from(b.position_m)),
+                motion,
+            );
             for (wi, w) in b.walls.iter().enumerate() {
                 let mat = self.material_index(&w.material, "walls")?;
                 let geometry = match &w.geometry {
@@ -409,7 +441,9 @@ impl Scenario {
                         let path = base_dir.join(&s.path);
                         let mut mesh = crate::stl::read_stl(&path)
                             .map_err(|e| format!("bodies[{bi}].walls[{wi}].geometry.path: {e}"))?;
-                        mesh = mesh.transformed(s.scale, Vec3::from(s.translation_m));
+                        mesh = mesh
+                            .transformed(s.scale, Vec3::from(s.translation_m))
+                            .map_err(|e| format!("bodies[{bi}].walls[{wi}].geometry.scale: {e}"))?;
                         if s.flip_normals {
                             mesh.flip_normals();
                         }
@@ -425,17 +459,26 @@ impl Scenario {
             world.add_body(body);
         }
         let up = -world.gravity_m_s2;
-        let up = if up.norm() > 0.0 { up.normalize() } else { Vec3::z() };
+        let up = if up.norm() > 0.0 {
+            up.normalize()
+        } else {
+            Vec3::z()
+        };
         let mut placed: Vec<(Vec3, f64)> = Vec::new();
         for (g, grp) in self.particles.iter().enumerate() {
             let mat = self.material_index(&grp.material, "particles")?;
-            let radii = grp.size.sample_n(grp.count, self.simulation.seed.wrapping_add(g as u64));
+            let radii = grp
+                .size
+                .sample_n(grp.count, self.simulation.seed.wrapping_add(g as u64));
             let pl = &grp.placement;
             let pos = match pl.method {
                 PlacementMethod::Grid => grid_packing(&pl.region, &radii, pl.gap_m, &up),
                 PlacementMethod::Tight => tight_packing(&pl.region, &radii, pl.gap_m, &up),
                 PlacementMethod::Random => {
-                    let layering = pl.layer_height_m.map(|h| Layering { up, layer_height_m: h });
+                    let layering = pl.layer_height_m.map(|h| Layering {
+                        up,
+                        layer_height_m: h,
+                    });
                     random_insertion(
                         &pl.region,
                         &radii,
@@ -459,7 +502,9 @@ impl Scenario {
         if !world.particles.is_empty() {
             let tc = world.min_contact_time_s(self.simulation.check_impact_velocity_m_s);
             let ratio = self.simulation.time_step_s / tc;
-            if matches!(world.integrator, Integrator::VelocityVerlet) && ratio > self.simulation.max_time_step_ratio {
+            if matches!(world.integrator, Integrator::VelocityVerlet)
+                && ratio > self.simulation.max_time_step_ratio
+            {
                 return Err(format!(
                     "simulation.time_step_s = {:.3e} s is {:.2} of the shortest contact time {:.3e} s (impact at {} m/s); \
                      use at most {:.3e} s (max_time_step_ratio = {})",

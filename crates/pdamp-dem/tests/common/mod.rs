@@ -14,7 +14,16 @@ pub fn soft_steel() -> Material {
 
 /// A world with particles of radius `r` randomly inserted in a closed box of `side` × `side` ×
 /// `height` (the box's floor at z = 0), with the given container geometry (analytic or mesh).
-pub fn box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, dt: f64, mesh: bool, seed: u64) -> World {
+pub fn box_world(
+    n: usize,
+    r: f64,
+    side: f64,
+    height: f64,
+    model: ContactModel,
+    dt: f64,
+    mesh: bool,
+    seed: u64,
+) -> World {
     let mut w = World::new(vec![soft_steel()], model, dt);
     let c = Vec3::new(0.0, 0.0, 0.5 * height);
     let h = Vec3::new(0.5 * side, 0.5 * side, 0.5 * height);
@@ -23,7 +32,10 @@ pub fn box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, 
     } else {
         Geometry::BoxInside(BoxInside::new(c, h))
     };
-    w.add_body(RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall("box", geometry, 0));
+    w.add_body(
+        RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed)
+            .with_wall("box", geometry, 0),
+    );
     let region = Region::Box {
         min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
         max_m: Vec3::new(0.5 * side, 0.5 * side, height),
@@ -40,7 +52,11 @@ pub fn box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, 
 pub fn randomize_velocities(w: &mut World, vmax: f64, seed: u64) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     for v in w.particles.velocity.iter_mut() {
-        *v = Vec3::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5) * (2.0 * vmax);
+        *v = Vec3::new(
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+        ) * (2.0 * vmax);
     }
 }
 
@@ -51,22 +67,33 @@ pub fn hertz_mindlin(e: f64, mu: f64) -> ContactModel {
             restitution: e,
             clip_attractive: false,
         },
-        friction: FrictionLaw::Mindlin { friction_coefficient: mu },
+        friction: FrictionLaw::Mindlin {
+            friction_coefficient: mu,
+        },
         rolling: None,
         adhesion: None,
     }
 }
 
 /// Particles in hexagonal close packing in a box region above the floor.
-pub fn tight_box_world(n: usize, r: f64, side: f64, height: f64, model: ContactModel, dt: f64) -> World {
+pub fn tight_box_world(
+    n: usize,
+    r: f64,
+    side: f64,
+    height: f64,
+    model: ContactModel,
+    dt: f64,
+) -> World {
     let mut w = World::new(vec![soft_steel()], model, dt);
     let c = Vec3::new(0.0, 0.0, 0.5 * height);
     let h = Vec3::new(0.5 * side, 0.5 * side, 0.5 * height);
-    w.add_body(RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
-        "box",
-        Geometry::BoxInside(BoxInside::new(c, h)),
-        0,
-    ));
+    w.add_body(
+        RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+            "box",
+            Geometry::BoxInside(BoxInside::new(c, h)),
+            0,
+        ),
+    );
     let region = Region::Box {
         min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
         max_m: Vec3::new(0.5 * side, 0.5 * side, height),
