@@ -207,7 +207,7 @@ fn main() -> Result<()> {
     }
 }
 
-fn cmd_run(scenario: &str, out: &PathBuf) -> Result<()> {
+fn cmd_run(scenario: &str, out: &std::path::Path) -> Result<()> {
     let (sc, base) = if scenario == "builtin:shaken-box" {
         (
             pdamp_io::examples::shaken_box(2000, 0.5),

@@ -64,6 +64,7 @@ pub struct PairOutput {
 
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn account(
     st: &mut PairState,
     f: &ContactForce,

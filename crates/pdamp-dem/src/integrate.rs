@@ -14,7 +14,8 @@ use serde::{Deserialize, Serialize};
 pub struct GearParams {
     /// Smallest step $\Delta t_{min}$, s.
     pub dt_min_s: f64,
-    /// Largest step $\Delta t_{max}$, s; `None` = $\pi / \max \omega_{con}$ [D Tab. 2.3, Eq. 2.83].
+    /// Largest step $\Delta t_{max}$, s; `None` = $\pi / \max \omega_{con}$ [D Tab. 2.3, Eq. 2.83],
+    /// see [`World::gear_default_dt_max_s`].
     pub dt_max_s: Option<f64>,
     /// Absolute tolerance $\tau_{abs}$ on the acceleration correction, m/s².
     pub tolerance_abs: f64,
@@ -61,6 +62,8 @@ pub struct GearState {
     dt_max_s: f64,
     backup_pairs: Vec<PairState>,
     backup_walls: Vec<Vec<WallSlot>>,
+    pred_trans: Vec<[Vec3; 5]>,
+    pred_rot: Vec<[Vec3; 5]>,
     /// Corrector steps used by the last accepted step.
     pub last_corrections: u32,
 }
@@ -110,12 +113,6 @@ impl World {
         self.time_s = t1;
     }
 
-    /// Largest linear contact eigenfrequency $\omega_{con} = \sqrt{k_n/m}$ [D Eq. 2.83] at an
-    /// impact velocity of 1 m/s, for the Gear $\Delta t_{max}$ default.
-    fn max_contact_frequency(&self) -> f64 {
-        std::f64::consts::PI / self.min_contact_time_s(1.0).max(1e-300)
-    }
-
     pub(crate) fn step_gear(&mut self, params: &GearParams) -> EnergyIncrements {
         let n = self.particles.len();
         if self.gear.as_ref().is_none_or(|g| g.trans.len() != n) {
@@ -143,10 +140,9 @@ impl World {
                     Vec3::zeros(),
                 ]);
             }
-            // Δt_max = π / max ω_con [D Tab. 2.3]; ω_con from the contact time: t_c ≈ π/ω_con.
             g.dt_max_s = params
                 .dt_max_s
-                .unwrap_or_else(|| std::f64::consts::PI / self.max_contact_frequency());
+                .unwrap_or_else(|| self.gear_default_dt_max_s());
             self.gear = Some(g);
         }
         let mut gear = self.gear.take().unwrap();
@@ -169,8 +165,16 @@ impl World {
                     d[4],
                 ]
             };
-            let mut tr: Vec<[Vec3; 5]> = gear.trans.par_iter().map(predict).collect();
-            let mut ro: Vec<[Vec3; 5]> = gear.rot.par_iter().map(predict).collect();
+            let mut tr = std::mem::take(&mut gear.pred_trans);
+            let mut ro = std::mem::take(&mut gear.pred_rot);
+            tr.resize(n, [Vec3::zeros(); 5]);
+            ro.resize(n, [Vec3::zeros(); 5]);
+            tr.par_iter_mut()
+                .zip(gear.trans.par_iter())
+                .for_each(|(t, d)| *t = predict(d));
+            ro.par_iter_mut()
+                .zip(gear.rot.par_iter())
+                .for_each(|(t, d)| *t = predict(d));
             for (b, bk) in self.bodies.iter_mut().zip(&body_backup) {
                 b.state = bk.0;
             }
@@ -237,8 +241,9 @@ impl World {
                     p.velocity[i] = tr[i][1];
                     p.angular_velocity[i] = ro[i][1];
                 }
-                gear.trans = tr;
-                gear.rot = ro;
+                // Accepted state becomes current; the old buffers are reused for the next prediction.
+                gear.pred_trans = std::mem::replace(&mut gear.trans, tr);
+                gear.pred_rot = std::mem::replace(&mut gear.rot, ro);
                 gear.last_corrections = corrections;
                 // Step-size controller [D Eq. 2.105/2.106].
                 let f = params.safety_factor
@@ -249,6 +254,8 @@ impl World {
                 return inc;
             }
             self.counters.rejected_steps += 1;
+            gear.pred_trans = tr;
+            gear.pred_rot = ro;
             let f = params.safety_factor * 0.5f64.powf(1.0 / p_order);
             self.dt_s = (self.dt_s * f).max(params.dt_min_s);
         }

@@ -112,8 +112,8 @@ impl NeighborList {
                     let xi = position[i];
                     grid.for_each_near(&xi, |j| {
                         if j > i {
-                            let cut = radius[i] + radius[j as usize] + reach;
-                            if (position[j as usize] - xi).norm_squared() < cut * cut {
+                            let cut = radius[i] + radius[j] + reach;
+                            if (position[j] - xi).norm_squared() < cut * cut {
                                 partners.push(j as u32);
                             }
                         }
@@ -329,9 +329,9 @@ mod tests {
         }
         let moved: Vec<Vec3> = pos.iter().map(|x| x + Vec3::new(1e-5, 0.0, 0.0)).collect();
         list.rebuild(&moved, &rad, &mut state);
-        for p in 0..list.num_pairs() {
+        for (p, s) in state.iter().enumerate().take(list.num_pairs()) {
             let key = ((list.first[p] as u64) << 32) | list.second[p] as u64;
-            assert_eq!(state[p], key);
+            assert_eq!(*s, key);
         }
         // Transposed index covers every pair once.
         let mut seen = vec![0; list.num_pairs()];

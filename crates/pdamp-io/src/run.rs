@@ -103,7 +103,7 @@ pub fn settle(
     let check_every = 200u64;
     while world.time_s < max_duration_s {
         world.step();
-        if world.counters.steps % check_every == 0 {
+        if world.counters.steps.is_multiple_of(check_every) {
             tick(world.time_s / max_duration_s);
             if world.ledger.kinetic_j / n < ke_per_particle_j {
                 break;
@@ -130,7 +130,7 @@ pub fn write_snapshot(
     let mat: Vec<u32> = p.material.iter().map(|&m| m as u32).collect();
     let ids: Vec<u32> = p.id.clone();
     write_particles_vtp(
-        &dir.join(&name),
+        dir.join(&name),
         &p.position,
         &p.radius,
         &[
@@ -150,7 +150,7 @@ pub fn write_snapshot(
                 let world_verts: Vec<Vec3> =
                     verts.iter().map(|v| b.state.point_to_world(v)).collect();
                 write_mesh_vtp(
-                    &dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")),
+                    dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")),
                     &world_verts,
                     &tris,
                 )?;
@@ -243,11 +243,8 @@ pub fn run_scenario(
     let io = |e: std::io::Error| format!("output: {e}");
     let mut world = scenario.build_world(base_dir)?;
     std::fs::create_dir_all(out_dir).map_err(io)?;
-    crate::atomic::write_atomic(
-        &out_dir.join("scenario.toml"),
-        scenario.to_toml().as_bytes(),
-    )
-    .map_err(io)?;
+    crate::atomic::write_atomic(out_dir.join("scenario.toml"), scenario.to_toml().as_bytes())
+        .map_err(io)?;
     let settle_t = match &scenario.settle {
         Some(s) => settle(
             &mut world,
@@ -293,17 +290,17 @@ pub fn run_scenario(
             next_e += e_every;
             progress("running", w.time_s / t_end);
         }
-        if let Some(s) = series.as_mut() {
-            if w.time_s >= next_v - 1e-12 {
-                match write_snapshot(w, &vtk_dir, snap) {
-                    Ok(f) => {
-                        let _ = s.add(w.time_s, f.to_string_lossy());
-                    }
-                    Err(e) => err = Some(format!("output: {e}")),
+        if let Some(s) = series.as_mut()
+            && w.time_s >= next_v - 1e-12
+        {
+            match write_snapshot(w, &vtk_dir, snap) {
+                Ok(f) => {
+                    let _ = s.add(w.time_s, f.to_string_lossy());
                 }
-                snap += 1;
-                next_v += vtk_every;
+                Err(e) => err = Some(format!("output: {e}")),
             }
+            snap += 1;
+            next_v += vtk_every;
         }
     });
     if let Some(e) = err {
@@ -340,6 +337,6 @@ pub fn run_scenario(
         bed_height_m: bed_height_m(&world),
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
-    crate::atomic::write_atomic(&out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
+    crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
     Ok(summary)
 }

@@ -14,6 +14,7 @@ pub fn soft_steel() -> Material {
 
 /// A world with particles of radius `r` randomly inserted in a closed box of `side` × `side` ×
 /// `height` (the box's floor at z = 0), with the given container geometry (analytic or mesh).
+#[allow(clippy::too_many_arguments)]
 pub fn box_world(
     n: usize,
     r: f64,
