@@ -3,8 +3,8 @@
 //!   controller grows the step to Δt_max;
 //! - a sphere dropped on a floor rebounds with Gonthier's restitution [D Eq. 2.78/2.79] using the
 //!   established parameters of [D Tab. 2.3];
-//! - a small settling bed closes its energy balance and reaches the packing height that velocity
-//!   Verlet gives.
+//! - a bed of 1 000 particles settles to the packing height that velocity Verlet gives, and its
+//!   energy balance closes.
 
 mod common;
 use common::*;
@@ -108,18 +108,17 @@ fn bounce_restitution_matches_gonthier() {
     }
 }
 
-/// A bed of 150 particles settles under gravity: the energy balance closes and the final
-/// packing height agrees with velocity Verlet within 2 % (the packings differ in detail since the
-/// integrators take different steps through a chaotic transient).
+/// Must-show of the DEM core issue: 1 000 particles stacked in a close packing with 2 % gaps drop
+/// and settle in a box; Gear (step control, [D Tab. 2.3] parameters except τ = 1e-3) and
+/// velocity Verlet reach the same packing height within 1 %.
 #[test]
-fn settling_bed_closes_energy_and_matches_verlet() {
+fn gear_and_verlet_settle_1000_particles_to_same_height() {
     let mut heights = Vec::new();
     for gear in [false, true] {
-        let mut w = box_world(150, 1e-3, 0.01, 0.04, gonthier(0.5, 0.3), 1e-5, false, 5);
-        // Softer particles keep the test fast.
+        let model = gonthier(0.5, 0.3);
+        let mut w = tight_box_world(1000, 1e-3, 0.016, 0.04, model.clone(), 1e-5);
         w.materials[0].youngs_modulus_pa = 2e7;
-        w.interactions =
-            pdamp_dem::interaction::InteractionTable::new(&w.materials, gonthier(0.5, 0.3));
+        w.interactions = pdamp_dem::interaction::InteractionTable::new(&w.materials, model);
         if gear {
             w.integrator = Integrator::Gear(GearParams {
                 tolerance_abs: 1e-3,
@@ -127,11 +126,11 @@ fn settling_bed_closes_energy_and_matches_verlet() {
                 ..Default::default()
             });
         }
-        w.run_until(0.15, |_| {});
-        let closure = w.ledger.closure_error_j().abs() / w.ledger.dissipated_j();
+        let h0 = bed_height(&w);
+        w.run_until(0.1, |_| {});
         eprintln!(
-            "gear={gear}: steps {}, rejected {}, force evaluations {}, height {:.5e} m, KE {:.3e} J, \
-             dissipated {:.4e} J, closure error / dissipated {closure:.2e}",
+            "gear={gear}: steps {}, rejected {}, force evaluations {}, height {:.6e} m (initial {h0:.6e} m), \
+             KE {:.3e} J, dissipated {:.4e} J",
             w.counters.steps,
             w.counters.rejected_steps,
             w.counters.force_evaluations,
@@ -139,19 +138,21 @@ fn settling_bed_closes_energy_and_matches_verlet() {
             w.ledger.kinetic_j,
             w.ledger.dissipated_j()
         );
-        // Verlet's contact work uses the step's mean velocity and closes to round-off level;
-        // Gear evaluates the contact power with end-of-step velocities before the last correction,
-        // which leaves a balance error of the order of its tolerance times the step count ratio.
-        let limit = if gear { 2e-2 } else { 1e-3 };
-        assert!(closure < limit, "energy closure {closure:e}");
         assert!(
             w.ledger.kinetic_j < 1e-3 * w.ledger.dissipated_j(),
             "bed not settled"
         );
+        // Verlet's contact work uses the step's mean velocity and closes to round-off level;
+        // Gear evaluates the contact power with end-of-step velocities before the last correction,
+        // which leaves a balance error of the order of its tolerance.
+        let closure = w.ledger.closure_error_j().abs() / w.ledger.dissipated_j();
+        eprintln!("closure error / dissipated {closure:.2e}");
+        let limit = if gear { 2e-2 } else { 1e-3 };
+        assert!(closure < limit, "energy closure {closure:e}");
         heights.push(bed_height(&w));
     }
     assert!(
-        (heights[1] / heights[0] - 1.0).abs() < 0.02,
+        (heights[1] / heights[0] - 1.0).abs() < 0.01,
         "heights {heights:?}"
     );
 }

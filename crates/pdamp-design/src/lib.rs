@@ -1,0 +1,1 @@
+//! Design level: single damper under harmonic excitation, effective fields, motion modes.

@@ -1,0 +1,1 @@
+//! Plots (PNG and SVG) of effective-field maps, decay curves and FRFs.

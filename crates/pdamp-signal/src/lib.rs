@@ -1,0 +1,1 @@
+//! Signal analysis: harmonic amplitudes, complex power method, decay and FRF evaluation.
