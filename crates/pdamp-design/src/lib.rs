@@ -1,1 +1,11 @@
-//! Design level: single damper under harmonic excitation, effective fields, motion modes.
+//! Design level of pdamp: a single particle damper under harmonic excitation evaluated by the
+//! complex power method [D Sect. 3.2], effective fields over frequency × amplitude, motion modes,
+//! and reference solutions of idealised damper motions.
+
+pub mod damper;
+pub mod event_driven;
+pub mod fields;
+pub mod motion;
+
+pub use damper::{Damper, PointObserver, PointResult};
+pub use fields::{FieldGrid, run_fields};

@@ -71,7 +71,8 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
         }],
         particles: vec![ParticleGroupSpec {
             material: "steel".into(),
-            count: n,
+            count: Some(n),
+            filling: None,
             size: SizeDistribution::Monodisperse { radius_m: 1e-3 },
             placement: PlacementSpec {
                 method: PlacementMethod::Tight,
@@ -88,5 +89,7 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
             max_duration_s: 0.05,
             kinetic_energy_per_particle_j: 0.0,
         }),
+        damper: None,
+        fields: None,
     }
 }

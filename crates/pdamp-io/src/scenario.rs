@@ -69,6 +69,267 @@ pub struct Scenario {
     /// Optional settling (drop-down) phase before the main run.
     #[serde(default)]
     pub settle: Option<SettleSpec>,
+    /// Single-damper evaluation: harmonic excitation of a container and the complex power
+    /// method [D Sect. 3.2]. With it, `pdamp run` evaluates one point and `pdamp fields` a grid.
+    #[serde(default)]
+    pub damper: Option<DamperSpec>,
+    /// Grid of excitation points for `pdamp fields` (needs `[damper]`).
+    #[serde(default)]
+    pub fields: Option<FieldsSpec>,
+}
+
+/// Standard gravity used for the excitation intensity Γ = A/g [D Eq. 3.11], m/s².
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
+
+/// A particle damper moved harmonically, $x_c = X \sin(\Omega t)$ along `direction`
+/// [D Eq. 3.8–3.11].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamperSpec {
+    /// Name of the body that is the container (its `motion` is replaced by the excitation).
+    pub container_body: String,
+    /// Mass of the container m_con, kg (its inertia is part of the driving force).
+    pub container_mass_kg: f64,
+    /// Excitation direction (normalised on use).
+    pub direction: [f64; 3],
+    /// Excitation frequency f, Hz (for `pdamp run`; `pdamp fields` uses the grid).
+    #[serde(default)]
+    pub frequency_hz: Option<f64>,
+    /// Displacement amplitude X, m (give exactly one of X, A or Γ).
+    #[serde(default)]
+    pub amplitude_m: Option<f64>,
+    /// Acceleration amplitude A = XΩ², m/s².
+    #[serde(default)]
+    pub acceleration_m_s2: Option<f64>,
+    /// Excitation intensity Γ = A/g (g = 9.81 m/s²).
+    #[serde(default)]
+    pub intensity: Option<f64>,
+    /// Excitation cycles simulated in total.
+    #[serde(default = "default_cycles")]
+    pub cycles: u32,
+    /// Leading cycles dropped as transient before the evaluation.
+    #[serde(default = "default_transient_cycles")]
+    pub transient_cycles: u32,
+    /// Motion-mode output of `pdamp run` (velocity fields, trajectories, VTK frames).
+    #[serde(default)]
+    pub motion_output: MotionOutputSpec,
+}
+
+fn default_cycles() -> u32 {
+    20
+}
+fn default_transient_cycles() -> u32 {
+    5
+}
+
+/// What `pdamp run` records of the bed motion on a damper scenario [D Sect. 3.2.1].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionOutputSpec {
+    /// Phases per cycle at which phase-averaged velocity fields are taken (0 = none); phase k
+    /// is Ωt = 2πk/n, so n = 4 gives x_c = 0, X, 0, −X.
+    #[serde(default = "default_phases")]
+    pub phases_per_cycle: u32,
+    /// Cells of the velocity-field grid along the excitation direction (the other axis scales
+    /// with the container's aspect ratio).
+    #[serde(default = "default_field_cells")]
+    pub field_cells: u32,
+    /// Particle indices whose trajectories (container frame) are written.
+    #[serde(default)]
+    pub trajectory_particles: Vec<usize>,
+    /// VTK frames per cycle over the last evaluated cycle (0 = none).
+    #[serde(default = "default_vtk_frames")]
+    pub vtk_frames_per_cycle: u32,
+}
+
+fn default_phases() -> u32 {
+    4
+}
+fn default_field_cells() -> u32 {
+    24
+}
+fn default_vtk_frames() -> u32 {
+    16
+}
+
+impl Default for MotionOutputSpec {
+    fn default() -> Self {
+        Self {
+            phases_per_cycle: default_phases(),
+            field_cells: default_field_cells(),
+            trajectory_particles: Vec::new(),
+            vtk_frames_per_cycle: default_vtk_frames(),
+        }
+    }
+}
+
+impl DamperSpec {
+    /// Displacement amplitude X at `frequency_hz` from whichever of X, A, Γ is given, m.
+    pub fn amplitude_at(&self, frequency_hz: f64) -> Option<f64> {
+        let w = 2.0 * std::f64::consts::PI * frequency_hz;
+        match (self.amplitude_m, self.acceleration_m_s2, self.intensity) {
+            (Some(x), None, None) => Some(x),
+            (None, Some(a), None) => Some(a / (w * w)),
+            (None, None, Some(g)) => Some(g * STANDARD_GRAVITY_M_S2 / (w * w)),
+            _ => None,
+        }
+    }
+}
+
+/// Values along one axis of the effective-field grid: an explicit list or a range.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AxisSpec {
+    /// Explicit values.
+    List(Vec<f64>),
+    /// `count` values from `from` to `to`, evenly spaced (`linear`) or geometrically (`log`).
+    Range {
+        /// First value.
+        from: f64,
+        /// Last value.
+        to: f64,
+        /// Number of values (≥ 1).
+        count: usize,
+        /// `linear` or `log`.
+        #[serde(default)]
+        spacing: Spacing,
+    },
+}
+
+/// Spacing of a range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Spacing {
+    /// Equal differences.
+    #[default]
+    Linear,
+    /// Equal ratios.
+    Log,
+}
+
+impl AxisSpec {
+    /// The values.
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            AxisSpec::List(v) => v.clone(),
+            AxisSpec::Range {
+                from,
+                to,
+                count,
+                spacing,
+            } => {
+                let n = *count;
+                if n == 1 {
+                    return vec![*from];
+                }
+                (0..n)
+                    .map(|k| {
+                        let s = k as f64 / (n - 1) as f64;
+                        match spacing {
+                            Spacing::Linear => from + (to - from) * s,
+                            Spacing::Log => from * (to / from).powf(s),
+                        }
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// True for a logarithmic range (or a list with constant ratios).
+    pub fn is_log(&self) -> bool {
+        match self {
+            AxisSpec::Range { spacing, .. } => *spacing == Spacing::Log,
+            AxisSpec::List(v) => {
+                v.len() > 2
+                    && v.iter().all(|x| *x > 0.0)
+                    && v.windows(3).all(|w| {
+                        let (a, b) = (w[1] / w[0], w[2] / w[1]);
+                        (a / b - 1.0).abs() < 1e-6
+                    })
+                    && (v[1] / v[0] - 1.0).abs() > 1e-6
+                    && {
+                        let d = v[1] - v[0];
+                        let d2 = v[2] - v[1];
+                        (d / d2 - 1.0).abs() > 1e-6
+                    }
+            }
+        }
+    }
+
+    fn validate(&self, key: &str) -> Result<(), String> {
+        let v = self.values();
+        if v.is_empty() {
+            return Err(format!("{key}: no values"));
+        }
+        if let AxisSpec::Range {
+            from,
+            to,
+            spacing: Spacing::Log,
+            ..
+        } = self
+            && !(*from > 0.0 && *to > 0.0)
+        {
+            return Err(format!("{key}: a log range needs from > 0 and to > 0"));
+        }
+        if v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+            return Err(format!("{key}: all values must be finite and > 0"));
+        }
+        Ok(())
+    }
+}
+
+/// Which amplitude measure the second grid axis gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum AmplitudeAxis {
+    /// Displacement amplitude X, m.
+    Displacement,
+    /// Acceleration amplitude A, m/s².
+    Acceleration,
+    /// Intensity Γ = A/g.
+    Intensity,
+}
+
+/// Grid of an effective field: frequencies × one amplitude measure [D Sect. 8.1.1].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldsSpec {
+    /// Excitation frequencies, Hz.
+    pub frequencies_hz: AxisSpec,
+    /// Displacement amplitudes X, m (give exactly one amplitude axis).
+    #[serde(default)]
+    pub amplitudes_m: Option<AxisSpec>,
+    /// Acceleration amplitudes A, m/s².
+    #[serde(default)]
+    pub accelerations_m_s2: Option<AxisSpec>,
+    /// Intensities Γ = A/g.
+    #[serde(default)]
+    pub intensities: Option<AxisSpec>,
+}
+
+impl FieldsSpec {
+    /// The amplitude axis and its spec.
+    pub fn amplitude_axis(&self) -> Option<(AmplitudeAxis, &AxisSpec)> {
+        match (
+            &self.amplitudes_m,
+            &self.accelerations_m_s2,
+            &self.intensities,
+        ) {
+            (Some(a), None, None) => Some((AmplitudeAxis::Displacement, a)),
+            (None, Some(a), None) => Some((AmplitudeAxis::Acceleration, a)),
+            (None, None, Some(a)) => Some((AmplitudeAxis::Intensity, a)),
+            _ => None,
+        }
+    }
+
+    /// Displacement amplitude X for frequency `f` and amplitude-axis value `a`, m.
+    pub fn displacement(axis: AmplitudeAxis, f: f64, a: f64) -> f64 {
+        let w = 2.0 * std::f64::consts::PI * f;
+        match axis {
+            AmplitudeAxis::Displacement => a,
+            AmplitudeAxis::Acceleration => a / (w * w),
+            AmplitudeAxis::Intensity => a * STANDARD_GRAVITY_M_S2 / (w * w),
+        }
+    }
 }
 
 /// Global settings of the run.
@@ -248,8 +509,12 @@ fn one() -> f64 {
 pub struct ParticleGroupSpec {
     /// Material name.
     pub material: String,
-    /// Number of particles.
-    pub count: usize,
+    /// Number of particles (or give `filling`).
+    #[serde(default)]
+    pub count: Option<usize>,
+    /// Number of particles from a filling ratio or a clearance [D Eq. 8.1].
+    #[serde(default)]
+    pub filling: Option<FillingSpec>,
     /// Size distribution.
     pub size: SizeDistribution,
     /// Where the particles start.
@@ -257,6 +522,62 @@ pub struct ParticleGroupSpec {
     /// Initial velocity, m/s.
     #[serde(default)]
     pub initial_velocity_m_s: [f64; 3],
+}
+
+/// Particle number from the container's capacity $n_p^{max}$: either a filling ratio
+/// $n_p/n_p^{max}$ or a clearance h to the lid, $n_p = n_p^{max}(1 - h/L)$ [D Eq. 8.1].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FillingSpec {
+    /// Particles that fill the container completely, $n_p^{max}$.
+    pub max_count: usize,
+    /// Filling ratio $n_p / n_p^{max}$ in (0, 1].
+    #[serde(default)]
+    pub ratio: Option<f64>,
+    /// Clearance h between bed and lid, m.
+    #[serde(default)]
+    pub clearance_m: Option<f64>,
+    /// Inner container length L along the excitation, m (with `clearance_m`).
+    #[serde(default)]
+    pub container_length_m: Option<f64>,
+}
+
+impl ParticleGroupSpec {
+    /// Number of particles of the group from `count` or `filling`.
+    pub fn resolved_count(&self) -> Result<usize, String> {
+        match (&self.count, &self.filling) {
+            (Some(n), None) => Ok(*n),
+            (None, Some(f)) => {
+                if f.max_count == 0 {
+                    return Err("filling.max_count must be > 0".into());
+                }
+                let ratio = match (f.ratio, f.clearance_m, f.container_length_m) {
+                    (Some(r), None, None) => {
+                        if !(r > 0.0 && r <= 1.0) {
+                            return Err(format!("filling.ratio must be in (0, 1], got {r}"));
+                        }
+                        r
+                    }
+                    (None, Some(h), Some(l)) => {
+                        if !(l > 0.0 && h >= 0.0 && h < l) {
+                            return Err(format!(
+                                "filling: need 0 <= clearance_m < container_length_m, got {h} and {l}"
+                            ));
+                        }
+                        1.0 - h / l
+                    }
+                    _ => {
+                        return Err(
+                            "filling: give either ratio, or clearance_m together with container_length_m"
+                                .into(),
+                        );
+                    }
+                };
+                Ok((ratio * f.max_count as f64).round() as usize)
+            }
+            _ => Err("give exactly one of count and filling".into()),
+        }
+    }
 }
 
 /// Initial placement of a particle group.
@@ -393,8 +714,88 @@ impl Scenario {
                 }
             }
         }
+        if let Some(d) = &self.damper {
+            if !self.bodies.iter().any(|b| b.name == d.container_body) {
+                let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+                return Err(format!(
+                    "damper.container_body: no body named '{}' (bodies: {})",
+                    d.container_body,
+                    known.join(", ")
+                ));
+            }
+            if !(d.container_mass_kg.is_finite() && d.container_mass_kg >= 0.0) {
+                return Err(format!(
+                    "damper.container_mass_kg must be >= 0, got {}",
+                    d.container_mass_kg
+                ));
+            }
+            if !(Vec3::from(d.direction).norm() > 0.0) {
+                return Err("damper.direction must not be zero".into());
+            }
+            let given = [
+                d.amplitude_m.is_some(),
+                d.acceleration_m_s2.is_some(),
+                d.intensity.is_some(),
+            ]
+            .iter()
+            .filter(|x| **x)
+            .count();
+            if given > 1 {
+                return Err(
+                    "damper: give only one of amplitude_m, acceleration_m_s2, intensity".into(),
+                );
+            }
+            if self.fields.is_none() && given == 0 {
+                return Err(
+                    "damper: give one of amplitude_m, acceleration_m_s2 or intensity (or a [fields] grid)"
+                        .into(),
+                );
+            }
+            for (k, v) in [
+                ("amplitude_m", d.amplitude_m),
+                ("acceleration_m_s2", d.acceleration_m_s2),
+                ("intensity", d.intensity),
+                ("frequency_hz", d.frequency_hz),
+            ] {
+                if let Some(v) = v
+                    && !(v.is_finite() && v > 0.0)
+                {
+                    return Err(format!("damper.{k} must be > 0, got {v}"));
+                }
+            }
+            if self.fields.is_none() && d.frequency_hz.is_none() {
+                return Err("damper.frequency_hz is needed (or a [fields] grid)".into());
+            }
+            if d.cycles <= d.transient_cycles {
+                return Err(format!(
+                    "damper.cycles ({}) must exceed damper.transient_cycles ({})",
+                    d.cycles, d.transient_cycles
+                ));
+            }
+        }
+        if let Some(f) = &self.fields {
+            if self.damper.is_none() {
+                return Err("fields: a [damper] section is needed".into());
+            }
+            f.frequencies_hz.validate("fields.frequencies_hz")?;
+            match f.amplitude_axis() {
+                Some((AmplitudeAxis::Displacement, a)) => a.validate("fields.amplitudes_m")?,
+                Some((AmplitudeAxis::Acceleration, a)) => {
+                    a.validate("fields.accelerations_m_s2")?
+                }
+                Some((AmplitudeAxis::Intensity, a)) => a.validate("fields.intensities")?,
+                None => {
+                    return Err(
+                        "fields: give exactly one of amplitudes_m, accelerations_m_s2, intensities"
+                            .into(),
+                    );
+                }
+            }
+        }
         for (g, grp) in self.particles.iter().enumerate() {
             self.material_index(&grp.material, &format!("particles[{g}].material"))?;
+            grp.resolved_count()
+                .map_err(|e| format!("particles[{g}].{e}"))?;
             grp.size
                 .validate()
                 .map_err(|e| format!("particles[{g}].size: {e}"))?;
@@ -467,9 +868,12 @@ impl Scenario {
         let mut placed: Vec<(Vec3, f64)> = Vec::new();
         for (g, grp) in self.particles.iter().enumerate() {
             let mat = self.material_index(&grp.material, "particles")?;
+            let count = grp
+                .resolved_count()
+                .map_err(|e| format!("particles[{g}].{e}"))?;
             let radii = grp
                 .size
-                .sample_n(grp.count, self.simulation.seed.wrapping_add(g as u64));
+                .sample_n(count, self.simulation.seed.wrapping_add(g as u64));
             let pl = &grp.placement;
             let pos = match pl.method {
                 PlacementMethod::Grid => grid_packing(&pl.region, &radii, pl.gap_m, &up),

@@ -1,0 +1,185 @@
+//! Effective fields [D Sect. 3.2.2, 8.1.1]: the damper evaluated on a grid of excitation
+//! frequencies × amplitudes, each point an independent simulation from the same settled bed,
+//! run in parallel and resumable (every finished point is stored at once and never recomputed).
+
+use crate::damper::{Damper, PointResult};
+use pdamp_io::scenario::{AmplitudeAxis, FieldsSpec};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Columns of `fields.csv`: the required columns first, then diagnostics.
+pub const FIELD_COLUMNS: [&str; 17] = [
+    "frequency_hz",
+    "amplitude_m",
+    "acceleration_m_s2",
+    "intensity",
+    "dissipated_energy_per_cycle_j",
+    "loss_factor",
+    "effective_loss_factor",
+    "effective_mass_ratio",
+    "effective_moving_mass_re_kg",
+    "effective_moving_mass_im_kg",
+    "ledger_dissipated_per_cycle_j",
+    "share_normal_pp",
+    "share_normal_pw",
+    "share_tangential_pp",
+    "share_tangential_pw",
+    "energy_closure_relative",
+    "wall_time_s",
+];
+
+/// The grid of an effective field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldGrid {
+    /// Frequencies, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// Which amplitude measure the second axis holds.
+    pub amplitude_axis: AmplitudeAxis,
+    /// Values of the second axis (m, m/s² or Γ).
+    pub amplitude_values: Vec<f64>,
+    /// Frequency axis is logarithmic.
+    pub frequency_log: bool,
+    /// Amplitude axis is logarithmic.
+    pub amplitude_log: bool,
+}
+
+impl FieldGrid {
+    /// Grid from the scenario's `[fields]` section.
+    pub fn from_spec(spec: &FieldsSpec) -> Result<Self, String> {
+        let (axis, a) = spec
+            .amplitude_axis()
+            .ok_or("fields: give exactly one amplitude axis")?;
+        Ok(Self {
+            frequencies_hz: spec.frequencies_hz.values(),
+            amplitude_axis: axis,
+            amplitude_values: a.values(),
+            frequency_log: spec.frequencies_hz.is_log(),
+            amplitude_log: a.is_log(),
+        })
+    }
+
+    /// All points (frequency index, amplitude index, f, X), frequency-major.
+    pub fn points(&self) -> Vec<(usize, usize, f64, f64)> {
+        let mut out = Vec::new();
+        for (i, &f) in self.frequencies_hz.iter().enumerate() {
+            for (j, &a) in self.amplitude_values.iter().enumerate() {
+                out.push((i, j, f, FieldsSpec::displacement(self.amplitude_axis, f, a)));
+            }
+        }
+        out
+    }
+
+    /// Axis title of the amplitude axis with its unit.
+    pub fn amplitude_title(&self) -> &'static str {
+        match self.amplitude_axis {
+            AmplitudeAxis::Displacement => "amplitude X (m)",
+            AmplitudeAxis::Acceleration => "acceleration A (m/s²)",
+            AmplitudeAxis::Intensity => "intensity Γ = A/g (-)",
+        }
+    }
+}
+
+/// One row of `fields.csv` for a point.
+pub fn field_row(r: &PointResult) -> Vec<f64> {
+    vec![
+        r.frequency_hz,
+        r.amplitude_m,
+        r.acceleration_m_s2,
+        r.intensity,
+        r.dissipated_energy_per_cycle_j,
+        r.loss_factor,
+        r.effective_loss_factor,
+        r.effective_mass_ratio,
+        r.effective_moving_mass_re_kg,
+        r.effective_moving_mass_im_kg,
+        r.ledger_dissipated_per_cycle_j,
+        r.share_normal_pp,
+        r.share_normal_pw,
+        r.share_tangential_pp,
+        r.share_tangential_pw,
+        r.energy_closure_relative,
+        r.wall_time_s,
+    ]
+}
+
+fn point_path(dir: &Path, i: usize, j: usize) -> PathBuf {
+    dir.join("points").join(format!("f{i:03}_a{j:03}.json"))
+}
+
+/// A stored point is reused only if it belongs to the same excitation.
+fn load_point(path: &Path, f: f64, x: f64) -> Option<PointResult> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let r: PointResult = serde_json::from_str(&text).ok()?;
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    (same(r.frequency_hz, f) && same(r.amplitude_m, x)).then_some(r)
+}
+
+/// Outcome of [`run_fields`].
+#[derive(Debug, Clone)]
+pub struct FieldsOutcome {
+    /// All points in grid order (frequency-major).
+    pub points: Vec<PointResult>,
+    /// Points taken from an earlier, interrupted run.
+    pub reused: usize,
+}
+
+/// Runs all grid points not yet stored in `out_dir/points/`, in parallel, then writes
+/// `out_dir/fields.csv`. `on_point(done, total)` is called after every finished point.
+pub fn run_fields(
+    damper: &Damper,
+    grid: &FieldGrid,
+    out_dir: &Path,
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    let io = |e: std::io::Error| format!("output: {e}");
+    std::fs::create_dir_all(out_dir.join("points")).map_err(io)?;
+    let points = grid.points();
+    let total = points.len();
+    let mut results: Vec<Option<PointResult>> = points
+        .iter()
+        .map(|&(i, j, f, x)| load_point(&point_path(out_dir, i, j), f, x))
+        .collect();
+    let reused = results.iter().filter(|r| r.is_some()).count();
+    let done = std::sync::atomic::AtomicUsize::new(reused);
+    on_point(reused, total);
+    let pending: Vec<usize> = (0..total).filter(|&k| results[k].is_none()).collect();
+    // Expensive points (many steps: low frequency) first for better load balance.
+    let mut pending = pending;
+    pending.sort_by(|&a, &b| points[a].2.total_cmp(&points[b].2));
+    let fresh: Vec<(usize, Result<PointResult, String>)> = pending
+        .par_iter()
+        .with_max_len(1)
+        .map(|&k| {
+            let (i, j, f, x) = points[k];
+            let stored = damper.run_point(f, x, &mut ()).and_then(|r| {
+                let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
+                pdamp_io::atomic::write_atomic(point_path(out_dir, i, j), json.as_bytes())
+                    .map_err(|e| format!("output: {e}"))?;
+                Ok(r)
+            });
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            on_point(n, total);
+            (k, stored)
+        })
+        .collect();
+    for (k, r) in fresh {
+        results[k] = Some(r?);
+    }
+    let points: Vec<PointResult> = results.into_iter().map(|r| r.unwrap()).collect();
+    write_fields_csv(&out_dir.join("fields.csv"), &points)?;
+    Ok(FieldsOutcome { points, reused })
+}
+
+/// Writes `fields.csv` atomically.
+pub fn write_fields_csv(path: &Path, points: &[PointResult]) -> Result<(), String> {
+    let mut buf = Vec::new();
+    {
+        let mut w =
+            pdamp_io::csv::CsvWriter::new(&mut buf, &FIELD_COLUMNS).map_err(|e| e.to_string())?;
+        for p in points {
+            w.write_row(&field_row(p)).map_err(|e| e.to_string())?;
+        }
+        w.flush().map_err(|e| e.to_string())?;
+    }
+    pdamp_io::atomic::write_atomic(path, &buf).map_err(|e| format!("output: {e}"))
+}

@@ -1,0 +1,227 @@
+//! Motion modes of the bed [D Sect. 3.2.1]: phase-resolved velocity fields in the container frame
+//! normalised by the container velocity amplitude V, trajectories of chosen particles, and VTK
+//! frames of the last cycle for animation.
+
+use crate::damper::{Damper, PointObserver};
+use pdamp_dem::{Vec3, World};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// One phase-averaged velocity field on a grid in the plane (excitation direction, up).
+#[derive(Debug, Clone)]
+pub struct PhaseField {
+    /// Phase Ωt of the field, rad.
+    pub phase_rad: f64,
+    /// Sum of |v|/V per cell.
+    pub speed_sum: Vec<f64>,
+    /// Sum of the in-plane velocity components / V per cell.
+    pub vel_sum: Vec<[f64; 2]>,
+    /// Particle samples per cell.
+    pub count: Vec<u64>,
+}
+
+/// Records velocity fields, trajectories and VTK frames while a point runs.
+#[derive(Debug)]
+pub struct MotionRecorder {
+    /// Unit vectors of the field plane: excitation direction and the up direction.
+    pub axes: [Vec3; 2],
+    /// Lower corner of the grid in (axis 0, axis 1), container frame, m.
+    pub origin_m: [f64; 2],
+    /// Cell size, m.
+    pub cell_m: f64,
+    /// Cells along both axes.
+    pub cells: [usize; 2],
+    /// Container velocity amplitude V, m/s.
+    pub velocity_amplitude_m_s: f64,
+    /// One field per recorded phase.
+    pub fields: Vec<PhaseField>,
+    /// Particles whose trajectories are recorded.
+    pub trajectory_particles: Vec<usize>,
+    /// Trajectory rows: particle, time, position in the container frame (x, y, z).
+    pub trajectories: Vec<[f64; 5]>,
+    /// VTK output folder and frames per cycle (last cycle only).
+    pub vtk: Option<(PathBuf, u32)>,
+    /// (time, file) of written VTK frames.
+    pub vtk_frames: Vec<(f64, String)>,
+    /// First error while writing VTK frames.
+    pub error: Option<String>,
+    prev_phase: f64,
+    traj_every: u64,
+}
+
+impl MotionRecorder {
+    /// A recorder for `damper` at velocity amplitude `v_amp` with `phases` fields per cycle and
+    /// `cells_along` cells along the excitation direction over the container's extent.
+    pub fn new(
+        damper: &Damper,
+        v_amp: f64,
+        phases: u32,
+        cells_along: u32,
+        trajectory_particles: Vec<usize>,
+        steps_per_cycle: f64,
+    ) -> Self {
+        let w = &damper.settled;
+        let e = damper.direction;
+        let g = -w.gravity_m_s2;
+        let mut up = g - e * g.dot(&e);
+        if up.norm() < 1e-9 * g.norm().max(1e-300) || g.norm() == 0.0 {
+            // Gravity along the excitation or zero: pick a perpendicular axis.
+            let t = if e.z.abs() < 0.9 {
+                Vec3::z()
+            } else {
+                Vec3::x()
+            };
+            up = t - e * t.dot(&e);
+        }
+        let up = up.normalize();
+        let axes = [e, up];
+        // Extent: container walls (body frame) or, without bounded walls, the bed ± 50 %.
+        let body = &w.bodies[damper.container];
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for wall in &body.walls {
+            if let Some((a, b)) = wall.geometry.bounding_box() {
+                for c in 0..8 {
+                    let p = Vec3::new(
+                        if c & 1 == 0 { a.x } else { b.x },
+                        if c & 2 == 0 { a.y } else { b.y },
+                        if c & 4 == 0 { a.z } else { b.z },
+                    );
+                    let p = body.reference.orientation.transform_vector(&p);
+                    for k in 0..2 {
+                        lo[k] = lo[k].min(p.dot(&axes[k]));
+                        hi[k] = hi[k].max(p.dot(&axes[k]));
+                    }
+                }
+            }
+        }
+        if !lo[0].is_finite() || !lo[1].is_finite() {
+            for (x, r) in w.particles.position.iter().zip(&w.particles.radius) {
+                let rel = x - body.reference.position_m;
+                for k in 0..2 {
+                    lo[k] = lo[k].min(rel.dot(&axes[k]) - r);
+                    hi[k] = hi[k].max(rel.dot(&axes[k]) + r);
+                }
+            }
+            for k in 0..2 {
+                let m = 0.5 * (hi[k] - lo[k]);
+                lo[k] -= m;
+                hi[k] += m;
+            }
+        }
+        let cell = (hi[0] - lo[0]).max(1e-12) / cells_along.max(1) as f64;
+        let cells = [
+            cells_along.max(1) as usize,
+            (((hi[1] - lo[1]) / cell).ceil() as usize).max(1),
+        ];
+        let nc = cells[0] * cells[1];
+        let fields = (0..phases)
+            .map(|k| PhaseField {
+                phase_rad: 2.0 * PI * k as f64 / phases as f64,
+                speed_sum: vec![0.0; nc],
+                vel_sum: vec![[0.0; 2]; nc],
+                count: vec![0; nc],
+            })
+            .collect();
+        Self {
+            axes,
+            origin_m: lo,
+            cell_m: cell,
+            cells,
+            velocity_amplitude_m_s: v_amp,
+            fields,
+            trajectory_particles,
+            trajectories: Vec::new(),
+            vtk: None,
+            vtk_frames: Vec::new(),
+            error: None,
+            prev_phase: 0.0,
+            traj_every: ((steps_per_cycle / 200.0).floor() as u64).max(1),
+        }
+    }
+
+    fn accumulate(&mut self, w: &World, k: usize, container_pos: &Vec3) {
+        let p = &w.particles;
+        let v_amp = self.velocity_amplitude_m_s.max(1e-300);
+        let f = &mut self.fields[k];
+        for i in 0..p.len() {
+            let rel = p.position[i] - container_pos;
+            let c0 = ((rel.dot(&self.axes[0]) - self.origin_m[0]) / self.cell_m).floor();
+            let c1 = ((rel.dot(&self.axes[1]) - self.origin_m[1]) / self.cell_m).floor();
+            if c0 < 0.0 || c1 < 0.0 {
+                continue;
+            }
+            let (c0, c1) = (c0 as usize, c1 as usize);
+            if c0 >= self.cells[0] || c1 >= self.cells[1] {
+                continue;
+            }
+            let c = c1 * self.cells[0] + c0;
+            let v = p.velocity[i];
+            f.speed_sum[c] += v.norm() / v_amp;
+            f.vel_sum[c][0] += v.dot(&self.axes[0]) / v_amp;
+            f.vel_sum[c][1] += v.dot(&self.axes[1]) / v_amp;
+            f.count[c] += 1;
+        }
+    }
+
+    /// Cell centre (axis 0, axis 1) of cell `c`, m.
+    pub fn cell_center(&self, c: usize) -> [f64; 2] {
+        let (c0, c1) = (c % self.cells[0], c / self.cells[0]);
+        [
+            self.origin_m[0] + (c0 as f64 + 0.5) * self.cell_m,
+            self.origin_m[1] + (c1 as f64 + 0.5) * self.cell_m,
+        ]
+    }
+}
+
+impl PointObserver for MotionRecorder {
+    fn on_step(&mut self, w: &World, cycle: u32, phase: f64, damper: &Damper) {
+        let prev = self.prev_phase;
+        self.prev_phase = phase;
+        if cycle < damper.transient_cycles {
+            return;
+        }
+        let container_pos = w.bodies[damper.container].state.position_m;
+        let wrapped = phase < prev;
+        for k in 0..self.fields.len() {
+            let target = self.fields[k].phase_rad;
+            let crossed = if wrapped {
+                target > prev || target <= phase
+            } else {
+                target > prev && target <= phase
+            };
+            if crossed {
+                self.accumulate(w, k, &container_pos);
+            }
+        }
+        if !self.trajectory_particles.is_empty() && w.counters.steps.is_multiple_of(self.traj_every)
+        {
+            for &i in &self.trajectory_particles {
+                if i < w.particles.len() {
+                    let r = w.particles.position[i] - container_pos;
+                    self.trajectories.push([i as f64, w.time_s, r.x, r.y, r.z]);
+                }
+            }
+        }
+        if let Some((dir, frames)) = &self.vtk
+            && cycle + 1 == damper.cycles
+            && *frames > 0
+        {
+            let slot = (phase / (2.0 * PI) * *frames as f64).floor();
+            let prev_slot = (prev / (2.0 * PI) * *frames as f64).floor();
+            if slot != prev_slot || self.vtk_frames.is_empty() {
+                let idx = self.vtk_frames.len();
+                match pdamp_io::run::write_snapshot(w, dir, idx) {
+                    Ok(f) => self
+                        .vtk_frames
+                        .push((w.time_s, f.to_string_lossy().into_owned())),
+                    Err(e) => {
+                        if self.error.is_none() {
+                            self.error = Some(e.to_string());
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
