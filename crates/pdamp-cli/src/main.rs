@@ -34,6 +34,15 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Effective fields of a damper scenario over its [fields] grid (resumable): writes
+    /// DIR/fields.csv and PNG/SVG maps of η̄, m̄_bed/m_bed and the dissipated energy.
+    Fields {
+        /// Scenario file (TOML) with [damper] and [fields] sections.
+        scenario: PathBuf,
+        /// Output directory (finished points in DIR/points/ are reused).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Print the built-in example scenario as TOML.
     Example {
         /// Number of particles.
@@ -108,6 +117,7 @@ fn main() -> Result<()> {
         .context("cannot start the thread pool")?;
     match cli.command {
         Command::Run { scenario, out } => cmd_run(&scenario, &out),
+        Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
         Command::Example {
             particles,
             duration_s,
@@ -226,12 +236,65 @@ fn cmd_run(scenario: &str, out: &std::path::Path) -> Result<()> {
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let summary = pdamp_io::run::run_scenario(&sc, &base, out, |phase, f| {
+    let tick = |phase: &str, f: f64| {
         bar.set_message(phase.to_string());
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-    })
+    };
+    let json = if sc.damper.is_some() {
+        let s = pdamp_design::report::run_damper_scenario(&sc, &base, out, tick)
+            .map_err(anyhow::Error::msg)?;
+        serde_json::to_string_pretty(&s)?
+    } else {
+        let s = pdamp_io::run::run_scenario(&sc, &base, out, tick).map_err(anyhow::Error::msg)?;
+        serde_json::to_string_pretty(&s)?
+    };
+    bar.finish_and_clear();
+    println!("{json}");
+    Ok(())
+}
+
+fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
+    let sc = pdamp_io::scenario::Scenario::load(scenario)?;
+    if sc.fields.is_none() {
+        bail!(
+            "{}: `pdamp fields` needs a [fields] section (and [damper])",
+            scenario.display()
+        );
+    }
+    let base = scenario
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default();
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{msg:>9} [{elapsed_precise}] {wide_bar} {pos}/{len} eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message("settling");
+    let start = std::time::Instant::now();
+    let outcome = pdamp_design::report::run_fields_scenario(
+        &sc,
+        &base,
+        out,
+        |f| bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64),
+        |done, total| {
+            bar.set_message("points");
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
-    println!("{}", serde_json::to_string_pretty(&summary)?);
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "points": outcome.points.len(),
+            "reused_points": outcome.reused,
+            "wall_time_s": start.elapsed().as_secs_f64(),
+            "fields_csv": out.join("fields.csv"),
+        }))?
+    );
     Ok(())
 }

@@ -134,12 +134,7 @@ impl Damper {
             .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
         world.bodies[container].motion = Motion::Fixed;
         let settling_time_s = match &scenario.settle {
-            Some(s) => pdamp_io::run::settle(
-                &mut world,
-                s.max_duration_s,
-                s.kinetic_energy_per_particle_j,
-                &mut progress,
-            ),
+            Some(s) => pdamp_io::run::settle_with(&mut world, s, &mut progress),
             None => {
                 world.initialize();
                 0.0

@@ -6,6 +6,8 @@ pub mod damper;
 pub mod event_driven;
 pub mod fields;
 pub mod motion;
+pub mod plots;
+pub mod report;
 
 pub use damper::{Damper, PointObserver, PointResult};
 pub use fields::{FieldGrid, run_fields};

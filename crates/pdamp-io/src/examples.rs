@@ -88,6 +88,7 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
         settle: Some(SettleSpec {
             max_duration_s: 0.05,
             kinetic_energy_per_particle_j: 0.0,
+            gravity_m_s2: None,
         }),
         damper: None,
         fields: None,

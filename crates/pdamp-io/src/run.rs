@@ -118,6 +118,29 @@ pub fn settle(
     t
 }
 
+/// Settles `world` as `spec` says (with its own gravity if given) and restarts the clock.
+pub fn settle_with(
+    world: &mut World,
+    spec: &crate::scenario::SettleSpec,
+    tick: impl FnMut(f64),
+) -> f64 {
+    let g = world.gravity_m_s2;
+    if let Some(gs) = spec.gravity_m_s2 {
+        world.gravity_m_s2 = Vec3::from(gs);
+    }
+    let t = settle(
+        world,
+        spec.max_duration_s,
+        spec.kinetic_energy_per_particle_j,
+        tick,
+    );
+    if spec.gravity_m_s2.is_some() {
+        world.gravity_m_s2 = g;
+        world.restart_clock();
+    }
+    t
+}
+
 /// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
 pub fn write_snapshot(
     world: &World,
@@ -246,12 +269,7 @@ pub fn run_scenario(
     crate::atomic::write_atomic(out_dir.join("scenario.toml"), scenario.to_toml().as_bytes())
         .map_err(io)?;
     let settle_t = match &scenario.settle {
-        Some(s) => settle(
-            &mut world,
-            s.max_duration_s,
-            s.kinetic_energy_per_particle_j,
-            |f| progress("settling", f),
-        ),
+        Some(s) => settle_with(&mut world, s, |f| progress("settling", f)),
         None => 0.0,
     };
     world.initialize();

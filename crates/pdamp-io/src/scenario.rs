@@ -617,6 +617,11 @@ pub struct SettleSpec {
     /// Settling ends early when the kinetic energy per particle falls below this, J.
     #[serde(default)]
     pub kinetic_energy_per_particle_j: f64,
+    /// Gravity during settling, m/s² (default: `simulation.gravity_m_s2`). Lets a container be
+    /// filled along one axis and then "turned", e.g. a cylinder filled with its axis vertical and
+    /// excited with the axis horizontal [D Sect. 8.1.1].
+    #[serde(default)]
+    pub gravity_m_s2: Option<[f64; 3]>,
 }
 
 impl Scenario {

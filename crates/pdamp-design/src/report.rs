@@ -1,0 +1,225 @@
+//! Output of damper runs: `summary.json` with the effective quantities, velocity fields,
+//! trajectories, VTK animation of the last cycle and plots.
+
+use crate::damper::{Damper, PointResult};
+use crate::fields::{FieldGrid, FieldsOutcome, run_fields};
+use crate::motion::MotionRecorder;
+use pdamp_io::scenario::Scenario;
+use serde::Serialize;
+use std::path::Path;
+
+/// `summary.json` of `pdamp run` on a damper scenario.
+#[derive(Debug, Clone, Serialize)]
+pub struct DamperRunSummary {
+    /// pdamp version.
+    pub pdamp_version: String,
+    /// Scenario title.
+    pub title: String,
+    /// Number of particles.
+    pub particles: usize,
+    /// Bed mass m_bed, kg.
+    pub bed_mass_kg: f64,
+    /// Container mass m_con, kg.
+    pub container_mass_kg: f64,
+    /// Settling time, s.
+    pub settling_time_s: f64,
+    /// Excitation frequency, Hz.
+    pub frequency_hz: f64,
+    /// Displacement amplitude X, m.
+    pub amplitude_m: f64,
+    /// Acceleration amplitude A, m/s².
+    pub acceleration_m_s2: f64,
+    /// Intensity Γ.
+    pub intensity: f64,
+    /// Dissipated energy per cycle Ẽ [D Eq. 3.13], J.
+    pub dissipated_energy_per_cycle_j: f64,
+    /// Loss factor η [D Eq. 3.14].
+    pub loss_factor: f64,
+    /// Effective loss factor η̄ [D Eq. 3.15].
+    pub effective_loss_factor: f64,
+    /// Effective particle mass ratio m̄_bed/m_bed [D Eq. 3.17].
+    pub effective_mass_ratio: f64,
+    /// Everything else of the point (ledger cross-check, dissipation shares, timing).
+    pub point: PointResult,
+}
+
+/// Runs the single excitation point of a damper scenario and writes `summary.json`,
+/// `velocity_fields.csv`, `trajectories.csv`, `particles.pvd` + `vtk/` and plots into `out`.
+pub fn run_damper_scenario(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    mut progress: impl FnMut(&str, f64),
+) -> Result<DamperRunSummary, String> {
+    let spec = sc
+        .damper
+        .as_ref()
+        .ok_or("scenario has no [damper] section")?;
+    let f = spec
+        .frequency_hz
+        .ok_or("damper.frequency_hz is needed for `pdamp run`")?;
+    let x = spec
+        .amplitude_at(f)
+        .ok_or("damper: give one of amplitude_m, acceleration_m_s2, intensity")?;
+    let io = |e: std::io::Error| format!("output: {e}");
+    std::fs::create_dir_all(out).map_err(io)?;
+    pdamp_io::atomic::write_atomic(out.join("scenario.toml"), sc.to_toml().as_bytes())
+        .map_err(io)?;
+    let damper = Damper::from_scenario(sc, base_dir, |p| progress("settling", p))?;
+    let omega = 2.0 * std::f64::consts::PI * f;
+    let steps_per_cycle = (1.0 / (f * damper.time_step_s)).ceil();
+    let mo = &spec.motion_output;
+    let mut rec = MotionRecorder::new(
+        &damper,
+        x * omega,
+        mo.phases_per_cycle,
+        mo.field_cells,
+        mo.trajectory_particles.clone(),
+        steps_per_cycle,
+    );
+    if mo.vtk_frames_per_cycle > 0 {
+        let dir = out.join("vtk");
+        std::fs::create_dir_all(&dir).map_err(io)?;
+        rec.vtk = Some((dir, mo.vtk_frames_per_cycle));
+    }
+    let cycles = damper.cycles;
+    let mut wrapped = ProgressObserver {
+        inner: &mut rec,
+        progress: &mut progress,
+        cycles,
+        last: u32::MAX,
+    };
+    let p = damper.run_point(f, x, &mut wrapped)?;
+    if let Some(e) = &rec.error {
+        return Err(format!("output: {e}"));
+    }
+    if !rec.vtk_frames.is_empty() {
+        let mut pvd = pdamp_io::vtk::PvdSeries::new(out.join("particles.pvd"));
+        for (t, file) in &rec.vtk_frames {
+            pvd.add(*t, file.clone()).map_err(|e| e.to_string())?;
+        }
+    }
+    write_velocity_fields(&rec, &out.join("velocity_fields.csv"))?;
+    if !rec.trajectories.is_empty() {
+        let mut buf = Vec::new();
+        {
+            let mut w = pdamp_io::csv::CsvWriter::new(
+                &mut buf,
+                &["particle", "time_s", "x_m", "y_m", "z_m"],
+            )
+            .map_err(|e| e.to_string())?;
+            for row in &rec.trajectories {
+                w.write_row(row).map_err(|e| e.to_string())?;
+            }
+            w.flush().map_err(|e| e.to_string())?;
+        }
+        pdamp_io::atomic::write_atomic(out.join("trajectories.csv"), &buf).map_err(io)?;
+    }
+    crate::plots::velocity_field_plots(&rec, out)?;
+    crate::plots::trajectory_plot(&rec, out)?;
+    let summary = DamperRunSummary {
+        pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+        title: sc.title.clone(),
+        particles: damper.settled.particles.len(),
+        bed_mass_kg: damper.bed_mass_kg,
+        container_mass_kg: damper.container_mass_kg,
+        settling_time_s: damper.settling_time_s,
+        frequency_hz: f,
+        amplitude_m: x,
+        acceleration_m_s2: p.acceleration_m_s2,
+        intensity: p.intensity,
+        dissipated_energy_per_cycle_j: p.dissipated_energy_per_cycle_j,
+        loss_factor: p.loss_factor,
+        effective_loss_factor: p.effective_loss_factor,
+        effective_mass_ratio: p.effective_mass_ratio,
+        point: p,
+    };
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    pdamp_io::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
+    Ok(summary)
+}
+
+struct ProgressObserver<'a, P: FnMut(&str, f64)> {
+    inner: &'a mut MotionRecorder,
+    progress: &'a mut P,
+    cycles: u32,
+    last: u32,
+}
+
+impl<P: FnMut(&str, f64)> crate::damper::PointObserver for ProgressObserver<'_, P> {
+    fn on_step(&mut self, w: &pdamp_dem::World, cycle: u32, phase: f64, d: &Damper) {
+        self.inner.on_step(w, cycle, phase, d);
+        let pct = ((cycle as f64 + phase / (2.0 * std::f64::consts::PI)) / self.cycles as f64
+            * 1000.0) as u32;
+        if pct != self.last {
+            self.last = pct;
+            (self.progress)("running", pct as f64 / 1000.0);
+        }
+    }
+}
+
+/// Writes the phase-averaged velocity fields: one row per phase and occupied cell.
+pub fn write_velocity_fields(rec: &MotionRecorder, path: &Path) -> Result<(), String> {
+    let mut buf = Vec::new();
+    {
+        let mut w = pdamp_io::csv::CsvWriter::new(
+            &mut buf,
+            &[
+                "phase_rad",
+                "x_m",
+                "y_m",
+                "speed_over_v",
+                "vx_over_v",
+                "vy_over_v",
+                "samples",
+            ],
+        )
+        .map_err(|e| e.to_string())?;
+        for f in &rec.fields {
+            for c in 0..f.count.len() {
+                let n = f.count[c];
+                if n == 0 {
+                    continue;
+                }
+                let [x, y] = rec.cell_center(c);
+                let nf = n as f64;
+                w.write_row(&[
+                    f.phase_rad,
+                    x,
+                    y,
+                    f.speed_sum[c] / nf,
+                    f.vel_sum[c][0] / nf,
+                    f.vel_sum[c][1] / nf,
+                    nf,
+                ])
+                .map_err(|e| e.to_string())?;
+            }
+        }
+        w.flush().map_err(|e| e.to_string())?;
+    }
+    pdamp_io::atomic::write_atomic(path, &buf).map_err(|e| format!("output: {e}"))
+}
+
+/// `pdamp fields`: settles the damper once, runs the grid (resumable) and writes `fields.csv`
+/// and the maps.
+pub fn run_fields_scenario(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    mut settle_progress: impl FnMut(f64),
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    let spec = sc
+        .fields
+        .as_ref()
+        .ok_or("scenario has no [fields] section")?;
+    let grid = FieldGrid::from_spec(spec)?;
+    let io = |e: std::io::Error| format!("output: {e}");
+    std::fs::create_dir_all(out).map_err(io)?;
+    pdamp_io::atomic::write_atomic(out.join("scenario.toml"), sc.to_toml().as_bytes())
+        .map_err(io)?;
+    let damper = Damper::from_scenario(sc, base_dir, &mut settle_progress)?;
+    let outcome = run_fields(&damper, &grid, out, on_point)?;
+    crate::plots::field_maps(&grid, &outcome.points, out)?;
+    Ok(outcome)
+}
