@@ -235,6 +235,15 @@ impl Damper {
                 let phase = (omega * w.time_s).rem_euclid(2.0 * PI);
                 observer.on_step(w, cycle, phase, self);
             });
+            if !w.ledger.kinetic_j.is_finite() {
+                return Err(format!(
+                    "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m: the simulation became unstable in cycle {} \
+                     (non-finite kinetic energy). Reduce simulation.time_step_s, or for the Gonthier and \
+                     Lankarani–Nikravesh laws raise min_impact_velocity_m_s: enduring contacts created at rest \
+                     get a damping coefficient ∝ 1/min_impact_velocity_m_s that a fixed explicit step cannot follow",
+                    cycle + 1
+                ));
+            }
         }
         debug_assert!((times[0] - t_eval).abs() < 1e-9 * period.max(1.0));
         let f_hat = harmonic_amplitude(&times, &force, frequency_hz);

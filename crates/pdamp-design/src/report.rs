@@ -218,6 +218,33 @@ pub fn run_fields_scenario(
     std::fs::create_dir_all(out).map_err(io)?;
     pdamp_io::atomic::write_atomic(out.join("scenario.toml"), sc.to_toml().as_bytes())
         .map_err(io)?;
+    // Stored points are reused only for the same physics: everything but the grid itself and
+    // the single-point excitation must match.
+    let mut physics = sc.clone();
+    physics.fields = None;
+    if let Some(d) = physics.damper.as_mut() {
+        d.frequency_hz = None;
+        d.amplitude_m = None;
+        d.acceleration_m_s2 = None;
+        d.intensity = None;
+        d.motion_output = Default::default();
+    }
+    let fingerprint = physics.to_toml();
+    let fp_path = out.join("points").join("scenario_physics.toml");
+    std::fs::create_dir_all(out.join("points")).map_err(io)?;
+    match std::fs::read_to_string(&fp_path) {
+        Ok(old) if old != fingerprint => {
+            return Err(format!(
+                "{}: holds points of a different scenario (see {}); use another --out or delete its points/ folder",
+                out.display(),
+                fp_path.display()
+            ));
+        }
+        Ok(_) => {}
+        Err(_) => {
+            pdamp_io::atomic::write_atomic(&fp_path, fingerprint.as_bytes()).map_err(io)?;
+        }
+    }
     let damper = Damper::from_scenario(sc, base_dir, &mut settle_progress)?;
     let outcome = run_fields(&damper, &grid, out, on_point)?;
     crate::plots::field_maps(&grid, &outcome.points, out)?;

@@ -734,7 +734,8 @@ impl Scenario {
                     d.container_mass_kg
                 ));
             }
-            if !(Vec3::from(d.direction).norm() > 0.0) {
+            if Vec3::from(d.direction).norm() == 0.0 || !Vec3::from(d.direction).norm().is_finite()
+            {
                 return Err("damper.direction must not be zero".into());
             }
             let given = [
