@@ -43,6 +43,12 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Load, validate and build a scenario without running it; prints what would run as JSON
+    /// (particles, masses, shortest contact time, time-step ratio, damper grid).
+    Check {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+    },
     /// Print the built-in example scenario as TOML.
     Example {
         /// Number of particles.
@@ -118,6 +124,7 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Run { scenario, out } => cmd_run(&scenario, &out),
         Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
+        Command::Check { scenario } => cmd_check(&scenario),
         Command::Example {
             particles,
             duration_s,
@@ -296,5 +303,54 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
             "fields_csv": out.join("fields.csv"),
         }))?
     );
+    Ok(())
+}
+
+fn cmd_check(scenario: &std::path::Path) -> Result<()> {
+    let sc = pdamp_io::scenario::Scenario::load(scenario)?;
+    let base = scenario
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default();
+    let world = sc.build_world(&base).map_err(anyhow::Error::msg)?;
+    let p = &world.particles;
+    let bed_mass: f64 = p.mass.iter().sum();
+    let (rmin, rmax) = p
+        .radius
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(a, b), &r| (a.min(r), b.max(r)));
+    let tc = world.min_contact_time_s(sc.simulation.check_impact_velocity_m_s);
+    let mut report = serde_json::json!({
+        "scenario": scenario,
+        "title": sc.title,
+        "particles": p.len(),
+        "bed_mass_kg": bed_mass,
+        "min_radius_m": rmin,
+        "max_radius_m": rmax,
+        "bodies": world.bodies.iter().map(|b| b.name.clone()).collect::<Vec<_>>(),
+        "time_step_s": sc.simulation.time_step_s,
+        "shortest_contact_time_s": tc,
+        "time_step_over_contact_time": sc.simulation.time_step_s / tc,
+    });
+    if let Some(d) = &sc.damper {
+        report["damper"] = serde_json::json!({
+            "container_body": d.container_body,
+            "container_mass_kg": d.container_mass_kg,
+            "frequency_hz": d.frequency_hz,
+            "amplitude_m": d.frequency_hz.and_then(|f| d.amplitude_at(f)),
+            "cycles": d.cycles,
+            "transient_cycles": d.transient_cycles,
+        });
+    }
+    if let Some(f) = &sc.fields {
+        let g = pdamp_design::FieldGrid::from_spec(f).map_err(anyhow::Error::msg)?;
+        report["fields"] = serde_json::json!({
+            "frequencies_hz": g.frequencies_hz,
+            "amplitude_axis": format!("{:?}", g.amplitude_axis),
+            "amplitude_values": g.amplitude_values,
+            "points": g.frequencies_hz.len() * g.amplitude_values.len(),
+        });
+    }
+    println!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
 }
