@@ -157,3 +157,30 @@ fn restitution_hertz_mindlin() {
         }
     }
 }
+
+/// Velocity-dependent restitution [D Tab. 8.1, Chap. 4]: Gonthier's law with ε(δ̇₀) from a table
+/// reproduces the interpolated ε of every impact velocity within 1 %, sphere–wall and
+/// sphere–sphere.
+#[test]
+fn restitution_table_follows_impact_velocity() {
+    let law = NormalLaw::GonthierTable {
+        impact_velocities_m_s: vec![0.01, 0.1, 0.5, 2.0],
+        restitutions: vec![0.95, 0.85, 0.65, 0.55],
+        min_impact_velocity_m_s: 1e-3,
+    };
+    let mut worst: f64 = 0.0;
+    for partner in [Partner::Wall, Partner::Sphere] {
+        for v in [0.005, 0.01, 0.03, 0.1, 0.3, 1.0, 2.0, 5.0] {
+            let expect = law.restitution_at(v);
+            let res = head_on_impact(&setup(partner, 5e-3, v, law.clone()));
+            let err = (res.restitution / expect - 1.0).abs();
+            worst = worst.max(err);
+            assert!(
+                err < 0.01,
+                "{partner:?} v = {v}: restitution {} vs table {expect}",
+                res.restitution
+            );
+        }
+    }
+    eprintln!("ε(v) table: largest relative restitution error {worst:.2e}");
+}

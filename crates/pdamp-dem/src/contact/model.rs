@@ -59,6 +59,19 @@ pub enum NormalLaw {
         #[serde(default = "default_min_impact_velocity")]
         min_impact_velocity_m_s: f64,
     },
+    /// Gonthier's law [D Eq. 2.78, 2.79] with a velocity-dependent coefficient of restitution
+    /// $\varepsilon(\dot\delta_0)$ given as a table over the impact velocity (as measured or from
+    /// FE impact simulations [D Chap. 4]; [D Tab. 8.1] "velocity dependent"): each contact uses
+    /// ε of its own impact velocity, linearly interpolated and held constant outside the table.
+    GonthierTable {
+        /// Impact velocities of the table, m/s (strictly increasing, > 0).
+        impact_velocities_m_s: Vec<f64>,
+        /// Coefficients of restitution at those velocities, each in (0, 1].
+        restitutions: Vec<f64>,
+        /// Lower bound for the stored impact velocity $\dot\delta_0$ in m/s, default 1e-3 m/s.
+        #[serde(default = "default_min_impact_velocity")]
+        min_impact_velocity_m_s: f64,
+    },
     /// Lankarani–Nikravesh law
     /// $F_n = k_n \delta^{3/2}\,(1 + \tfrac34 (1-\varepsilon^2)\,\dot\delta/\dot\delta_0)$ [D Eq. 2.77],
     /// accurate for ε ≳ 0.8. Total force clipped at zero.
@@ -162,6 +175,20 @@ pub struct DmtAdhesion {
     pub cutoff_ratio: f64,
 }
 
+/// Piecewise-linear interpolation in a table `(x, y)` with increasing `x`, constant outside.
+pub(crate) fn interpolate_clamped(x: &[f64], y: &[f64], v: f64) -> f64 {
+    if v <= x[0] {
+        return y[0];
+    }
+    let n = x.len();
+    if v >= x[n - 1] {
+        return y[n - 1];
+    }
+    let k = x.partition_point(|&xi| xi <= v); // x[k-1] <= v < x[k]
+    let t = (v - x[k - 1]) / (x[k] - x[k - 1]);
+    y[k - 1] + t * (y[k] - y[k - 1])
+}
+
 fn check(ok: bool, field: &str, range: &str, value: f64) -> Result<(), String> {
     if ok {
         Ok(())
@@ -171,14 +198,29 @@ fn check(ok: bool, field: &str, range: &str, value: f64) -> Result<(), String> {
 }
 
 impl NormalLaw {
-    /// Coefficient of restitution the law is parametrised with (1 for [`NormalLaw::Hertz`]).
+    /// Coefficient of restitution the law is parametrised with (1 for [`NormalLaw::Hertz`]; for
+    /// [`NormalLaw::GonthierTable`] the value at 1 m/s).
     pub fn restitution(&self) -> f64 {
         match *self {
             NormalLaw::Hertz => 1.0,
+            NormalLaw::GonthierTable { .. } => self.restitution_at(1.0),
             NormalLaw::Gonthier { restitution, .. }
             | NormalLaw::LankaraniNikravesh { restitution, .. }
             | NormalLaw::Linear { restitution, .. }
             | NormalLaw::HertzMindlin { restitution, .. } => restitution,
+        }
+    }
+
+    /// Coefficient of restitution at impact velocity `v` (m/s): the table value for
+    /// [`NormalLaw::GonthierTable`] (linear interpolation, constant outside), else the constant.
+    pub fn restitution_at(&self, v: f64) -> f64 {
+        match self {
+            NormalLaw::GonthierTable {
+                impact_velocities_m_s: x,
+                restitutions: y,
+                ..
+            } => interpolate_clamped(x, y, v),
+            _ => self.restitution(),
         }
     }
 
@@ -187,6 +229,10 @@ impl NormalLaw {
     pub fn min_impact_velocity_m_s(&self) -> f64 {
         match *self {
             NormalLaw::Gonthier {
+                min_impact_velocity_m_s,
+                ..
+            }
+            | NormalLaw::GonthierTable {
                 min_impact_velocity_m_s,
                 ..
             }
@@ -204,8 +250,44 @@ impl NormalLaw {
     }
 
     fn validate(&self) -> Result<(), String> {
+        if let NormalLaw::GonthierTable {
+            impact_velocities_m_s: x,
+            restitutions: y,
+            min_impact_velocity_m_s,
+        } = self
+        {
+            if x.is_empty() || x.len() != y.len() {
+                return Err(format!(
+                    "normal.impact_velocities_m_s ({} values) and normal.restitutions ({} values) must be non-empty and of equal length",
+                    x.len(),
+                    y.len()
+                ));
+            }
+            for (k, v) in x.iter().enumerate() {
+                check(
+                    v.is_finite() && *v > 0.0 && (k == 0 || *v > x[k - 1]),
+                    &format!("normal.impact_velocities_m_s[{k}]"),
+                    "be > 0 and strictly increasing",
+                    *v,
+                )?;
+            }
+            for (k, e) in y.iter().enumerate() {
+                check(
+                    *e > 0.0 && *e <= 1.0,
+                    &format!("normal.restitutions[{k}]"),
+                    "lie in (0, 1]",
+                    *e,
+                )?;
+            }
+            return check(
+                *min_impact_velocity_m_s > 0.0 && min_impact_velocity_m_s.is_finite(),
+                "normal.min_impact_velocity_m_s",
+                "be > 0",
+                *min_impact_velocity_m_s,
+            );
+        }
         match *self {
-            NormalLaw::Hertz => Ok(()),
+            NormalLaw::Hertz | NormalLaw::GonthierTable { .. } => Ok(()),
             NormalLaw::Gonthier {
                 restitution,
                 min_impact_velocity_m_s,
