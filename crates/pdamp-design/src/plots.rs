@@ -11,8 +11,10 @@ fn err(e: impl std::fmt::Display) -> String {
     format!("plot: {e}")
 }
 
-/// Maps of η̄ (colour saturating at 1, as in the dissertation), m̄_bed/m_bed and Ẽ over the
-/// grid: `effective_loss_factor`, `effective_mass_ratio`, `dissipated_energy` (.png/.svg).
+/// Maps of η̄ (colour saturating at 1, as in the dissertation), m̄_bed/m_bed, Ẽ and the split of
+/// the dissipation over the grid: `effective_loss_factor`, `effective_mass_ratio`,
+/// `dissipated_energy`, `dissipation_normal_over_tangential` [D Fig. 8.8],
+/// `dissipation_wall_share` (.png/.svg).
 pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Result<(), String> {
     let nx = grid.frequencies_hz.len();
     let ny = grid.amplitude_values.len();
@@ -98,6 +100,33 @@ pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Resul
         .into_iter()
         .map(|v| if v > 0.0 { v } else { f64::NAN })
         .collect();
+    // Ratio of normal to tangential dissipation [D Fig. 8.8], log scale 1/4 … 4.
+    let ratio = pick(&|p| {
+        let n = p.share_normal_pp + p.share_normal_pw;
+        let t = p.share_tangential_pp + p.share_tangential_pw;
+        if n > 0.0 && t > 0.0 { n / t } else { f64::NAN }
+    });
+    pdamp_plot::heat_map(
+        out.join("dissipation_normal_over_tangential"),
+        &make(
+            ratio,
+            ColorScale::log(0.25, 4.0),
+            "dissipation in normal / tangential contacts",
+            "E_diss,n / E_diss,t (-)",
+        ),
+    )
+    .map_err(err)?;
+    let wall = pick(&|p| p.share_normal_pw + p.share_tangential_pw);
+    pdamp_plot::heat_map(
+        out.join("dissipation_wall_share"),
+        &make(
+            wall,
+            ColorScale::linear(0.0, 1.0),
+            "share of the dissipation in particle–wall contacts",
+            "E_diss,pw / E_diss (-)",
+        ),
+    )
+    .map_err(err)?;
     pdamp_plot::heat_map(
         out.join("dissipated_energy"),
         &make(e, color, "dissipated energy per cycle", "Ẽ_diss (J)"),

@@ -477,8 +477,21 @@ pub enum GeometrySpec {
     CylinderInside(CylinderInside),
     /// Solid rod.
     CylinderOutside(CylinderOutside),
+    /// Solid cuboid (plates, bars, crosses inside a container [D Sect. 8.1.4]), axis-aligned in
+    /// the body frame; a closed triangle mesh with outward normals.
+    BoxOutside(BoxOutsideSpec),
     /// Triangle mesh from an STL file.
     Stl(StlSpec),
+}
+
+/// A solid cuboid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxOutsideSpec {
+    /// Centre in the body frame, m.
+    pub center_m: [f64; 3],
+    /// Half edge lengths, m.
+    pub half_extents_m: [f64; 3],
 }
 
 /// A triangle mesh read from STL.
@@ -844,6 +857,23 @@ impl Scenario {
                     GeometrySpec::BoxInside(g) => Geometry::BoxInside(g.clone()),
                     GeometrySpec::CylinderInside(g) => Geometry::CylinderInside(g.clone()),
                     GeometrySpec::CylinderOutside(g) => Geometry::CylinderOutside(g.clone()),
+                    GeometrySpec::BoxOutside(b) => {
+                        if b.half_extents_m
+                            .iter()
+                            .any(|h| !(*h > 0.0 && h.is_finite()))
+                        {
+                            return Err(format!(
+                                "bodies[{bi}].walls[{wi}].geometry.half_extents_m must be > 0, got {:?}",
+                                b.half_extents_m
+                            ));
+                        }
+                        let mut m = pdamp_dem::walls::TriMesh::box_inside(
+                            Vec3::from(b.center_m),
+                            Vec3::from(b.half_extents_m),
+                        );
+                        m.flip_normals();
+                        Geometry::Mesh(m)
+                    }
                     GeometrySpec::Stl(s) => {
                         let path = base_dir.join(&s.path);
                         let mut mesh = crate::stl::read_stl(&path)
