@@ -45,15 +45,20 @@ pub struct MotionRecorder {
     pub vtk_frames: Vec<(f64, String)>,
     /// First error while writing VTK frames.
     pub error: Option<String>,
+    /// Angular excitation frequency Ω, rad/s.
+    pub omega_rad_s: f64,
     prev_phase: f64,
+    prev_theta: f64,
     traj_every: u64,
 }
 
 impl MotionRecorder {
-    /// A recorder for `damper` at velocity amplitude `v_amp` with `phases` fields per cycle and
-    /// `cells_along` cells along the excitation direction over the container's extent.
+    /// A recorder for `damper` excited at `frequency_hz` with velocity amplitude `v_amp`, with
+    /// `phases` fields per cycle and `cells_along` cells along the excitation direction over the
+    /// container's extent.
     pub fn new(
         damper: &Damper,
+        frequency_hz: f64,
         v_amp: f64,
         phases: u32,
         cells_along: u32,
@@ -135,7 +140,9 @@ impl MotionRecorder {
             vtk: None,
             vtk_frames: Vec::new(),
             error: None,
+            omega_rad_s: 2.0 * PI * frequency_hz,
             prev_phase: 0.0,
+            prev_theta: 0.0,
             traj_every: ((steps_per_cycle / 200.0).floor() as u64).max(1),
         }
     }
@@ -179,18 +186,19 @@ impl PointObserver for MotionRecorder {
         let prev = self.prev_phase;
         self.prev_phase = phase;
         if cycle < damper.transient_cycles {
+            self.prev_theta = self.omega_rad_s * w.time_s;
             return;
         }
         let container_pos = w.bodies[damper.container].state.position_m;
-        let wrapped = phase < prev;
+        // Continuous phase θ = Ωt: phase k is crossed when ⌊(θ − φ_k)/2π⌋ grows (robust at the
+        // exact cycle boundaries where θ mod 2π may read 0 or 2π).
+        let theta = self.omega_rad_s * w.time_s;
+        let theta_prev = std::mem::replace(&mut self.prev_theta, theta);
         for k in 0..self.fields.len() {
             let target = self.fields[k].phase_rad;
-            let crossed = if wrapped {
-                target > prev || target <= phase
-            } else {
-                target > prev && target <= phase
-            };
-            if crossed {
+            let before = ((theta_prev - target) / (2.0 * PI) + 1e-9).floor();
+            let after = ((theta - target) / (2.0 * PI) + 1e-9).floor();
+            if after > before {
                 self.accumulate(w, k, &container_pos);
             }
         }

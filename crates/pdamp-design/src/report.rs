@@ -71,6 +71,7 @@ pub fn run_damper_scenario(
     let mo = &spec.motion_output;
     let mut rec = MotionRecorder::new(
         &damper,
+        f,
         x * omega,
         mo.phases_per_cycle,
         mo.field_cells,

@@ -238,7 +238,11 @@ fn velocity_field_of_stuck_bed_follows_container() {
     };
     let mut w = World::new(vec![steel()], model, 2e-7);
     let pre = 2e-6;
-    w.add_body(box_body(Vec3::new(2.0 * r - pre, 2.0 * r - pre, 2.0 * r - pre)));
+    w.add_body(box_body(Vec3::new(
+        2.0 * r - pre,
+        2.0 * r - pre,
+        2.0 * r - pre,
+    )));
     for i in 0..2 {
         for j in 0..2 {
             for k in 0..2 {
@@ -250,7 +254,7 @@ fn velocity_field_of_stuck_bed_follows_container() {
     let damper = Damper::from_world(w, 0, Vec3::x(), 0.05, 2, 1);
     let (f, x) = (100.0, 0.25e-3);
     let v_amp = x * 2.0 * std::f64::consts::PI * f;
-    let mut rec = MotionRecorder::new(&damper, v_amp, 4, 4, vec![0], 1.0 / (f * 2e-7));
+    let mut rec = MotionRecorder::new(&damper, f, v_amp, 4, 4, vec![0], 1.0 / (f * 2e-7));
     damper.run_point(f, x, &mut rec).expect("point");
     let expect = [1.0, 0.0, 1.0, 0.0];
     for (k, field) in rec.fields.iter().enumerate() {
