@@ -294,11 +294,19 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
     )
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
+    for (f, x, e) in &outcome.failed {
+        eprintln!(
+            "warning: point f = {f} Hz, X = {x:.4e} m failed (NaN in fields.csv, retried on the next run): {e}"
+        );
+    }
     println!(
         "{}",
         serde_json::to_string_pretty(&serde_json::json!({
             "points": outcome.points.len(),
             "reused_points": outcome.reused,
+            "failed_points": outcome.failed.iter().map(|(f, x, e)| serde_json::json!({
+                "frequency_hz": f, "amplitude_m": x, "error": e
+            })).collect::<Vec<_>>(),
             "wall_time_s": start.elapsed().as_secs_f64(),
             "fields_csv": out.join("fields.csv"),
         }))?

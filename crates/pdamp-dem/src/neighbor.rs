@@ -202,11 +202,13 @@ impl CellGrid {
     fn new(position: &[Vec3], cell: f64) -> Self {
         let mut lo = Vec3::repeat(f64::INFINITY);
         let mut hi = Vec3::repeat(f64::NEG_INFINITY);
-        for x in position {
+        // Non-finite positions (a blown-up run) are ignored for the bounds and land in cell 0, so
+        // the build terminates and the caller's finiteness checks can report the instability.
+        for x in position.iter().filter(|x| x.iter().all(|c| c.is_finite())) {
             lo = lo.inf(x);
             hi = hi.sup(x);
         }
-        if position.is_empty() {
+        if !lo.iter().all(|c| c.is_finite()) {
             lo = Vec3::zeros();
             hi = Vec3::zeros();
         }
@@ -215,7 +217,7 @@ impl CellGrid {
         let max_cells = (8 * position.len()).max(64) as f64;
         loop {
             let d = (hi - lo) / cell;
-            if (d.x + 1.0) * (d.y + 1.0) * (d.z + 1.0) <= max_cells {
+            if (d.x + 1.0) * (d.y + 1.0) * (d.z + 1.0) <= max_cells || !cell.is_finite() {
                 break;
             }
             cell *= 1.5;
@@ -287,6 +289,18 @@ impl CellGrid {
 mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
+
+    #[test]
+    fn grid_build_terminates_on_non_finite_positions() {
+        let pos = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(f64::NAN, 1.0, 0.0),
+            Vec3::new(1e-3, 0.0, f64::INFINITY),
+            Vec3::new(2e-3, 0.0, 0.0),
+        ];
+        let g = CellGrid::new(&pos, 1e-3);
+        assert_eq!(g.items.len(), 4);
+    }
 
     #[test]
     fn list_matches_brute_force_and_keeps_history() {

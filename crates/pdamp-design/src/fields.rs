@@ -118,9 +118,43 @@ fn load_point(path: &Path, f: f64, x: f64) -> Option<PointResult> {
 #[derive(Debug, Clone)]
 pub struct FieldsOutcome {
     /// All points in grid order (frequency-major).
+    /// Failed points have NaN results (grey on the maps) and are listed in `failed`.
     pub points: Vec<PointResult>,
     /// Points taken from an earlier, interrupted run.
     pub reused: usize,
+    /// Points that failed (e.g. an unstable simulation): frequency, amplitude and the message.
+    /// They are not stored, so a rerun tries them again.
+    pub failed: Vec<(f64, f64, String)>,
+}
+
+/// A point result with every evaluated quantity NaN (a failed point).
+fn failed_point(f: f64, x: f64) -> PointResult {
+    let w = 2.0 * std::f64::consts::PI * f;
+    let a = x * w * w;
+    PointResult {
+        frequency_hz: f,
+        amplitude_m: x,
+        acceleration_m_s2: a,
+        intensity: a / pdamp_io::scenario::STANDARD_GRAVITY_M_S2,
+        velocity_amplitude_m_s: x * w,
+        dissipated_energy_per_cycle_j: f64::NAN,
+        loss_factor: f64::NAN,
+        effective_loss_factor: f64::NAN,
+        effective_mass_ratio: f64::NAN,
+        effective_moving_mass_re_kg: f64::NAN,
+        effective_moving_mass_im_kg: f64::NAN,
+        ledger_dissipated_per_cycle_j: f64::NAN,
+        ledger_wall_work_per_cycle_j: f64::NAN,
+        share_normal_pp: f64::NAN,
+        share_normal_pw: f64::NAN,
+        share_tangential_pp: f64::NAN,
+        share_tangential_pw: f64::NAN,
+        energy_closure_relative: f64::NAN,
+        evaluated_cycles: 0,
+        time_step_s: f64::NAN,
+        steps: 0,
+        wall_time_s: f64::NAN,
+    }
 }
 
 /// Runs all grid points not yet stored in `out_dir/points/`, in parallel, then writes
@@ -162,12 +196,25 @@ pub fn run_fields(
             (k, stored)
         })
         .collect();
+    let mut failed = Vec::new();
     for (k, r) in fresh {
-        results[k] = Some(r?);
+        match r {
+            Ok(r) => results[k] = Some(r),
+            Err(e) if e.starts_with("output:") => return Err(e),
+            Err(e) => {
+                let (_, _, f, x) = points[k];
+                failed.push((f, x, e));
+                results[k] = Some(failed_point(f, x));
+            }
+        }
     }
     let points: Vec<PointResult> = results.into_iter().map(|r| r.unwrap()).collect();
     write_fields_csv(&out_dir.join("fields.csv"), &points)?;
-    Ok(FieldsOutcome { points, reused })
+    Ok(FieldsOutcome {
+        points,
+        reused,
+        failed,
+    })
 }
 
 /// Writes `fields.csv` atomically.
