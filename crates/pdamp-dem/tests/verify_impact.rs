@@ -184,3 +184,47 @@ fn restitution_table_follows_impact_velocity() {
     }
     eprintln!("ε(v) table: largest relative restitution error {worst:.2e}");
 }
+
+/// Stability cap of Gonthier's dashpot: an enduring contact that formed at rest (δ̇₀ at its
+/// floor) and is then compressed fast has its damping coefficient limited to M̄/Δt, so the
+/// dissipative force is at most M̄·δ̇/Δt; without Δt (impact integrators) the law is unchanged.
+#[test]
+fn gonthier_damping_capped_for_enduring_contacts() {
+    use pdamp_dem::Vec3;
+    use pdamp_dem::contact::{
+        ContactHistory, ContactKinematics, ContactModel, FrictionLaw, PairProps,
+    };
+    let model = ContactModel {
+        normal: NormalLaw::Gonthier {
+            restitution: 0.6,
+            min_impact_velocity_m_s: 1e-3,
+        },
+        friction: FrictionLaw::Frictionless,
+        rolling: None,
+        adhesion: None,
+    };
+    let p = PairProps {
+        e_eff_pa: 1e11,
+        g_eff_pa: 4e10,
+        poisson_mean: 0.3,
+        r_eff_m: 1e-3,
+        m_eff_kg: 3e-5,
+    };
+    let kin = |dt: f64| ContactKinematics {
+        overlap_m: 1e-6,
+        overlap_rate_m_s: 1.0,
+        normal: Vec3::z(),
+        tangential_velocity_m_s: Vec3::zeros(),
+        relative_angular_velocity_rad_s: Vec3::zeros(),
+        dt_s: dt,
+    };
+    let mut h = ContactHistory {
+        impact_velocity_m_s: 1e-3,
+        ..Default::default()
+    };
+    let dt = 1e-6;
+    let capped = model.evaluate(&p, &kin(dt), &mut h);
+    assert!((capped.normal_dissipative_n - p.m_eff_kg / dt * 1.0).abs() < 1e-9);
+    let uncapped = model.evaluate(&p, &kin(0.0), &mut h);
+    assert!(uncapped.normal_dissipative_n > 10.0 * capped.normal_dissipative_n);
+}

@@ -244,6 +244,16 @@ impl NormalLaw {
         }
     }
 
+    /// Whether the damping is scaled by the stored impact velocity (Gonthier, Lankarani–Nikravesh).
+    pub fn scales_with_impact_velocity(&self) -> bool {
+        matches!(
+            self,
+            NormalLaw::Gonthier { .. }
+                | NormalLaw::GonthierTable { .. }
+                | NormalLaw::LankaraniNikravesh { .. }
+        )
+    }
+
     /// Whether the law follows Hertz' $\delta^{3/2}$ elasticity (all but [`NormalLaw::Linear`]).
     pub fn is_hertz_type(&self) -> bool {
         !matches!(self, NormalLaw::Linear { .. })
@@ -460,9 +470,21 @@ impl ContactModel {
                     .overlap_rate_m_s
                     .max(self.normal.min_impact_velocity_m_s());
             }
-            let n = self
+            let mut n = self
                 .normal
                 .response(p, delta, k.overlap_rate_m_s, h.impact_velocity_m_s);
+            // Explicit-step stability cap of the impact-velocity-scaled dashpots (Gonthier,
+            // Lankarani–Nikravesh): their coefficient ∝ F_el/δ̇₀ grows without bound for contacts
+            // that formed at rest and are then loaded hard. A dashpot with c·Δt/M̄ > 2 makes any
+            // explicit step diverge, so c is limited to M̄/Δt (only such enduring contacts reach it;
+            // impact tests are unaffected).
+            if k.dt_s > 0.0 && self.normal.scales_with_impact_velocity() {
+                let c_max = p.m_eff_kg / k.dt_s;
+                if n.damping_n_s_m > c_max {
+                    n.damping_n_s_m = c_max;
+                    n.dissipative_n = (c_max * k.overlap_rate_m_s).max(-n.elastic_n);
+                }
+            }
             f.normal_elastic_n = n.elastic_n;
             f.normal_dissipative_n = n.dissipative_n;
             f.normal_energy_j = n.energy_j;
