@@ -219,14 +219,6 @@ pub fn run_fields(
 
 /// Writes `fields.csv` atomically.
 pub fn write_fields_csv(path: &Path, points: &[PointResult]) -> Result<(), String> {
-    let mut buf = Vec::new();
-    {
-        let mut w =
-            pdamp_io::csv::CsvWriter::new(&mut buf, &FIELD_COLUMNS).map_err(|e| e.to_string())?;
-        for p in points {
-            w.write_row(&field_row(p)).map_err(|e| e.to_string())?;
-        }
-        w.flush().map_err(|e| e.to_string())?;
-    }
-    pdamp_io::atomic::write_atomic(path, &buf).map_err(|e| format!("output: {e}"))
+    pdamp_io::csv::write_csv_atomic(path, &FIELD_COLUMNS, points.iter().map(field_row))
+        .map_err(|e| format!("output: {e}"))
 }

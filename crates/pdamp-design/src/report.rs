@@ -102,19 +102,12 @@ pub fn run_damper_scenario(
     }
     write_velocity_fields(&rec, &out.join("velocity_fields.csv"))?;
     if !rec.trajectories.is_empty() {
-        let mut buf = Vec::new();
-        {
-            let mut w = pdamp_io::csv::CsvWriter::new(
-                &mut buf,
-                &["particle", "time_s", "x_m", "y_m", "z_m"],
-            )
-            .map_err(|e| e.to_string())?;
-            for row in &rec.trajectories {
-                w.write_row(row).map_err(|e| e.to_string())?;
-            }
-            w.flush().map_err(|e| e.to_string())?;
-        }
-        pdamp_io::atomic::write_atomic(out.join("trajectories.csv"), &buf).map_err(io)?;
+        pdamp_io::csv::write_csv_atomic(
+            out.join("trajectories.csv"),
+            &["particle", "time_s", "x_m", "y_m", "z_m"],
+            &rec.trajectories,
+        )
+        .map_err(|e| format!("output: {e}"))?;
     }
     crate::plots::velocity_field_plots(&rec, out)?;
     crate::plots::trajectory_plot(&rec, out)?;
@@ -161,44 +154,37 @@ impl<P: FnMut(&str, f64)> crate::damper::PointObserver for ProgressObserver<'_, 
 
 /// Writes the phase-averaged velocity fields: one row per phase and occupied cell.
 pub fn write_velocity_fields(rec: &MotionRecorder, path: &Path) -> Result<(), String> {
-    let mut buf = Vec::new();
-    {
-        let mut w = pdamp_io::csv::CsvWriter::new(
-            &mut buf,
-            &[
-                "phase_rad",
-                "x_m",
-                "y_m",
-                "speed_over_v",
-                "vx_over_v",
-                "vy_over_v",
-                "samples",
-            ],
-        )
-        .map_err(|e| e.to_string())?;
-        for f in &rec.fields {
-            for c in 0..f.count.len() {
-                let n = f.count[c];
-                if n == 0 {
-                    continue;
-                }
+    let rows = rec.fields.iter().flat_map(|f| {
+        (0..f.count.len())
+            .filter(|&c| f.count[c] > 0)
+            .map(move |c| {
                 let [x, y] = rec.cell_center(c);
-                let nf = n as f64;
-                w.write_row(&[
+                let n = f.count[c] as f64;
+                [
                     f.phase_rad,
                     x,
                     y,
-                    f.speed_sum[c] / nf,
-                    f.vel_sum[c][0] / nf,
-                    f.vel_sum[c][1] / nf,
-                    nf,
-                ])
-                .map_err(|e| e.to_string())?;
-            }
-        }
-        w.flush().map_err(|e| e.to_string())?;
-    }
-    pdamp_io::atomic::write_atomic(path, &buf).map_err(|e| format!("output: {e}"))
+                    f.speed_sum[c] / n,
+                    f.vel_sum[c][0] / n,
+                    f.vel_sum[c][1] / n,
+                    n,
+                ]
+            })
+    });
+    pdamp_io::csv::write_csv_atomic(
+        path,
+        &[
+            "phase_rad",
+            "x_m",
+            "y_m",
+            "speed_over_v",
+            "vx_over_v",
+            "vy_over_v",
+            "samples",
+        ],
+        rows,
+    )
+    .map_err(|e| format!("output: {e}"))
 }
 
 /// `pdamp fields`: settles the damper once, runs the grid (resumable) and writes `fields.csv`

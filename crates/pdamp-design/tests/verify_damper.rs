@@ -28,6 +28,39 @@ fn box_body(half: Vec3) -> RigidBody {
     )
 }
 
+/// A 2×2×2 block of spheres (r = 1 mm) pre-compressed by 2 µm in a box without clearance, huge
+/// friction: a bed that moves rigidly with its container (m_con = 0.05 kg, excitation along x).
+fn stuck_bed_damper(cycles: u32, transient_cycles: u32) -> Damper {
+    let r = 1e-3;
+    let model = ContactModel {
+        normal: NormalLaw::HertzMindlin {
+            restitution: 0.5,
+            clip_attractive: false,
+        },
+        friction: FrictionLaw::Mindlin {
+            friction_coefficient: 10.0,
+        },
+        rolling: None,
+        adhesion: None,
+    };
+    let mut w = World::new(vec![steel()], model, 2e-7);
+    let pre = 2e-6;
+    w.add_body(box_body(Vec3::new(
+        2.0 * r - pre,
+        2.0 * r - pre,
+        2.0 * r - pre,
+    )));
+    for i in 0..2 {
+        for j in 0..2 {
+            for k in 0..2 {
+                let c = |n: i32| (2 * n - 1) as f64 * (r - 0.5 * pre);
+                w.add_particle(Vec3::new(c(i), c(j), c(k)), r, 0);
+            }
+        }
+    }
+    Damper::from_world(w, 0, Vec3::x(), 0.05, cycles, transient_cycles)
+}
+
 /// Must-show 1a: η̄ of one particle in a box (zero gravity, ε = 0.02 linear contacts) within 5 %
 /// of the event-driven plastic collect-and-collide solution, for strokes X/h = 0.5, 1 and 2.
 #[test]
@@ -83,34 +116,7 @@ fn single_particle_matches_event_driven_collect_and_collide() {
 /// friction: the bed moves with the container, η̄ ≈ 0 and m̄_bed/m_bed ≈ 1 within 3 %.
 #[test]
 fn stuck_bed_has_no_damping_and_full_mass() {
-    let r = 1e-3;
-    let model = ContactModel {
-        normal: NormalLaw::HertzMindlin {
-            restitution: 0.5,
-            clip_attractive: false,
-        },
-        friction: FrictionLaw::Mindlin {
-            friction_coefficient: 10.0,
-        },
-        rolling: None,
-        adhesion: None,
-    };
-    let mut w = World::new(vec![steel()], model, 2e-7);
-    let pre = 2e-6; // pre-compression of each contact chain, m
-    w.add_body(box_body(Vec3::new(
-        2.0 * r - pre,
-        2.0 * r - pre,
-        2.0 * r - pre,
-    )));
-    for i in 0..2 {
-        for j in 0..2 {
-            for k in 0..2 {
-                let c = |n: i32| (2 * n - 1) as f64 * (r - 0.5 * pre);
-                w.add_particle(Vec3::new(c(i), c(j), c(k)), r, 0);
-            }
-        }
-    }
-    let damper = Damper::from_world(w, 0, Vec3::x(), 0.05, 6, 3);
+    let damper = stuck_bed_damper(6, 3);
     let p = damper.run_point(50.0, 1e-3, &mut ()).expect("point");
     eprintln!(
         "stuck bed: η̄ = {:.3e}, m̄/m = {:.5}, Ẽ = {:.3e} J",
@@ -224,34 +230,7 @@ fn fields_grid_is_resumable_and_deterministic() {
 #[test]
 fn velocity_field_of_stuck_bed_follows_container() {
     use pdamp_design::motion::MotionRecorder;
-    let r = 1e-3;
-    let model = ContactModel {
-        normal: NormalLaw::HertzMindlin {
-            restitution: 0.5,
-            clip_attractive: false,
-        },
-        friction: FrictionLaw::Mindlin {
-            friction_coefficient: 10.0,
-        },
-        rolling: None,
-        adhesion: None,
-    };
-    let mut w = World::new(vec![steel()], model, 2e-7);
-    let pre = 2e-6;
-    w.add_body(box_body(Vec3::new(
-        2.0 * r - pre,
-        2.0 * r - pre,
-        2.0 * r - pre,
-    )));
-    for i in 0..2 {
-        for j in 0..2 {
-            for k in 0..2 {
-                let c = |n: i32| (2 * n - 1) as f64 * (r - 0.5 * pre);
-                w.add_particle(Vec3::new(c(i), c(j), c(k)), r, 0);
-            }
-        }
-    }
-    let damper = Damper::from_world(w, 0, Vec3::x(), 0.05, 2, 1);
+    let damper = stuck_bed_damper(2, 1);
     let (f, x) = (100.0, 0.25e-3);
     let v_amp = x * 2.0 * std::f64::consts::PI * f;
     let mut rec = MotionRecorder::new(&damper, f, v_amp, 4, 4, vec![0], 1.0 / (f * 2e-7));

@@ -57,6 +57,25 @@ pub fn format_f64(x: f64, out: &mut String) {
     }
 }
 
+/// Writes a whole table (header + rows of f64) to `path` atomically (temporary file + rename),
+/// so an interrupted run never leaves a half-written file.
+pub fn write_csv_atomic<R: AsRef<[f64]>>(
+    path: impl AsRef<Path>,
+    header: &[&str],
+    rows: impl IntoIterator<Item = R>,
+) -> Result<(), CsvError> {
+    let path = path.as_ref();
+    let mut w = CsvWriter::new(Vec::new(), header)?;
+    for row in rows {
+        w.write_row(row.as_ref())?;
+    }
+    let bytes = w.into_inner()?;
+    crate::atomic::write_atomic(path, &bytes).map_err(|source| CsvError::Io {
+        path: path.into(),
+        source,
+    })
+}
+
 /// Buffered CSV writer for rows of f64 with a fixed header.
 pub struct CsvWriter<W: Write> {
     out: W,
