@@ -33,6 +33,13 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Continue from DIR/checkpoint.bin (written every --checkpoint-interval-s and on
+        /// Ctrl-C); the results equal those of an uninterrupted run.
+        #[arg(long)]
+        resume: bool,
+        /// Wall-clock seconds between checkpoints (0 = only on Ctrl-C).
+        #[arg(long, default_value_t = 60.0)]
+        checkpoint_interval_s: f64,
     },
     /// Effective fields of a damper scenario over its [fields] grid (resumable): writes
     /// DIR/fields.csv and PNG/SVG maps of η̄, m̄_bed/m_bed and the dissipated energy.
@@ -114,7 +121,23 @@ enum LawArg {
     HertzMindlin,
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
+    // Ctrl-C / SIGTERM: long runs write a checkpoint and stop (see `--resume`).
+    let _ = ctrlc::set_handler(pdamp_io::checkpoint::request_stop);
+    match run_cli() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if format!("{e}").starts_with(pdamp_io::checkpoint::INTERRUPTED) {
+                std::process::ExitCode::from(130)
+            } else {
+                std::process::ExitCode::FAILURE
+            }
+        }
+    }
+}
+
+fn run_cli() -> Result<()> {
     let cli = Cli::parse();
     let threads = cli.threads.unwrap_or(0);
     rayon::ThreadPoolBuilder::new()
@@ -122,7 +145,19 @@ fn main() -> Result<()> {
         .build_global()
         .context("cannot start the thread pool")?;
     match cli.command {
-        Command::Run { scenario, out } => cmd_run(&scenario, &out),
+        Command::Run {
+            scenario,
+            out,
+            resume,
+            checkpoint_interval_s,
+        } => cmd_run(
+            &scenario,
+            &out,
+            pdamp_io::run::RunOptions {
+                checkpoint_interval_s,
+                resume,
+            },
+        ),
         Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
         Command::Check { scenario } => cmd_check(&scenario),
         Command::Example {
@@ -224,7 +259,11 @@ fn main() -> Result<()> {
     }
 }
 
-fn cmd_run(scenario: &str, out: &std::path::Path) -> Result<()> {
+fn cmd_run(
+    scenario: &str,
+    out: &std::path::Path,
+    options: pdamp_io::run::RunOptions,
+) -> Result<()> {
     let (sc, base) = if scenario == "builtin:shaken-box" {
         (
             pdamp_io::examples::shaken_box(2000, 0.5),
@@ -252,7 +291,8 @@ fn cmd_run(scenario: &str, out: &std::path::Path) -> Result<()> {
             .map_err(anyhow::Error::msg)?;
         serde_json::to_string_pretty(&s)?
     } else {
-        let s = pdamp_io::run::run_scenario(&sc, &base, out, tick).map_err(anyhow::Error::msg)?;
+        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
+            .map_err(anyhow::Error::msg)?;
         serde_json::to_string_pretty(&s)?
     };
     bar.finish_and_clear();

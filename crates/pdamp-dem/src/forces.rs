@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 /// State of one contact carried from step to step: the law's history plus the forces and stored
 /// energies of the previous evaluation (for trapezoidal work integration).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairState {
     /// History owned by the contact law.
     pub history: ContactHistory,
@@ -31,7 +31,7 @@ pub struct PairState {
 }
 
 /// A particle–wall contact slot of one particle.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WallSlot {
     /// Body index.
     pub body: u16,
@@ -52,7 +52,7 @@ pub struct WallSlot {
 }
 
 /// Output of one pair evaluation: force on the first partner, torques on both.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairOutput {
     /// Force on the first partner (the second gets the opposite), N.
     pub force: Vec3,

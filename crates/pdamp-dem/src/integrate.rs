@@ -55,7 +55,7 @@ const GEAR5: [f64; 5] = [19.0 / 90.0, 3.0 / 4.0, 1.0, 1.0 / 2.0, 1.0 / 12.0];
 
 /// Time derivatives kept by the Gear scheme for every particle: translation (x, ẋ, ẍ, x⃛, x⁗) and
 /// rotation (θ, ω, ω̇, ω̈, ω⃛).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GearState {
     trans: Vec<[Vec3; 5]>,
     rot: Vec<[Vec3; 5]>,

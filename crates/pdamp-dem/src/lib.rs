@@ -18,6 +18,7 @@ pub mod material;
 pub mod math;
 pub mod neighbor;
 pub mod particles;
+pub mod state;
 pub mod walls;
 pub mod world;
 
@@ -28,6 +29,7 @@ pub use integrate::{GearParams, Integrator};
 pub use material::Material;
 pub use math::Vec3;
 pub use particles::ParticleSet;
+pub use state::WorldState;
 pub use walls::Geometry;
 pub use world::World;
 pub mod impact;

@@ -37,20 +37,20 @@ impl Material {
     pub fn validate(&self) -> Result<(), String> {
         if !(self.density_kg_m3.is_finite() && self.density_kg_m3 > 0.0) {
             return Err(format!(
-                "material '{}': density_kg_m3 must be > 0, got {}",
-                self.name, self.density_kg_m3
+                "density_kg_m3 must be > 0, got {} (material '{}')",
+                self.density_kg_m3, self.name
             ));
         }
         if !(self.youngs_modulus_pa.is_finite() && self.youngs_modulus_pa > 0.0) {
             return Err(format!(
-                "material '{}': youngs_modulus_pa must be > 0, got {}",
-                self.name, self.youngs_modulus_pa
+                "youngs_modulus_pa must be > 0, got {} (material '{}')",
+                self.youngs_modulus_pa, self.name
             ));
         }
         if !(self.poisson_ratio > -1.0 && self.poisson_ratio < 0.5) {
             return Err(format!(
-                "material '{}': poisson_ratio must lie in (-1, 0.5), got {}",
-                self.name, self.poisson_ratio
+                "poisson_ratio must lie in (-1, 0.5), got {} (material '{}')",
+                self.poisson_ratio, self.name
             ));
         }
         Ok(())

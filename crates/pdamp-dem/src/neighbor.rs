@@ -12,7 +12,7 @@ use crate::math::Vec3;
 use rayon::prelude::*;
 
 /// Half neighbour list with per-pair storage.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NeighborList {
     /// Verlet distance (skin) $d_v$, m.
     pub skin_m: f64,

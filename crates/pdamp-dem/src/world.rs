@@ -13,7 +13,7 @@ use crate::neighbor::NeighborList;
 use crate::particles::ParticleSet;
 
 /// Counters of work done, for diagnostics and benchmarks.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Counters {
     /// Accepted time steps.
     pub steps: u64,
@@ -307,6 +307,19 @@ impl World {
 
     /// Steps until `time_s` reaches `t_end_s` (the last step is shortened to land on it).
     pub fn run_until(&mut self, t_end_s: f64, mut observer: impl FnMut(&World)) {
+        self.run_until_or_break(t_end_s, |w| {
+            observer(w);
+            std::ops::ControlFlow::Continue(())
+        });
+    }
+
+    /// Like [`World::run_until`], but stops after the step at which `observer` returns
+    /// `Break`; returns true if `t_end_s` was reached.
+    pub fn run_until_or_break(
+        &mut self,
+        t_end_s: f64,
+        mut observer: impl FnMut(&World) -> std::ops::ControlFlow<()>,
+    ) -> bool {
         while self.time_s < t_end_s - 1e-12 * t_end_s.abs().max(1e-300) {
             let dt_nominal = self.dt_s;
             let remaining = t_end_s - self.time_s;
@@ -319,8 +332,11 @@ impl World {
             } else {
                 self.step();
             }
-            observer(self);
+            if observer(self).is_break() {
+                return self.time_s >= t_end_s - 1e-12 * t_end_s.abs().max(1e-300);
+            }
         }
+        true
     }
 
     /// Sets the clock back to zero and re-initialises (forces, body poses, ledger) while keeping

@@ -81,6 +81,7 @@ pub struct CsvWriter<W: Write> {
     out: W,
     columns: usize,
     rows: usize,
+    bytes: u64,
     line: String,
     path: PathBuf,
 }
@@ -97,6 +98,64 @@ impl CsvWriter<BufWriter<File>> {
         w.path = path.into();
         Ok(w)
     }
+
+    /// Reopens a file written by [`CsvWriter::create`] to append after a checkpoint: the file
+    /// is cut back to `bytes` (the length [`CsvWriter::sync`] returned, with `rows` data rows);
+    /// rows written after the checkpoint are dropped. Fails if the file is shorter than that
+    /// or its header differs.
+    pub fn resume(
+        path: impl AsRef<Path>,
+        header: &[&str],
+        bytes: u64,
+        rows: usize,
+    ) -> Result<Self, CsvError> {
+        use std::io::{Read, Seek, SeekFrom};
+        let path = path.as_ref();
+        let io = |source: io::Error| CsvError::Io {
+            path: path.into(),
+            source,
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        let head = header.join(",") + "\n";
+        if len < bytes || bytes < head.len() as u64 {
+            return Err(io(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("file has {len} bytes, the checkpoint expects at least {bytes}"),
+            )));
+        }
+        let mut first = vec![0u8; head.len()];
+        file.read_exact(&mut first).map_err(io)?;
+        if first != head.as_bytes() {
+            return Err(io(io::Error::new(
+                io::ErrorKind::InvalidData,
+                "header differs from the expected columns",
+            )));
+        }
+        file.set_len(bytes).map_err(io)?;
+        file.seek(SeekFrom::End(0)).map_err(io)?;
+        Ok(CsvWriter {
+            out: BufWriter::new(file),
+            columns: header.len(),
+            rows,
+            bytes,
+            line: String::new(),
+            path: path.into(),
+        })
+    }
+
+    /// Flushes and syncs the rows to disk; returns the file length in bytes (for
+    /// [`CsvWriter::resume`]).
+    pub fn sync(&mut self) -> Result<u64, CsvError> {
+        self.flush()?;
+        let r = self.out.get_ref().sync_data();
+        r.map_err(|e| self.io(e))?;
+        Ok(self.bytes)
+    }
 }
 
 impl<W: Write> CsvWriter<W> {
@@ -112,11 +171,13 @@ impl<W: Write> CsvWriter<W> {
             out,
             columns: header.len(),
             rows: 0,
+            bytes: 0,
             line: String::new(),
             path: PathBuf::new(),
         };
         let line = header.join(",") + "\n";
         w.out.write_all(line.as_bytes()).map_err(|e| w.io(e))?;
+        w.bytes = line.len() as u64;
         Ok(w)
     }
 
@@ -147,6 +208,7 @@ impl<W: Write> CsvWriter<W> {
         let r = self.out.write_all(self.line.as_bytes());
         r.map_err(|e| self.io(e))?;
         self.rows += 1;
+        self.bytes += self.line.len() as u64;
         Ok(())
     }
 

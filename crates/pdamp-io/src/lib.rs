@@ -5,6 +5,7 @@
 
 pub mod atomic;
 pub mod bench;
+pub mod checkpoint;
 pub mod csv;
 pub mod examples;
 pub mod run;

@@ -4,8 +4,10 @@
 use crate::csv::CsvWriter;
 use crate::scenario::Scenario;
 use crate::vtk::{PointField, PvdSeries, write_mesh_vtp, write_particles_vtp};
+use pdamp_dem::WorldState;
 use pdamp_dem::{Geometry, Motion, Vec3, World};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Column names of `energy.csv` (SI units in every name).
@@ -24,12 +26,16 @@ pub const ENERGY_COLUMNS: [&str; 11] = [
 ];
 
 /// What a run reports in `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunSummary {
     /// pdamp version that produced the file.
     pub pdamp_version: String,
     /// Scenario title.
     pub title: String,
+    /// Digest of the scenario (FNV-1a 64 of the canonical TOML written as `scenario.toml`).
+    pub scenario_digest: String,
+    /// Worker threads used.
+    pub threads: usize,
     /// Random seed.
     pub seed: u64,
     /// Number of particles.
@@ -93,6 +99,23 @@ pub fn settle(
     ke_per_particle_j: f64,
     mut tick: impl FnMut(f64),
 ) -> f64 {
+    settle_or_break(world, max_duration_s, ke_per_particle_j, |w| {
+        tick(w.time_s / max_duration_s);
+        ControlFlow::Continue(())
+    })
+    .unwrap_or(max_duration_s)
+}
+
+/// Settling as in [`settle`], with `hook` called every 200 steps; when it returns `Break` the
+/// loop stops at once (bodies get their motion back, the clock is not restarted) and the result
+/// is `None`. The check of the kinetic energy uses the step counter, so a settling resumed from
+/// a checkpoint ends at the same step as an uninterrupted one.
+pub fn settle_or_break(
+    world: &mut World,
+    max_duration_s: f64,
+    ke_per_particle_j: f64,
+    mut hook: impl FnMut(&World) -> ControlFlow<()>,
+) -> Option<f64> {
     let motions: Vec<Motion> = world.bodies.iter().map(|b| b.motion.clone()).collect();
     for b in world.bodies.iter_mut() {
         if !matches!(b.motion, Motion::Driven) {
@@ -101,11 +124,15 @@ pub fn settle(
     }
     let n = world.particles.len().max(1) as f64;
     let check_every = 200u64;
+    let mut stopped = false;
     while world.time_s < max_duration_s {
         world.step();
         if world.counters.steps.is_multiple_of(check_every) {
-            tick(world.time_s / max_duration_s);
             if world.ledger.kinetic_j / n < ke_per_particle_j {
+                break;
+            }
+            if hook(world).is_break() {
+                stopped = true;
                 break;
             }
         }
@@ -114,31 +141,50 @@ pub fn settle(
     for (b, m) in world.bodies.iter_mut().zip(motions) {
         b.motion = m;
     }
+    if stopped {
+        return None;
+    }
     world.restart_clock();
-    t
+    Some(t)
 }
 
 /// Settles `world` as `spec` says (with its own gravity if given) and restarts the clock.
 pub fn settle_with(
     world: &mut World,
     spec: &crate::scenario::SettleSpec,
-    tick: impl FnMut(f64),
+    mut tick: impl FnMut(f64),
 ) -> f64 {
     let g = world.gravity_m_s2;
+    let max = spec.max_duration_s;
+    settle_with_or_break(world, spec, g, |w| {
+        tick(w.time_s / max);
+        ControlFlow::Continue(())
+    })
+    .unwrap_or(max)
+}
+
+/// [`settle_with`] with a hook as in [`settle_or_break`]; `main_gravity_m_s2` is put back
+/// after settling (needed when resuming: the restored world carries the settling gravity).
+pub fn settle_with_or_break(
+    world: &mut World,
+    spec: &crate::scenario::SettleSpec,
+    main_gravity_m_s2: Vec3,
+    hook: impl FnMut(&World) -> ControlFlow<()>,
+) -> Option<f64> {
     if let Some(gs) = spec.gravity_m_s2 {
         world.gravity_m_s2 = Vec3::from(gs);
     }
-    let t = settle(
+    let t = settle_or_break(
         world,
         spec.max_duration_s,
         spec.kinetic_energy_per_particle_j,
-        tick,
-    );
-    if spec.gravity_m_s2.is_some() {
-        world.gravity_m_s2 = g;
+        hook,
+    )?;
+    if world.gravity_m_s2 != main_gravity_m_s2 {
+        world.gravity_m_s2 = main_gravity_m_s2;
         world.restart_clock();
     }
-    t
+    Some(t)
 }
 
 /// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
@@ -255,55 +301,224 @@ fn ledger_row(w: &World) -> Vec<f64> {
     ]
 }
 
+/// How `run_scenario` checkpoints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    /// Wall-clock seconds between checkpoints (≤ 0: none, except on a stop request).
+    pub checkpoint_interval_s: f64,
+    /// Continue from `DIR/checkpoint.bin` if there is one.
+    pub resume: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            checkpoint_interval_s: 60.0,
+            resume: false,
+        }
+    }
+}
+
+/// Phase a run checkpoint was taken in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+enum RunPhase {
+    Settling,
+    Running,
+    Finished,
+}
+
+/// Everything `run_scenario` needs to continue: the DEM state and the output streams.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct RunCheckpoint {
+    phase: RunPhase,
+    world: Option<WorldState>,
+    settle_time_s: f64,
+    energy_csv_bytes: u64,
+    energy_rows: usize,
+    next_energy_s: f64,
+    next_vtk_s: f64,
+    snapshot: usize,
+    pvd: Vec<(f64, String)>,
+    steps_at_start: u64,
+    wall_time_s: f64,
+}
+
+impl RunCheckpoint {
+    fn settling(world: &World, wall_time_s: f64) -> Self {
+        Self {
+            phase: RunPhase::Settling,
+            world: Some(world.save_state()),
+            settle_time_s: 0.0,
+            energy_csv_bytes: 0,
+            energy_rows: 0,
+            next_energy_s: 0.0,
+            next_vtk_s: 0.0,
+            snapshot: 0,
+            pvd: Vec::new(),
+            steps_at_start: 0,
+            wall_time_s,
+        }
+    }
+}
+
+/// Kind tag of `run` checkpoints.
+const RUN_KIND: &str = "run";
+
+/// Digest identifying a scenario in checkpoints and outputs (of its canonical TOML).
+pub fn scenario_digest(scenario: &Scenario) -> String {
+    crate::checkpoint::digest(scenario.to_toml().as_bytes())
+}
+
 /// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
-/// `progress(phase, fraction)` is called regularly.
+/// `progress(phase, fraction)` is called regularly. Checkpoints every
+/// `options.checkpoint_interval_s` of wall-clock time and on a stop request
+/// ([`crate::checkpoint::request_stop`]), which ends the run with an error starting with
+/// [`crate::checkpoint::INTERRUPTED`]. With `options.resume`, continues from the last
+/// checkpoint; the outputs then equal those of an uninterrupted run (timing fields aside).
 pub fn run_scenario(
     scenario: &Scenario,
     base_dir: &Path,
     out_dir: &Path,
+    options: RunOptions,
     mut progress: impl FnMut(&str, f64),
 ) -> Result<RunSummary, String> {
+    use crate::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
     let io = |e: std::io::Error| format!("output: {e}");
     let mut world = scenario.build_world(base_dir)?;
-    std::fs::create_dir_all(out_dir).map_err(io)?;
-    crate::atomic::write_atomic(out_dir.join("scenario.toml"), scenario.to_toml().as_bytes())
-        .map_err(io)?;
-    let settle_t = match &scenario.settle {
-        Some(s) => settle_with(&mut world, s, |f| progress("settling", f)),
-        None => 0.0,
-    };
-    world.initialize();
-    let vtk_dir = out_dir.join("vtk");
-    let vtk_every = scenario.output.vtk_interval_s;
-    let mut series = if vtk_every > 0.0 {
-        std::fs::create_dir_all(&vtk_dir).map_err(io)?;
-        Some(PvdSeries::new(out_dir.join("particles.pvd")))
+    let digest = scenario_digest(scenario);
+    let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
+    let header = CheckpointHeader::new(RUN_KIND, &digest);
+    let resumed: Option<RunCheckpoint> = if options.resume {
+        ck::load(&ck_path, RUN_KIND, &digest)?
     } else {
         None
     };
-    let csvio = |e: crate::csv::CsvError| format!("output: {e}");
-    let mut csv = CsvWriter::create(out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(csvio)?;
-    csv.write_row(&ledger_row(&world)).map_err(csvio)?;
-    let mut snap = 0usize;
-    if let Some(s) = series.as_mut() {
-        let f = write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
-        s.add(world.time_s, f.to_string_lossy())
-            .map_err(|e| e.to_string())?;
-        snap += 1;
+    if let Some(c) = &resumed
+        && c.phase == RunPhase::Finished
+    {
+        let text = std::fs::read_to_string(out_dir.join("summary.json")).map_err(io)?;
+        return serde_json::from_str(&text).map_err(|e| format!("summary.json: {e}"));
     }
-    let t_end = scenario.simulation.duration_s;
-    let e_every = scenario.output.energy_interval_s;
-    let (mut next_e, mut next_v) = (e_every, vtk_every);
+    std::fs::create_dir_all(out_dir).map_err(io)?;
+    crate::atomic::write_atomic(out_dir.join("scenario.toml"), scenario.to_toml().as_bytes())
+        .map_err(io)?;
     let start = std::time::Instant::now();
-    let steps0 = world.counters.steps;
-    let mut err: Option<String> = None;
-    world.run_until(t_end, |w| {
-        if err.is_some() {
-            return;
+    let wall_before = resumed.as_ref().map_or(0.0, |c| c.wall_time_s);
+    let wall = |start: &std::time::Instant| wall_before + start.elapsed().as_secs_f64();
+    let mut timer = CheckpointTimer::new(options.checkpoint_interval_s);
+    let interrupted = |t: f64| {
+        ck::Interrupted {
+            time_s: t,
+            path: ck_path.clone(),
         }
+        .to_string()
+    };
+    let main_gravity = Vec3::from(scenario.simulation.gravity_m_s2);
+
+    // Settling (fresh, or resumed in the middle of it).
+    let mut state = match resumed {
+        Some(mut c) if c.phase == RunPhase::Running => {
+            world.restore_state(c.world.take().ok_or("checkpoint without state")?)?;
+            Some(c)
+        }
+        Some(mut c) => {
+            world.restore_state(c.world.take().ok_or("checkpoint without state")?)?;
+            world.gravity_m_s2 = main_gravity;
+            None
+        }
+        None => None,
+    };
+    let settle_t = match (&state, &scenario.settle) {
+        (Some(c), _) => c.settle_time_s,
+        (None, Some(spec)) => {
+            let mut err = None;
+            let max = spec.max_duration_s;
+            let r = settle_with_or_break(&mut world, spec, main_gravity, |w| {
+                progress("settling", w.time_s / max);
+                let stop = ck::stop_requested();
+                if stop || timer.due() {
+                    if let Err(e) =
+                        ck::save(&ck_path, &header, &RunCheckpoint::settling(w, wall(&start)))
+                    {
+                        err = Some(e);
+                        return ControlFlow::Break(());
+                    }
+                    if stop {
+                        return ControlFlow::Break(());
+                    }
+                }
+                ControlFlow::Continue(())
+            });
+            if let Some(e) = err {
+                return Err(e);
+            }
+            match r {
+                Some(t) => t,
+                None => return Err(interrupted(world.time_s)),
+            }
+        }
+        (None, None) => 0.0,
+    };
+
+    // Main run: outputs opened fresh or continued at the checkpoint.
+    let vtk_dir = out_dir.join("vtk");
+    let vtk_every = scenario.output.vtk_interval_s;
+    let e_every = scenario.output.energy_interval_s;
+    let csvio = |e: crate::csv::CsvError| format!("output: {e}");
+    let pvd_path = out_dir.join("particles.pvd");
+    let (mut csv, mut series, mut snap, mut next_e, mut next_v, steps0) = match state.take() {
+        Some(c) => {
+            let csv = crate::csv::CsvWriter::resume(
+                out_dir.join("energy.csv"),
+                &ENERGY_COLUMNS,
+                c.energy_csv_bytes,
+                c.energy_rows,
+            )
+            .map_err(csvio)?;
+            let series = if vtk_every > 0.0 {
+                std::fs::create_dir_all(&vtk_dir).map_err(io)?;
+                Some(PvdSeries::resume(&pvd_path, c.pvd).map_err(|e| e.to_string())?)
+            } else {
+                None
+            };
+            (
+                csv,
+                series,
+                c.snapshot,
+                c.next_energy_s,
+                c.next_vtk_s,
+                c.steps_at_start,
+            )
+        }
+        None => {
+            world.initialize();
+            let mut series = if vtk_every > 0.0 {
+                std::fs::create_dir_all(&vtk_dir).map_err(io)?;
+                Some(PvdSeries::new(&pvd_path))
+            } else {
+                None
+            };
+            let mut csv =
+                CsvWriter::create(out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(csvio)?;
+            csv.write_row(&ledger_row(&world)).map_err(csvio)?;
+            let mut snap = 0usize;
+            if let Some(s) = series.as_mut() {
+                let f = write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
+                s.add(world.time_s, f.to_string_lossy())
+                    .map_err(|e| e.to_string())?;
+                snap += 1;
+            }
+            (csv, series, snap, e_every, vtk_every, world.counters.steps)
+        }
+    };
+    let t_end = scenario.simulation.duration_s;
+    let mut err: Option<String> = None;
+    let mut stopped = false;
+    world.run_until_or_break(t_end, |w| {
         if w.time_s >= next_e - 1e-12 {
             if let Err(e) = csv.write_row(&ledger_row(w)) {
                 err = Some(format!("output: {e}"));
+                return ControlFlow::Break(());
             }
             next_e += e_every;
             progress("running", w.time_s / t_end);
@@ -313,19 +528,56 @@ pub fn run_scenario(
         {
             match write_snapshot(w, &vtk_dir, snap) {
                 Ok(f) => {
-                    let _ = s.add(w.time_s, f.to_string_lossy());
+                    if let Err(e) = s.add(w.time_s, f.to_string_lossy()) {
+                        err = Some(format!("output: {e}"));
+                        return ControlFlow::Break(());
+                    }
                 }
-                Err(e) => err = Some(format!("output: {e}")),
+                Err(e) => {
+                    err = Some(format!("output: {e}"));
+                    return ControlFlow::Break(());
+                }
             }
             snap += 1;
             next_v += vtk_every;
         }
+        let stop = ck::stop_requested();
+        if stop || timer.due() {
+            let r = csv.sync().map_err(csvio).and_then(|bytes| {
+                let c = RunCheckpoint {
+                    phase: RunPhase::Running,
+                    world: Some(w.save_state()),
+                    settle_time_s: settle_t,
+                    energy_csv_bytes: bytes,
+                    energy_rows: csv.rows(),
+                    next_energy_s: next_e,
+                    next_vtk_s: next_v,
+                    snapshot: snap,
+                    pvd: series.as_ref().map_or(Vec::new(), |s| s.entries().to_vec()),
+                    steps_at_start: steps0,
+                    wall_time_s: wall(&start),
+                };
+                ck::save(&ck_path, &header, &c)
+            });
+            if let Err(e) = r {
+                err = Some(e);
+                return ControlFlow::Break(());
+            }
+            if stop {
+                stopped = true;
+                return ControlFlow::Break(());
+            }
+        }
+        ControlFlow::Continue(())
     });
     if let Some(e) = err {
         return Err(e);
     }
-    csv.flush().map_err(csvio)?;
-    let wall = start.elapsed().as_secs_f64();
+    if stopped {
+        return Err(interrupted(world.time_s));
+    }
+    csv.sync().map_err(csvio)?;
+    let wall_s = wall(&start);
     let steps = world.counters.steps - steps0;
     let l = world.ledger;
     let scale = l
@@ -338,13 +590,15 @@ pub fn run_scenario(
     let summary = RunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: scenario.title.clone(),
+        scenario_digest: digest.clone(),
         seed: scenario.simulation.seed,
+        threads: rayon::current_num_threads(),
         particles: world.particles.len(),
         simulated_time_s: world.time_s,
         settling_time_s: settle_t,
         steps,
-        wall_time_s: wall,
-        particle_steps_per_s: steps as f64 * world.particles.len() as f64 / wall.max(1e-12),
+        wall_time_s: wall_s,
+        particle_steps_per_s: steps as f64 * world.particles.len() as f64 / wall_s.max(1e-12),
         energy: l,
         dissipated_j: l.dissipated_j(),
         energy_closure_error_j: l.closure_error_j(),
@@ -356,5 +610,11 @@ pub fn run_scenario(
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
+    let done = RunCheckpoint {
+        phase: RunPhase::Finished,
+        world: None,
+        ..RunCheckpoint::settling(&world, wall_s)
+    };
+    ck::save(&ck_path, &header, &done)?;
     Ok(summary)
 }

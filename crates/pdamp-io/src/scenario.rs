@@ -35,13 +35,93 @@ pub enum ScenarioError {
         message: String,
     },
     /// A value is out of range or inconsistent.
-    #[error("scenario '{path}': {message}")]
+    #[error("scenario '{path}'{}: {message}", at(*line_col))]
     Invalid {
         /// File.
         path: PathBuf,
-        /// What is wrong and which key.
+        /// 1-based line and column of the offending key in the file, when it is there.
+        line_col: Option<(usize, usize)>,
+        /// What is wrong, which key (the message starts with its path, e.g.
+        /// `particles[0].size.radius_m`) and how to fix it.
         message: String,
     },
+}
+
+fn at(line_col: Option<(usize, usize)>) -> String {
+    match line_col {
+        Some((l, c)) => format!(", line {l}, column {c}"),
+        None => String::new(),
+    }
+}
+
+impl ScenarioError {
+    /// An [`ScenarioError::Invalid`] for `message` about the scenario file `path` whose text is
+    /// `text`: the key path the message starts with is looked up in the text for its line and
+    /// column (the deepest part of the path that is in the file).
+    pub fn invalid(path: &Path, text: Option<&str>, message: impl Into<String>) -> Self {
+        let message = message.into();
+        let line_col = text.and_then(|t| locate_key(t, leading_key_path(&message)));
+        ScenarioError::Invalid {
+            path: path.to_path_buf(),
+            line_col,
+            message,
+        }
+    }
+}
+
+/// The key path a validation message starts with: `a.b[2].c` of `a.b[2].c must be > 0`.
+pub fn leading_key_path(message: &str) -> &str {
+    let end = message
+        .find(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '[' | ']' | '-')))
+        .unwrap_or(message.len());
+    message[..end].trim_end_matches('.')
+}
+
+/// 1-based line and column of key path `key` (`particles[0].size.radius_m`) in TOML `text`: of
+/// the deepest prefix of the path present in the file (so a missing key points at its table).
+/// `None` if the text does not parse or not even the first key is there.
+pub fn locate_key(text: &str, key: &str) -> Option<(usize, usize)> {
+    use toml::de::{DeTable, DeValue};
+    let root = DeTable::parse(text).ok()?;
+    let mut segments: Vec<(String, Vec<usize>)> = Vec::new();
+    for part in key.split('.').filter(|p| !p.is_empty()) {
+        let (name, rest) = part.split_once('[').unwrap_or((part, ""));
+        let idx = rest
+            .split('[')
+            .filter_map(|i| i.trim_end_matches(']').parse().ok())
+            .collect();
+        segments.push((name.to_string(), idx));
+    }
+    let mut table = root.get_ref();
+    let mut best: Option<std::ops::Range<usize>> = None;
+    'outer: for (name, idx) in &segments {
+        let Some((k, v)) = table
+            .iter()
+            .find(|(k, _)| k.get_ref().as_ref() == name.as_str())
+        else {
+            break;
+        };
+        best = Some(k.span());
+        let mut value = v;
+        for &i in idx {
+            match value.get_ref() {
+                DeValue::Array(a) if i < a.len() => {
+                    value = &a[i];
+                    best = Some(value.span());
+                }
+                _ => break 'outer,
+            }
+        }
+        match value.get_ref() {
+            DeValue::Table(t) => table = t,
+            _ => break,
+        }
+    }
+    let off = best?.start.min(text.len());
+    let before = &text[..off];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rfind('\n').map_or(off, |p| off - p - 1) + 1;
+    Some((line, col))
 }
 
 /// A complete scenario.
@@ -648,11 +728,22 @@ impl Scenario {
             path: path.to_path_buf(),
             message,
         })?;
-        s.validate().map_err(|message| ScenarioError::Invalid {
-            path: path.to_path_buf(),
-            message,
-        })?;
+        s.validate()
+            .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
         Ok(s)
+    }
+
+    /// Reads and validates a scenario file and builds its world (paths relative to the file):
+    /// all checks run before any output is written, and every error names the file, the key
+    /// with its line and column, and the fix.
+    pub fn load_and_build(path: &Path) -> Result<(Self, World), ScenarioError> {
+        let s = Self::load(path)?;
+        let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+        let world = s.build_world(&base).map_err(|m| {
+            let text = std::fs::read_to_string(path).ok();
+            ScenarioError::invalid(path, text.as_deref(), m)
+        })?;
+        Ok((s, world))
     }
 
     /// Parses TOML text (no validation).
@@ -698,7 +789,7 @@ impl Scenario {
             return Err("materials: at least one [[materials]] entry is needed".into());
         }
         for (k, m) in self.materials.iter().enumerate() {
-            m.validate().map_err(|e| format!("materials[{k}]: {e}"))?;
+            m.validate().map_err(|e| format!("materials[{k}].{e}"))?;
             if self.materials[..k].iter().any(|o| o.name == m.name) {
                 return Err(format!(
                     "materials[{k}].name: duplicate material name '{}'",

@@ -413,6 +413,18 @@ impl PvdSeries {
         }
     }
 
+    /// A series that continues with the frames `entries` (from a checkpoint); rewrites the file.
+    pub fn resume(path: impl AsRef<Path>, entries: Vec<(f64, String)>) -> Result<Self, VtkError> {
+        let s = PvdSeries {
+            path: path.as_ref().to_path_buf(),
+            entries,
+        };
+        if !s.entries.is_empty() {
+            s.write()?;
+        }
+        Ok(s)
+    }
+
     /// Appends a frame at `time_s` whose data file is `file`, relative to the `.pvd`'s
     /// directory (e.g. `particles_000042.vtp`), and rewrites the collection.
     pub fn add(&mut self, time_s: f64, file: impl Into<String>) -> Result<(), VtkError> {

@@ -1,0 +1,287 @@
+//! Snapshot of everything in a [`World`] that changes while it runs, for checkpoints: restoring
+//! a snapshot into a world built from the same scenario continues the run bit for bit (same
+//! neighbour list, contact history, integrator history and ledger), so a resumed run ends with
+//! the same numbers as an uninterrupted one.
+
+use crate::body::BodyState;
+use crate::energy::EnergyLedger;
+use crate::forces::{PairOutput, PairState, WallSlot};
+use crate::integrate::GearState;
+use crate::math::Vec3;
+use crate::neighbor::NeighborList;
+use crate::world::{Counters, World};
+use serde::{Deserialize, Serialize};
+
+/// Dynamic state of one rigid body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct BodySnapshot {
+    name: String,
+    state: BodyState,
+    previous: BodyState,
+    contact_force_n: Vec3,
+    contact_torque_nm: Vec3,
+}
+
+/// The time-dependent state of a [`World`] (see the module docs). Static data (materials,
+/// contact models, wall geometry, particle radii and masses) is not stored; it comes from the
+/// scenario the world is rebuilt from, and [`World::restore_state`] checks that it matches.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WorldState {
+    radius: Vec<f64>,
+    material: Vec<u16>,
+    id: Vec<u32>,
+    position: Vec<Vec3>,
+    velocity: Vec<Vec3>,
+    angular_velocity: Vec<Vec3>,
+    force: Vec<Vec3>,
+    torque: Vec<Vec3>,
+    external_force: Vec<Vec3>,
+    bodies: Vec<BodySnapshot>,
+    gravity_m_s2: Vec3,
+    time_s: f64,
+    dt_s: f64,
+    ledger: EnergyLedger,
+    counters: Counters,
+    neighbors: NeighborList,
+    pair_state: Vec<PairState>,
+    pair_output: Vec<PairOutput>,
+    wall_slots: Vec<Vec<WallSlot>>,
+    gear: Option<GearState>,
+    initialized: bool,
+}
+
+impl WorldState {
+    /// Simulated time of the snapshot, s.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+}
+
+impl World {
+    /// Copies the time-dependent state (does not change the world).
+    pub fn save_state(&self) -> WorldState {
+        let p = &self.particles;
+        WorldState {
+            radius: p.radius.clone(),
+            material: p.material.clone(),
+            id: p.id.clone(),
+            position: p.position.clone(),
+            velocity: p.velocity.clone(),
+            angular_velocity: p.angular_velocity.clone(),
+            force: p.force.clone(),
+            torque: p.torque.clone(),
+            external_force: p.external_force.clone(),
+            bodies: self
+                .bodies
+                .iter()
+                .map(|b| BodySnapshot {
+                    name: b.name.clone(),
+                    state: b.state,
+                    previous: b.previous,
+                    contact_force_n: b.contact_force_n,
+                    contact_torque_nm: b.contact_torque_nm,
+                })
+                .collect(),
+            gravity_m_s2: self.gravity_m_s2,
+            time_s: self.time_s,
+            dt_s: self.dt_s,
+            ledger: self.ledger,
+            counters: self.counters,
+            neighbors: self.neighbors.clone(),
+            pair_state: self.pair_state.clone(),
+            pair_output: self.pair_output.clone(),
+            wall_slots: self.wall_slots.clone(),
+            gear: self.gear.clone(),
+            initialized: self.initialized,
+        }
+    }
+
+    /// Puts a snapshot back. The world must have been built from the same scenario: same
+    /// particles (radius, material, id) and the same bodies; otherwise an error says what differs
+    /// and the world is left unchanged.
+    pub fn restore_state(&mut self, s: WorldState) -> Result<(), String> {
+        let p = &self.particles;
+        if s.radius.len() != p.len() {
+            return Err(format!(
+                "checkpoint has {} particles, the scenario builds {}",
+                s.radius.len(),
+                p.len()
+            ));
+        }
+        if s.radius != p.radius || s.material != p.material || s.id != p.id {
+            return Err(
+                "checkpoint particles (radius, material or id) differ from the scenario's".into(),
+            );
+        }
+        let n = p.len();
+        for (k, v) in [
+            ("position", s.position.len()),
+            ("velocity", s.velocity.len()),
+            ("angular_velocity", s.angular_velocity.len()),
+            ("force", s.force.len()),
+            ("torque", s.torque.len()),
+            ("external_force", s.external_force.len()),
+        ] {
+            if v != n {
+                return Err(format!("checkpoint {k} has {v} entries, expected {n}"));
+            }
+        }
+        if s.bodies.len() != self.bodies.len()
+            || s.bodies
+                .iter()
+                .zip(&self.bodies)
+                .any(|(a, b)| a.name != b.name)
+        {
+            return Err("checkpoint bodies differ from the scenario's".into());
+        }
+        let np = s.neighbors.first.len();
+        if s.neighbors.second.len() != np
+            || s.pair_state.len() != np
+            || s.pair_output.len() != np
+            || s.neighbors
+                .first
+                .iter()
+                .chain(&s.neighbors.second)
+                .any(|&i| i as usize >= n)
+            || (s.initialized && s.wall_slots.len() != n)
+        {
+            return Err("checkpoint neighbour list is inconsistent".into());
+        }
+        let p = &mut self.particles;
+        p.position = s.position;
+        p.velocity = s.velocity;
+        p.angular_velocity = s.angular_velocity;
+        p.force = s.force;
+        p.torque = s.torque;
+        p.external_force = s.external_force;
+        for (b, snap) in self.bodies.iter_mut().zip(s.bodies) {
+            b.state = snap.state;
+            b.previous = snap.previous;
+            b.contact_force_n = snap.contact_force_n;
+            b.contact_torque_nm = snap.contact_torque_nm;
+        }
+        self.gravity_m_s2 = s.gravity_m_s2;
+        self.time_s = s.time_s;
+        self.dt_s = s.dt_s;
+        self.ledger = s.ledger;
+        self.counters = s.counters;
+        self.neighbors = s.neighbors;
+        self.pair_state = s.pair_state;
+        self.pair_output = s.pair_output;
+        self.wall_slots = s.wall_slots;
+        self.gear = s.gear;
+        self.initialized = s.initialized;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::contact::{ContactModel, FrictionLaw, NormalLaw};
+    use crate::walls::{BoxInside, Geometry};
+    use crate::{
+        BodyState, GearParams, HarmonicTranslation, Integrator, Material, Motion, RigidBody, Vec3,
+        Wall, World,
+    };
+    use std::sync::Arc;
+
+    fn shaken_box(n_side: usize) -> World {
+        let steel = Material::new("steel", 7850.0, 2.1e11, 0.3);
+        let model = ContactModel {
+            normal: NormalLaw::HertzMindlin {
+                restitution: 0.7,
+                clip_attractive: false,
+            },
+            friction: FrictionLaw::Mindlin {
+                friction_coefficient: 0.3,
+            },
+            rolling: None,
+            adhesion: None,
+        };
+        let mut w = World::new(vec![steel], model, 2e-7);
+        let motion = HarmonicTranslation {
+            direction: [0.0, 0.0, 1.0],
+            amplitude_m: 1e-3,
+            frequency_hz: 60.0,
+            phase_rad: 0.0,
+        };
+        let mut body = RigidBody::new(
+            "box",
+            BodyState::at_rest(Vec3::zeros()),
+            Motion::Prescribed(Arc::new(motion)),
+        );
+        body.walls.push(Wall {
+            geometry: Geometry::BoxInside(BoxInside {
+                center_m: Vec3::zeros(),
+                half_extents_m: Vec3::new(0.01, 0.01, 0.02),
+            }),
+            material: 0,
+            name: "box".into(),
+        });
+        w.add_body(body);
+        let r = 1e-3;
+        for i in 0..n_side {
+            for j in 0..n_side {
+                for k in 0..n_side {
+                    let x = Vec3::new(
+                        -0.008 + 2.2 * r * i as f64 + 1e-5 * k as f64,
+                        -0.008 + 2.2 * r * j as f64,
+                        -0.018 + 2.2 * r * k as f64,
+                    );
+                    let id = w.add_particle(x, r, 0);
+                    let s = id as f64;
+                    w.particles.velocity[id] = Vec3::new(s.sin(), (2.0 * s).cos(), (3.0 * s).sin());
+                }
+            }
+        }
+        w
+    }
+
+    /// Restoring a snapshot after `first` steps and running `second` more equals running
+    /// `first + second` steps without interruption, bit for bit.
+    fn check_continuation(integrator: Integrator, first: usize, second: usize) {
+        let mut a = shaken_box(4);
+        a.integrator = integrator.clone();
+        for _ in 0..first {
+            a.step();
+        }
+        let snap = a.save_state();
+        for _ in 0..second {
+            a.step();
+        }
+        let mut b = shaken_box(4);
+        b.integrator = integrator;
+        b.restore_state(snap).unwrap();
+        for _ in 0..second {
+            b.step();
+        }
+        assert_eq!(a.particles.position, b.particles.position);
+        assert_eq!(a.particles.velocity, b.particles.velocity);
+        assert_eq!(a.particles.angular_velocity, b.particles.angular_velocity);
+        assert_eq!(a.ledger, b.ledger);
+        assert_eq!(a.dt_s, b.dt_s);
+        assert!(
+            a.counters.neighbor_builds > 1,
+            "list was rebuilt in between"
+        );
+        assert!(a.ledger.dissipated_j() > 0.0, "contacts happened");
+    }
+
+    #[test]
+    fn restored_world_continues_bit_for_bit_verlet() {
+        check_continuation(Integrator::VelocityVerlet, 1500, 1500);
+    }
+
+    #[test]
+    fn restored_world_continues_bit_for_bit_gear() {
+        check_continuation(Integrator::Gear(GearParams::default()), 600, 600);
+    }
+
+    #[test]
+    fn restore_rejects_other_scenario() {
+        let a = shaken_box(3);
+        let mut b = shaken_box(4);
+        let e = b.restore_state(a.save_state()).unwrap_err();
+        assert!(e.contains("27 particles"), "{e}");
+    }
+}

@@ -1,0 +1,239 @@
+//! Checkpoints of long runs: the complete dynamic state of the simulation plus the position of
+//! every output stream, written atomically (temporary file + fsync + rename) as
+//! `DIR/checkpoint.bin`. A run killed at any moment and resumed from its last checkpoint ends
+//! with outputs identical to an uninterrupted run: the DEM state is restored bit for bit
+//! ([`pdamp_dem::WorldState`]), `energy.csv` is cut back to the rows of the checkpoint, and VTK
+//! frames after it are written again.
+//!
+//! Stopping on request: [`request_stop`] (called by the CLI's SIGINT/SIGTERM handler) makes the
+//! running loop write a checkpoint and return [`Interrupted`].
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// File name of the checkpoint inside the output directory.
+pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+
+/// Format version of the checkpoint file; bumped when the layout changes.
+pub const CHECKPOINT_FORMAT: u32 = 1;
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Asks running loops to write a checkpoint and stop (async-signal-safe: one atomic store).
+pub fn request_stop() {
+    STOP.store(true, Ordering::SeqCst);
+}
+
+/// True once [`request_stop`] was called.
+pub fn stop_requested() -> bool {
+    STOP.load(Ordering::Relaxed)
+}
+
+/// Error text prefix of a run stopped on request after its checkpoint was written.
+pub const INTERRUPTED: &str = "interrupted";
+
+/// A run stopped on request; its checkpoint is on disk.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interrupted {
+    /// Simulated time of the checkpoint, s.
+    pub time_s: f64,
+    /// The checkpoint file.
+    pub path: PathBuf,
+}
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{INTERRUPTED}: checkpoint at t = {:.6e} s written to {}; continue with --resume",
+            self.time_s,
+            self.path.display()
+        )
+    }
+}
+
+/// 64-bit FNV-1a digest (stable across platforms and Rust versions), printed as 16 hex digits.
+pub fn digest(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// Header common to every checkpoint: which program and which scenario wrote it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointHeader {
+    /// [`CHECKPOINT_FORMAT`] of the writer.
+    pub format: u32,
+    /// pdamp version of the writer.
+    pub pdamp_version: String,
+    /// Digest of the scenario (canonical TOML) the run belongs to.
+    pub scenario_digest: String,
+    /// Kind of run (`run`, `damper-point`, …).
+    pub kind: String,
+}
+
+impl CheckpointHeader {
+    /// Header for this build of pdamp.
+    pub fn new(kind: &str, scenario_digest: &str) -> Self {
+        Self {
+            format: CHECKPOINT_FORMAT,
+            pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+            scenario_digest: scenario_digest.to_string(),
+            kind: kind.to_string(),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct OutFile<'a, T> {
+    header: &'a CheckpointHeader,
+    body: &'a T,
+}
+
+#[derive(Deserialize)]
+struct InFile<T> {
+    header: CheckpointHeader,
+    body: T,
+}
+
+const MAGIC: &[u8; 8] = b"PDAMPCK\0";
+
+/// Writes `body` with `header` to `path` atomically.
+pub fn save<T: Serialize>(path: &Path, header: &CheckpointHeader, body: &T) -> Result<(), String> {
+    let mut bytes = MAGIC.to_vec();
+    bincode::serialize_into(&mut bytes, &OutFile { header, body })
+        .map_err(|e| format!("checkpoint {}: {e}", path.display()))?;
+    let sum = digest(&bytes);
+    bytes.extend_from_slice(sum.as_bytes());
+    crate::atomic::write_atomic(path, &bytes)
+        .map_err(|e| format!("checkpoint {}: {e}", path.display()))
+}
+
+/// Reads a checkpoint written by [`save`]; checks the magic, the trailing digest, the format,
+/// the kind and the scenario digest, and says which one fails. `Ok(None)` if there is no file.
+pub fn load<T: for<'de> Deserialize<'de>>(
+    path: &Path,
+    kind: &str,
+    scenario_digest: &str,
+) -> Result<Option<T>, String> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(format!("checkpoint {}: {e}", path.display())),
+    };
+    let bad = |why: &str| format!("checkpoint {}: {why}", path.display());
+    if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err(bad("not a pdamp checkpoint"));
+    }
+    let (data, sum) = bytes.split_at(bytes.len() - 16);
+    if digest(data).as_bytes() != sum {
+        return Err(bad("damaged (digest mismatch)"));
+    }
+    let f: InFile<T> = bincode::deserialize(&data[MAGIC.len()..])
+        .map_err(|e| bad(&format!("unreadable ({e})")))?;
+    if f.header.format != CHECKPOINT_FORMAT {
+        return Err(bad(&format!(
+            "format {} written by pdamp {}, this pdamp reads format {CHECKPOINT_FORMAT}",
+            f.header.format, f.header.pdamp_version
+        )));
+    }
+    if f.header.kind != kind {
+        return Err(bad(&format!(
+            "written by a '{}' run, not '{kind}'",
+            f.header.kind
+        )));
+    }
+    if f.header.scenario_digest != scenario_digest {
+        return Err(bad(
+            "written for a different scenario (the file changed since); start afresh without \
+             --resume or use another --out directory",
+        ));
+    }
+    Ok(Some(f.body))
+}
+
+/// Decides when to write the next checkpoint: every `interval` of wall-clock time (checked
+/// every 64 calls, so the clock is not read every step).
+#[derive(Debug)]
+pub struct CheckpointTimer {
+    interval: std::time::Duration,
+    last: std::time::Instant,
+    calls: u32,
+}
+
+impl CheckpointTimer {
+    /// A timer firing every `interval_s` seconds of wall-clock time (≤ 0: never).
+    pub fn new(interval_s: f64) -> Self {
+        Self {
+            interval: if interval_s > 0.0 {
+                std::time::Duration::from_secs_f64(interval_s)
+            } else {
+                std::time::Duration::MAX
+            },
+            last: std::time::Instant::now(),
+            calls: 0,
+        }
+    }
+
+    /// True if a checkpoint is due now (then the timer restarts).
+    pub fn due(&mut self) -> bool {
+        self.calls = self.calls.wrapping_add(1);
+        if !self.calls.is_multiple_of(64) || self.interval == std::time::Duration::MAX {
+            return false;
+        }
+        if self.last.elapsed() >= self.interval {
+            self.last = std::time::Instant::now();
+            true
+        } else {
+            false
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn save_load_round_trip_and_checks() {
+        let dir = std::env::temp_dir().join(format!("pdamp-ck-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(CHECKPOINT_FILE);
+        let h = CheckpointHeader::new("run", "abc");
+        let body = (1.5f64, vec![1u32, 2, 3], String::from("x"));
+        save(&p, &h, &body).unwrap();
+        let back: (f64, Vec<u32>, String) = load(&p, "run", "abc").unwrap().unwrap();
+        assert_eq!(back, body);
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "other").unwrap_err();
+        assert!(e.contains("different scenario"), "{e}");
+        let e = load::<(f64, Vec<u32>, String)>(&p, "fields", "abc").unwrap_err();
+        assert!(e.contains("not 'fields'"), "{e}");
+        let mut bytes = std::fs::read(&p).unwrap();
+        let k = bytes.len() / 2;
+        bytes[k] ^= 0x55;
+        std::fs::write(&p, &bytes).unwrap();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        assert!(e.contains("damaged"), "{e}");
+        std::fs::write(&p, b"garbage").unwrap();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        assert!(e.contains("not a pdamp checkpoint"), "{e}");
+        assert!(
+            load::<u8>(&dir.join("none.bin"), "run", "abc")
+                .unwrap()
+                .is_none()
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn digest_is_fnv1a() {
+        // Published FNV-1a 64 test vectors.
+        assert_eq!(digest(b""), "cbf29ce484222325");
+        assert_eq!(digest(b"a"), "af63dc4c8601ec8c");
+        assert_eq!(digest(b"foobar"), "85944171f73967e8");
+    }
+}
