@@ -1,0 +1,207 @@
+//! ε(v) curves: one impact model over many velocities (FE impacts in parallel with rayon), and
+//! repeated impacts on the same spot.
+
+use rayon::prelude::*;
+
+use crate::fe::{FeImpact, FeOptions, ImpactResult, Partner, effective_pair};
+use crate::hertz::{HertzPair, effective_modulus, sphere_mass};
+use crate::material::{Material, MaterialModel};
+use crate::thornton;
+use crate::viscoelastic::{kk_impact, prony_kk_parameters};
+
+/// Impact model of a curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CorModel {
+    /// Axisymmetric dynamic FE ([`crate::fe`]).
+    Fe(FeOptions),
+    /// Elastic Hertz (ε = 1, contact time [D Eq. 4.8], force [D Eq. 2.80]).
+    Hertz,
+    /// Thornton (1997) with limiting pressure $p_y$ = factor × (smaller initial yield stress).
+    Thornton {
+        /// $p_y/\sigma_y$ (1.6: first yield, Johnson 1985).
+        pressure_factor: f64,
+    },
+    /// Kuwabara–Kono viscoelastic Hertz ([`crate::viscoelastic`]).
+    Viscoelastic,
+}
+
+/// One point of an ε(v) curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CorPoint {
+    /// Impact velocity, m/s.
+    pub velocity_m_s: f64,
+    /// Impact number on the same spot (1 = first impact).
+    pub impact: usize,
+    /// Coefficient of restitution.
+    pub restitution: f64,
+    /// Contact time, s (NaN where the model gives none).
+    pub contact_time_s: f64,
+    /// Maximum contact force, N.
+    pub max_force_n: f64,
+    /// The FE result (FE model only).
+    pub fe: Option<ImpactResult>,
+}
+
+/// Elastic Hertz pair of the (long-term) elastic constants.
+pub fn hertz_pair(sphere: &Material, partner: &Partner, radius: f64) -> HertzPair {
+    let m = sphere_mass(radius, sphere.density_kg_m3);
+    match partner {
+        Partner::Wall(w) => HertzPair {
+            e_eff: effective_modulus(
+                sphere.youngs_modulus_pa,
+                sphere.poisson_ratio,
+                w.youngs_modulus_pa,
+                w.poisson_ratio,
+            ),
+            r_eff: radius,
+            m_eff: m,
+        },
+        Partner::Sphere => HertzPair {
+            e_eff: effective_modulus(
+                sphere.youngs_modulus_pa,
+                sphere.poisson_ratio,
+                sphere.youngs_modulus_pa,
+                sphere.poisson_ratio,
+            ),
+            r_eff: 0.5 * radius,
+            m_eff: 0.5 * m,
+        },
+    }
+}
+
+fn partner_material<'a>(sphere: &'a Material, partner: &'a Partner) -> &'a Material {
+    match partner {
+        Partner::Wall(w) => w,
+        Partner::Sphere => sphere,
+    }
+}
+
+/// One analytical point.
+fn analytical(
+    sphere: &Material,
+    partner: &Partner,
+    radius: f64,
+    v: f64,
+    model: CorModel,
+) -> CorPoint {
+    let pair = hertz_pair(sphere, partner, radius);
+    let mut p = CorPoint {
+        velocity_m_s: v,
+        impact: 1,
+        restitution: 1.0,
+        contact_time_s: pair.contact_time(v),
+        max_force_n: pair.max_force(v),
+        fe: None,
+    };
+    match model {
+        CorModel::Hertz | CorModel::Fe(_) => {}
+        CorModel::Thornton { pressure_factor } => {
+            let sy = sphere
+                .initial_yield_stress()
+                .min(partner_material(sphere, partner).initial_yield_stress());
+            if sy.is_finite() {
+                let p_y = pressure_factor * sy;
+                let vy = thornton::yield_velocity(&pair, p_y);
+                p.restitution = thornton::restitution(v, vy);
+                if v > vy {
+                    // loading: Hertz to δ_y, then F = F_y + π p_y R̄ (δ − δ_y) (Thornton 1997)
+                    let dy = pair.max_overlap(vy);
+                    let fy = pair.max_force(vy);
+                    let w_rest = 0.5 * pair.m_eff * (v * v - vy * vy);
+                    let c = std::f64::consts::PI * p_y * pair.r_eff;
+                    // w_rest = F_y x + c x²/2
+                    let x = (-fy + (fy * fy + 2.0 * c * w_rest).sqrt()) / c;
+                    let _ = dy;
+                    p.max_force_n = fy + c * x;
+                    p.contact_time_s = f64::NAN;
+                }
+            }
+        }
+        CorModel::Viscoelastic => {
+            let wall = partner_material(sphere, partner);
+            let (prony_mat, other) =
+                if matches!(wall.model, MaterialModel::ViscoelasticProny { .. }) {
+                    (Some(wall), sphere)
+                } else if matches!(sphere.model, MaterialModel::ViscoelasticProny { .. }) {
+                    (Some(sphere), wall)
+                } else {
+                    (None, sphere)
+                };
+            let (pair, a) = match prony_mat {
+                Some(pm) => {
+                    let MaterialModel::ViscoelasticProny { prony, .. } = &pm.model else {
+                        unreachable!()
+                    };
+                    let rigid = matches!(partner, Partner::Sphere);
+                    let other_c = if rigid && std::ptr::eq(pm, sphere) {
+                        (1.0 - pm.poisson_ratio.powi(2)) / pm.youngs_modulus_pa // same body
+                    } else {
+                        (1.0 - other.poisson_ratio.powi(2)) / other.youngs_modulus_pa
+                    };
+                    prony_kk_parameters(
+                        &pair,
+                        pm.instantaneous_shear_modulus(),
+                        prony,
+                        pm.poisson_ratio,
+                        other_c,
+                        v,
+                    )
+                }
+                None => (
+                    pair,
+                    sphere.kk_dissipation_time_s.unwrap_or(0.0)
+                        + wall.kk_dissipation_time_s.unwrap_or(0.0),
+                ),
+            };
+            let r = kk_impact(&pair, a, v);
+            p.restitution = r.restitution;
+            p.contact_time_s = r.contact_time_s;
+            p.max_force_n = r.max_force_n;
+        }
+    }
+    p
+}
+
+/// ε(v) of `model` for each velocity (m/s); with `repeat` > 1 each velocity is followed by
+/// repeated impacts on the same spot (FE: material state carried over; analytical models are
+/// history-free and repeat the first value). FE velocities run in parallel (rayon). Returns
+/// the points ordered by velocity, then impact number.
+pub fn cor_curve(
+    sphere: &Material,
+    partner: &Partner,
+    radius: f64,
+    velocities: &[f64],
+    model: CorModel,
+    repeat: usize,
+) -> Vec<CorPoint> {
+    let repeat = repeat.max(1);
+    let per_v: Vec<Vec<CorPoint>> = velocities
+        .par_iter()
+        .map(|&v| match model {
+            CorModel::Fe(opts) => {
+                let mut fe = FeImpact::new(sphere, partner, radius, v, &opts);
+                (1..=repeat)
+                    .map(|k| {
+                        let r = fe.run(v);
+                        CorPoint {
+                            velocity_m_s: v,
+                            impact: k,
+                            restitution: r.restitution,
+                            contact_time_s: r.contact_time_s,
+                            max_force_n: r.max_force_n,
+                            fe: Some(r),
+                        }
+                    })
+                    .collect()
+            }
+            _ => (1..=repeat)
+                .map(|k| CorPoint {
+                    impact: k,
+                    ..analytical(sphere, partner, radius, v, model)
+                })
+                .collect(),
+        })
+        .collect();
+    let _ = effective_pair;
+    per_v.into_iter().flatten().collect()
+}
