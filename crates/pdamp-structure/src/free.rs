@@ -1,0 +1,347 @@
+//! Free vibration [D Sect. 3.3.1]: the structure starts from an initial condition, attached
+//! equivalent dampers (approaches 2 and 3) are updated during the decay, and the damping ratio
+//! per cycle follows from the logarithmic decrement [D Eq. 3.40, 3.41].
+//!
+//! Updates of m̄_bed and d̄ happen at events of the damper point's motion: at zero crossings
+//! with $X = |\dot x_{pd}(t_0)|/\bar\omega$ (horizontal dampers, D Sect. 5.2.1) or at peaks
+//! with $X = |x_{pd}|$ (negative peaks for vertical dampers, D Sect. 7.2.1). Because
+//! $\bar\omega$ depends on $\bar m_{bed}$ [D Eq. 3.33] which depends on Ω and X, each update is
+//! a fixed-point iteration with $\Omega = \bar\omega_k$ [D Sect. 3.3.1].
+
+use crate::effective::EffectiveDamper;
+use crate::integrate::{Attachment, ModalIntegrator};
+use crate::modal::ModalStructure;
+use nalgebra::DVector;
+use pdamp_signal::decay::{PeakOptions, find_peaks};
+use serde::{Deserialize, Serialize};
+
+/// When attached equivalent dampers are updated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum UpdateRule {
+    /// At every zero crossing of the damper point, X = |ẋ|/ω̄ (D Sect. 5.2.1).
+    #[default]
+    ZeroCrossing,
+    /// At negative peaks, X = |x| (D Sect. 7.2.1).
+    NegativePeak,
+    /// At positive peaks, X = x.
+    PositivePeak,
+    /// At every peak, X = |x|.
+    EveryPeak,
+    /// Never (parameters from the initial amplitude only).
+    Never,
+}
+
+/// An equivalent damper attached at a named structure point.
+#[derive(Debug)]
+pub struct CoupledDamper {
+    /// Structure point (its mode-shape values give φ_pd).
+    pub point: String,
+    /// The damper model.
+    pub model: Box<dyn EffectiveDamper>,
+}
+
+/// One update of a damper's parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct UpdateRecord {
+    /// Time of the update, s.
+    pub time_s: f64,
+    /// Index of the damper.
+    pub damper: usize,
+    /// Amplitude X used, m.
+    pub amplitude_m: f64,
+    /// Frequency Ω/2π used (effective eigenfrequency), Hz.
+    pub frequency_hz: f64,
+    /// Effective particle mass m̄_bed, kg.
+    pub effective_mass_kg: f64,
+    /// Effective viscous damping d̄, N·s/m.
+    pub damping_n_s_m: f64,
+}
+
+/// Sampled response.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct TimeHistory {
+    /// Sample times, s (uniform).
+    pub time_s: Vec<f64>,
+    /// Displacement at the output point, m.
+    pub displacement_m: Vec<f64>,
+    /// Velocity at the output point, m/s.
+    pub velocity_m_s: Vec<f64>,
+    /// External force, N (zero for free vibration).
+    pub force_n: Vec<f64>,
+    /// Parameter updates.
+    pub updates: Vec<UpdateRecord>,
+}
+
+/// Free-vibration run settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FreeVibrationSpec {
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Time step, s.
+    pub time_step_s: f64,
+    /// Mode (0-based) that carries the initial condition and defines ω̄.
+    pub mode: usize,
+    /// Point where the initial condition is given.
+    pub initial_point: String,
+    /// Initial displacement there, m (q_k,0 = x_0/φ^(k)).
+    pub initial_displacement_m: f64,
+    /// Initial velocity there, m/s.
+    pub initial_velocity_m_s: f64,
+    /// Output point.
+    pub output_point: String,
+    /// Update rule for attached dampers.
+    pub update: UpdateRule,
+    /// Store every n-th step.
+    pub sample_every: usize,
+}
+
+/// Effective eigenfrequency of mode k with attached effective masses [D Eq. 3.33], rad/s.
+pub fn effective_omega(structure: &ModalStructure, mode: usize, masses: &[(Vec<f64>, f64)]) -> f64 {
+    let w = structure.modes[mode].omega_rad_s();
+    let extra: f64 = masses.iter().map(|(s, m)| s[mode] * s[mode] * m).sum();
+    w / (1.0 + extra).sqrt()
+}
+
+/// What was measured at an update event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Measure {
+    /// A peak: X = |x|.
+    Peak(f64),
+    /// A zero crossing with this velocity: X = |ẋ|/ω̄.
+    Velocity(f64),
+}
+
+/// Fixed-point update of damper `i` [D Sect. 3.3.1]: with Ω = ω̄_k (Eq. 3.33) and
+/// X from the [`Measure`], m̄ = m̄(Ω, X) (Eq. 3.38) until
+/// ω̄ settles; then d̄ = Ẽ/(πΩX²) (Eq. 3.39). Returns (X, Ω, m̄, d̄).
+pub fn fixed_point_update(
+    structure: &ModalStructure,
+    mode: usize,
+    dampers: &[CoupledDamper],
+    shapes: &[Vec<f64>],
+    attachments: &[Attachment],
+    i: usize,
+    measure: Measure,
+) -> (f64, f64, f64, f64) {
+    let mut masses: Vec<(Vec<f64>, f64)> = shapes
+        .iter()
+        .zip(attachments)
+        .map(|(s, a)| (s.clone(), a.mass_kg))
+        .collect();
+    let mut omega = effective_omega(structure, mode, &masses);
+    let mut x = 0.0;
+    for _ in 0..50 {
+        x = match measure {
+            Measure::Peak(p) => p.abs(),
+            Measure::Velocity(v) => v.abs() / omega.max(1e-300),
+        };
+        let m = dampers[i].model.evaluate(x, omega).effective_mass_kg;
+        masses[i].1 = m;
+        let w_new = effective_omega(structure, mode, &masses);
+        let done = (w_new - omega).abs() <= 1e-12 * omega;
+        omega = w_new;
+        if done {
+            break;
+        }
+    }
+    let s = dampers[i].model.evaluate(x, omega);
+    (
+        x,
+        omega,
+        s.effective_mass_kg,
+        s.viscous_damping_n_s_m(x, omega),
+    )
+}
+
+/// Runs a free vibration of `structure` with the equivalent `dampers` [D Sect. 3.3.1].
+///
+/// # Errors
+/// Unknown points, invalid spec.
+pub fn run_free_vibration(
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    spec: &FreeVibrationSpec,
+) -> Result<TimeHistory, String> {
+    structure.validate()?;
+    if spec.mode >= structure.modes.len() {
+        return Err(format!(
+            "mode {} does not exist ({} modes)",
+            spec.mode + 1,
+            structure.modes.len()
+        ));
+    }
+    if !(spec.time_step_s > 0.0 && spec.duration_s > 0.0) {
+        return Err("duration_s and time_step_s must be > 0".into());
+    }
+    let init = structure.point(&spec.initial_point)?.to_vec();
+    let out = structure.point(&spec.output_point)?.to_vec();
+    let shapes: Vec<Vec<f64>> = dampers
+        .iter()
+        .map(|d| structure.point(&d.point).map(|s| s.to_vec()))
+        .collect::<Result<_, _>>()?;
+    let k = spec.mode;
+    if init[k] == 0.0 {
+        return Err(format!(
+            "point '{}' is a node of mode {}: cannot set the initial condition there",
+            spec.initial_point,
+            k + 1
+        ));
+    }
+    let mut it = ModalIntegrator::new(structure, spec.time_step_s);
+    it.q[k] = spec.initial_displacement_m / init[k];
+    it.v[k] = spec.initial_velocity_m_s / init[k];
+    let mut atts: Vec<Attachment> = shapes
+        .iter()
+        .map(|s| Attachment {
+            shape: s.clone(),
+            mass_kg: 0.0,
+            damping_n_s_m: 0.0,
+        })
+        .collect();
+    let mut hist = TimeHistory::default();
+    // Initial parameters from the initial amplitude.
+    for i in 0..dampers.len() {
+        let x0 = it.displacement(&shapes[i]).abs();
+        let v0 = it.velocity(&shapes[i]);
+        let (x, w, m, d) = if x0 > 0.0 {
+            fixed_point_update(structure, k, dampers, &shapes, &atts, i, Measure::Peak(x0))
+        } else {
+            fixed_point_update(
+                structure,
+                k,
+                dampers,
+                &shapes,
+                &atts,
+                i,
+                Measure::Velocity(v0),
+            )
+        };
+        atts[i].mass_kg = m;
+        atts[i].damping_n_s_m = d;
+        hist.updates.push(UpdateRecord {
+            time_s: 0.0,
+            damper: i,
+            amplitude_m: x,
+            frequency_hz: w / std::f64::consts::TAU,
+            effective_mass_kg: m,
+            damping_n_s_m: d,
+        });
+    }
+    let zero = DVector::zeros(structure.modes.len());
+    it.set_attachments(&atts);
+    it.make_consistent(&zero);
+    let n_steps = (spec.duration_s / spec.time_step_s).round() as usize;
+    let every = spec.sample_every.max(1);
+    let push = |it: &ModalIntegrator, h: &mut TimeHistory| {
+        h.time_s.push(it.time_s);
+        h.displacement_m.push(it.displacement(&out));
+        h.velocity_m_s.push(it.velocity(&out));
+        h.force_n.push(0.0);
+    };
+    push(&it, &mut hist);
+    let mut prev: Vec<(f64, f64)> = shapes
+        .iter()
+        .map(|s| (it.displacement(s), it.velocity(s)))
+        .collect();
+    for step in 1..=n_steps {
+        it.step(&zero);
+        let mut changed = false;
+        for i in 0..dampers.len() {
+            let (x1, v1) = (it.displacement(&shapes[i]), it.velocity(&shapes[i]));
+            let (x0, v0) = prev[i];
+            prev[i] = (x1, v1);
+            let event = match spec.update {
+                UpdateRule::Never => None,
+                UpdateRule::ZeroCrossing => (x0 != 0.0 && x0.signum() != x1.signum()).then(|| {
+                    let t = x0 / (x0 - x1);
+                    Measure::Velocity(v0 + (v1 - v0) * t)
+                }),
+                rule => {
+                    let pos = v0 > 0.0 && v1 <= 0.0;
+                    let neg = v0 < 0.0 && v1 >= 0.0;
+                    let hit = match rule {
+                        UpdateRule::PositivePeak => pos,
+                        UpdateRule::NegativePeak => neg,
+                        _ => pos || neg,
+                    };
+                    hit.then(|| Measure::Peak(x1.abs().max(x0.abs())))
+                }
+            };
+            if let Some(measure) = event {
+                let (x, w, m, d) =
+                    fixed_point_update(structure, k, dampers, &shapes, &atts, i, measure);
+                atts[i].mass_kg = m;
+                atts[i].damping_n_s_m = d;
+                changed = true;
+                hist.updates.push(UpdateRecord {
+                    time_s: it.time_s,
+                    damper: i,
+                    amplitude_m: x,
+                    frequency_hz: w / std::f64::consts::TAU,
+                    effective_mass_kg: m,
+                    damping_n_s_m: d,
+                });
+            }
+        }
+        if changed {
+            it.set_attachments(&atts);
+            it.make_consistent(&zero);
+        }
+        if step % every == 0 {
+            push(&it, &mut hist);
+        }
+    }
+    Ok(hist)
+}
+
+/// Damping of one vibration cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CycleDamping {
+    /// Time of the cycle's middle, s.
+    pub time_s: f64,
+    /// Mean amplitude $X_{n+1/2} = (X_n + X_{n+1})/2$ [D Sect. 3.3.1], m.
+    pub mean_amplitude_m: f64,
+    /// ζ from the logarithmic decrement $\vartheta = \ln(X_n/X_{n+1})$ [D Eq. 3.40, 3.41].
+    pub damping_ratio: f64,
+    /// 1/(t_{n+1} − t_n), Hz.
+    pub frequency_hz: f64,
+}
+
+/// Positive peaks of a uniformly sampled decay (parabolic refinement, pdamp-signal), with
+/// peaks closer than `min_separation_s` merged.
+pub fn decay_peaks(hist: &TimeHistory, min_separation_s: f64) -> Result<Vec<(f64, f64)>, String> {
+    if hist.time_s.len() < 3 {
+        return Err("too few samples".into());
+    }
+    let dt = hist.time_s[1] - hist.time_s[0];
+    let peaks = find_peaks(
+        &hist.displacement_m,
+        hist.time_s[0],
+        dt,
+        &PeakOptions {
+            min_separation_s,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(peaks.iter().map(|p| (p.time_s, p.value)).collect())
+}
+
+/// Damping ratio per cycle from successive positive peaks [D Eq. 3.40, 3.41], evaluated at the
+/// mean amplitude of the cycle.
+pub fn damping_per_cycle(peaks: &[(f64, f64)]) -> Vec<CycleDamping> {
+    peaks
+        .windows(2)
+        .filter(|w| w[0].1 > 0.0 && w[1].1 > 0.0)
+        .map(|w| {
+            let theta = (w[0].1 / w[1].1).ln();
+            CycleDamping {
+                time_s: 0.5 * (w[0].0 + w[1].0),
+                mean_amplitude_m: 0.5 * (w[0].1 + w[1].1),
+                damping_ratio: pdamp_signal::decay::damping_ratio_from_log_decrement(theta),
+                frequency_hz: 1.0 / (w[1].0 - w[0].0),
+            }
+        })
+        .collect()
+}
