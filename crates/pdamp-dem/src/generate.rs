@@ -79,9 +79,7 @@ impl SizeDistribution {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!(
-                    "size distribution: {name} must be finite and > 0, got {v}"
-                ))
+                Err(format!("{name} must be finite and > 0, got {v}"))
             }
         }
         match *self {
@@ -94,7 +92,7 @@ impl SizeDistribution {
                 positive("max_radius_m", max_radius_m)?;
                 if min_radius_m > max_radius_m {
                     return Err(format!(
-                        "size distribution: min_radius_m ({min_radius_m}) must not exceed max_radius_m ({max_radius_m})"
+                        "min_radius_m ({min_radius_m}) must not exceed max_radius_m ({max_radius_m})"
                     ));
                 }
                 Ok(())
@@ -107,9 +105,7 @@ impl SizeDistribution {
             } => {
                 positive("median_diameter_m", median_diameter_m)?;
                 if !(sigma.is_finite() && sigma >= 0.0) {
-                    return Err(format!(
-                        "size distribution: sigma must be finite and >= 0, got {sigma}"
-                    ));
+                    return Err(format!("sigma must be finite and >= 0, got {sigma}"));
                 }
                 if let Some(r) = min_radius_m {
                     positive("min_radius_m", r)?;
@@ -120,7 +116,7 @@ impl SizeDistribution {
                 match (min_radius_m, max_radius_m) {
                     (Some(lo), Some(hi)) if lo >= hi => {
                         return Err(format!(
-                            "size distribution: min_radius_m ({lo}) must be below max_radius_m ({hi})"
+                            "min_radius_m ({lo}) must be below max_radius_m ({hi})"
                         ));
                     }
                     _ => {}
@@ -131,7 +127,7 @@ impl SizeDistribution {
                         || max_radius_m.is_some_and(|hi| r50 > hi)
                     {
                         return Err(format!(
-                            "size distribution: with sigma = 0 the median radius {r50} m must lie within min_radius_m/max_radius_m"
+                            "with sigma = 0 the median radius {r50} m must lie within min_radius_m/max_radius_m"
                         ));
                     }
                     return Ok(());
@@ -141,7 +137,7 @@ impl SizeDistribution {
                     .map_or(1.0, |(a, b)| normal_cdf(b) - normal_cdf(a));
                 if mass < MIN_TRUNCATION_MASS {
                     return Err(format!(
-                        "size distribution: min_radius_m/max_radius_m keep only {mass:.3e} of the log-normal probability mass (need >= {MIN_TRUNCATION_MASS:e})"
+                        "min_radius_m/max_radius_m keep only {mass:.3e} of the log-normal probability mass (need >= {MIN_TRUNCATION_MASS:e})"
                     ));
                 }
                 Ok(())
@@ -463,11 +459,11 @@ impl Region {
         match self {
             Region::Box { min_m, max_m } => {
                 if !finite(min_m) || !finite(max_m) {
-                    return Err("region box: min_m and max_m must be finite".into());
+                    return Err("min_m and max_m must be finite".into());
                 }
                 if (0..3).any(|i| min_m[i] >= max_m[i]) {
                     return Err(format!(
-                        "region box: min_m {:?} must be below max_m {:?} in every component",
+                        "min_m {:?} must be below max_m {:?} in every component",
                         min_m.as_slice(),
                         max_m.as_slice()
                     ));
@@ -481,20 +477,16 @@ impl Region {
                 length_m,
             } => {
                 if !finite(base_center_m) {
-                    return Err("region cylinder: base_center_m must be finite".into());
+                    return Err("base_center_m must be finite".into());
                 }
                 if !finite(axis) || axis.norm() == 0.0 {
-                    return Err("region cylinder: axis must be finite and non-zero".into());
+                    return Err("axis must be finite and non-zero".into());
                 }
                 if !(radius_m.is_finite() && *radius_m > 0.0) {
-                    return Err(format!(
-                        "region cylinder: radius_m must be finite and > 0, got {radius_m}"
-                    ));
+                    return Err(format!("radius_m must be finite and > 0, got {radius_m}"));
                 }
                 if !(length_m.is_finite() && *length_m > 0.0) {
-                    return Err(format!(
-                        "region cylinder: length_m must be finite and > 0, got {length_m}"
-                    ));
+                    return Err(format!("length_m must be finite and > 0, got {length_m}"));
                 }
                 Ok(())
             }

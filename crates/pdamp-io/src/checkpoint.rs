@@ -125,35 +125,51 @@ pub fn load<T: for<'de> Deserialize<'de>>(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(format!("checkpoint {}: {e}", path.display())),
     };
-    let bad = |why: &str| format!("checkpoint {}: {why}", path.display());
+    decode(&bytes, kind, scenario_digest)
+        .map(Some)
+        .map_err(|why| format!("checkpoint {}: {why}", path.display()))
+}
+
+/// Decodes the bytes of a checkpoint file (see [`load`]). Never panics and never allocates
+/// more than the input length suggests, whatever the bytes are.
+pub fn decode<T: for<'de> Deserialize<'de>>(
+    bytes: &[u8],
+    kind: &str,
+    scenario_digest: &str,
+) -> Result<T, String> {
+    use bincode::Options;
     if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
-        return Err(bad("not a pdamp checkpoint"));
+        return Err("not a pdamp checkpoint".into());
     }
     let (data, sum) = bytes.split_at(bytes.len() - 16);
     if digest(data).as_bytes() != sum {
-        return Err(bad("damaged (digest mismatch)"));
+        return Err("damaged (digest mismatch)".into());
     }
-    let f: InFile<T> = bincode::deserialize(&data[MAGIC.len()..])
-        .map_err(|e| bad(&format!("unreadable ({e})")))?;
+    let f: InFile<T> = bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .with_limit(data.len() as u64)
+        .deserialize(&data[MAGIC.len()..])
+        .map_err(|e| format!("unreadable ({e})"))?;
     if f.header.format != CHECKPOINT_FORMAT {
-        return Err(bad(&format!(
+        return Err(format!(
             "format {} written by pdamp {}, this pdamp reads format {CHECKPOINT_FORMAT}",
             f.header.format, f.header.pdamp_version
-        )));
-    }
-    if f.header.kind != kind {
-        return Err(bad(&format!(
-            "written by a '{}' run, not '{kind}'",
-            f.header.kind
-        )));
-    }
-    if f.header.scenario_digest != scenario_digest {
-        return Err(bad(
-            "written for a different scenario (the file changed since); start afresh without \
-             --resume or use another --out directory",
         ));
     }
-    Ok(Some(f.body))
+    if f.header.kind != kind {
+        return Err(format!(
+            "written by a '{}' run, not '{kind}'",
+            f.header.kind
+        ));
+    }
+    if f.header.scenario_digest != scenario_digest {
+        return Err(
+            "written for a different scenario (the file changed since); start afresh without \
+             --resume or use another --out directory"
+                .into(),
+        );
+    }
+    Ok(f.body)
 }
 
 /// Decides when to write the next checkpoint: every `interval` of wall-clock time (checked

@@ -668,7 +668,7 @@ impl ParticleGroupSpec {
                 };
                 Ok((ratio * f.max_count as f64).round() as usize)
             }
-            _ => Err("give exactly one of count and filling".into()),
+            _ => Err("count: give exactly one of `count` and `filling` in the group".into()),
         }
     }
 }
@@ -724,9 +724,16 @@ impl Scenario {
             path: path.to_path_buf(),
             source,
         })?;
-        let s = Self::from_toml(&text).map_err(|message| ScenarioError::Parse {
-            path: path.to_path_buf(),
-            message,
+        let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+        let s = Self::from_toml_in(&text, &base).map_err(|message| {
+            if message.starts_with("contact.") {
+                ScenarioError::invalid(path, Some(&text), message)
+            } else {
+                ScenarioError::Parse {
+                    path: path.to_path_buf(),
+                    message,
+                }
+            }
         })?;
         s.validate()
             .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
@@ -751,6 +758,20 @@ impl Scenario {
         toml::from_str(text).map_err(|e| e.to_string())
     }
 
+    /// Parses TOML text whose file lies in `base_dir`: restitution tables named by
+    /// `restitution_table_csv` are read from CSV files relative to it
+    /// ([`crate::restitution::inline_tables`]). No validation.
+    pub fn from_toml_in(text: &str, base_dir: &Path) -> Result<Self, String> {
+        if !text.contains(crate::restitution::TABLE_KEY) {
+            return Self::from_toml(text);
+        }
+        let mut doc: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+        crate::restitution::inline_tables(&mut doc, base_dir)?;
+        toml::Value::Table(doc)
+            .try_into()
+            .map_err(|e: toml::de::Error| e.to_string())
+    }
+
     /// Serialises to TOML.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
@@ -770,29 +791,83 @@ impl Scenario {
             })
     }
 
-    /// Checks ranges and references; the message names the key.
+    /// Checks ranges and references. Every message starts with the path of the offending key
+    /// (`particles[0].size.radius_m …`, located by [`ScenarioError::invalid`]) and says how
+    /// to fix it.
     pub fn validate(&self) -> Result<(), String> {
         let s = &self.simulation;
+        let finite_pos = |v: f64| v.is_finite() && v > 0.0;
         if !(s.duration_s.is_finite() && s.duration_s >= 0.0) {
             return Err(format!(
-                "simulation.duration_s must be >= 0, got {}",
+                "simulation.duration_s must be a finite time >= 0 in seconds, got {}",
                 s.duration_s
             ));
         }
-        if !(s.time_step_s.is_finite() && s.time_step_s > 0.0) {
+        if !finite_pos(s.time_step_s) {
             return Err(format!(
-                "simulation.time_step_s must be > 0, got {}",
+                "simulation.time_step_s must be > 0 (seconds), got {}; a safe value is about 1/20 \
+                 of the contact time (`pdamp check` prints it)",
                 s.time_step_s
             ));
         }
+        if s.duration_s > 0.0 && s.time_step_s > s.duration_s {
+            return Err(format!(
+                "simulation.time_step_s ({}) exceeds simulation.duration_s ({}); check the units \
+                 (both in seconds)",
+                s.time_step_s, s.duration_s
+            ));
+        }
+        if s.gravity_m_s2.iter().any(|g| !g.is_finite()) {
+            return Err(format!(
+                "simulation.gravity_m_s2 must be finite, got {:?}; e.g. [0.0, 0.0, -9.81]",
+                s.gravity_m_s2
+            ));
+        }
+        if let Some(skin) = s.skin_m
+            && !finite_pos(skin)
+        {
+            return Err(format!(
+                "simulation.skin_m must be > 0 (metres), got {skin}; leave it out for the default \
+                 0.2 × smallest radius"
+            ));
+        }
+        if !(s.max_time_step_ratio > 0.0 && s.max_time_step_ratio <= 1.0) {
+            return Err(format!(
+                "simulation.max_time_step_ratio must lie in (0, 1], got {}; 0.1 is the default",
+                s.max_time_step_ratio
+            ));
+        }
+        if !finite_pos(s.check_impact_velocity_m_s) {
+            return Err(format!(
+                "simulation.check_impact_velocity_m_s must be > 0 (m/s), got {}",
+                s.check_impact_velocity_m_s
+            ));
+        }
+        if !finite_pos(self.output.energy_interval_s) {
+            return Err(format!(
+                "output.energy_interval_s must be > 0 (seconds), got {}",
+                self.output.energy_interval_s
+            ));
+        }
+        if !(self.output.vtk_interval_s.is_finite() && self.output.vtk_interval_s >= 0.0) {
+            return Err(format!(
+                "output.vtk_interval_s must be >= 0 (seconds; 0 switches VTK off), got {}",
+                self.output.vtk_interval_s
+            ));
+        }
         if self.materials.is_empty() {
-            return Err("materials: at least one [[materials]] entry is needed".into());
+            return Err(
+                "materials: at least one material is needed; add a [[materials]] table with name, \
+                 density_kg_m3, youngs_modulus_pa and poisson_ratio"
+                    .into(),
+            );
         }
         for (k, m) in self.materials.iter().enumerate() {
             m.validate().map_err(|e| format!("materials[{k}].{e}"))?;
             if self.materials[..k].iter().any(|o| o.name == m.name) {
                 return Err(format!(
-                    "materials[{k}].name: duplicate material name '{}'",
+                    "materials[{k}].name: duplicate material name '{}'; give every material its \
+                     own name",
                     m.name
                 ));
             }
@@ -802,23 +877,65 @@ impl Scenario {
             .validate()
             .map_err(|e| format!("contact.{e}"))?;
         for (k, p) in self.contact.pairs.iter().enumerate() {
-            self.material_index(&p.materials[0], &format!("contact.pairs[{k}].materials"))?;
-            self.material_index(&p.materials[1], &format!("contact.pairs[{k}].materials"))?;
+            let key = format!("contact.pairs[{k}].materials");
+            let a = self.material_index(&p.materials[0], &key)?;
+            let b = self.material_index(&p.materials[1], &key)?;
+            if self.contact.pairs[..k].iter().any(|o| {
+                let (c, d) = (
+                    self.material_index(&o.materials[0], "").unwrap_or(u16::MAX),
+                    self.material_index(&o.materials[1], "").unwrap_or(u16::MAX),
+                );
+                (a, b) == (c, d) || (a, b) == (d, c)
+            }) {
+                return Err(format!(
+                    "{key}: the pair {:?} has a contact model already; keep one [[contact.pairs]] \
+                     entry per material pair",
+                    p.materials
+                ));
+            }
             p.model
                 .validate()
                 .map_err(|e| format!("contact.pairs[{k}].{e}"))?;
         }
         for (b, body) in self.bodies.iter().enumerate() {
+            if self.bodies[..b].iter().any(|o| o.name == body.name) {
+                return Err(format!(
+                    "bodies[{b}].name: duplicate body name '{}'; give every body its own name",
+                    body.name
+                ));
+            }
+            if body.position_m.iter().any(|x| !x.is_finite()) {
+                return Err(format!("bodies[{b}].position_m must be finite"));
+            }
+            if body.walls.is_empty() {
+                return Err(format!(
+                    "bodies[{b}].walls: body '{}' has no walls; add a [[bodies.walls]] table",
+                    body.name
+                ));
+            }
             for (w, wall) in body.walls.iter().enumerate() {
                 self.material_index(&wall.material, &format!("bodies[{b}].walls[{w}].material"))?;
             }
             if let MotionSpec::Harmonic(h) = &body.motion {
-                if Vec3::from(h.direction).norm() == 0.0 {
-                    return Err(format!("bodies[{b}].motion.direction must not be zero"));
-                }
-                if !(h.frequency_hz > 0.0 && h.amplitude_m >= 0.0) {
+                if !Vec3::from(h.direction).norm().is_finite()
+                    || Vec3::from(h.direction).norm() == 0.0
+                {
                     return Err(format!(
-                        "bodies[{b}].motion: frequency_hz must be > 0 and amplitude_m >= 0"
+                        "bodies[{b}].motion.direction must be a finite non-zero vector, got {:?}; \
+                         e.g. [1.0, 0.0, 0.0] for horizontal shaking",
+                        h.direction
+                    ));
+                }
+                if !finite_pos(h.frequency_hz) {
+                    return Err(format!(
+                        "bodies[{b}].motion.frequency_hz must be > 0 (Hz), got {}",
+                        h.frequency_hz
+                    ));
+                }
+                if !(h.amplitude_m.is_finite() && h.amplitude_m >= 0.0) {
+                    return Err(format!(
+                        "bodies[{b}].motion.amplitude_m must be >= 0 (metres), got {}",
+                        h.amplitude_m
                     ));
                 }
             }
@@ -827,20 +944,23 @@ impl Scenario {
             if !self.bodies.iter().any(|b| b.name == d.container_body) {
                 let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
                 return Err(format!(
-                    "damper.container_body: no body named '{}' (bodies: {})",
+                    "damper.container_body: no body named '{}'; use one of: {}",
                     d.container_body,
                     known.join(", ")
                 ));
             }
             if !(d.container_mass_kg.is_finite() && d.container_mass_kg >= 0.0) {
                 return Err(format!(
-                    "damper.container_mass_kg must be >= 0, got {}",
+                    "damper.container_mass_kg must be >= 0 (kg), got {}",
                     d.container_mass_kg
                 ));
             }
             if Vec3::from(d.direction).norm() == 0.0 || !Vec3::from(d.direction).norm().is_finite()
             {
-                return Err("damper.direction must not be zero".into());
+                return Err(format!(
+                    "damper.direction must be a finite non-zero vector, got {:?}; e.g. [1.0, 0.0, 0.0]",
+                    d.direction
+                ));
             }
             let given = [
                 d.amplitude_m.is_some(),
@@ -852,7 +972,9 @@ impl Scenario {
             .count();
             if given > 1 {
                 return Err(
-                    "damper: give only one of amplitude_m, acceleration_m_s2, intensity".into(),
+                    "damper: give only one of amplitude_m, acceleration_m_s2, intensity (they \
+                     describe the same amplitude); delete the others"
+                        .into(),
                 );
             }
             if self.fields.is_none() && given == 0 {
@@ -868,7 +990,7 @@ impl Scenario {
                 ("frequency_hz", d.frequency_hz),
             ] {
                 if let Some(v) = v
-                    && !(v.is_finite() && v > 0.0)
+                    && !finite_pos(v)
                 {
                     return Err(format!("damper.{k} must be > 0, got {v}"));
                 }
@@ -878,14 +1000,20 @@ impl Scenario {
             }
             if d.cycles <= d.transient_cycles {
                 return Err(format!(
-                    "damper.cycles ({}) must exceed damper.transient_cycles ({})",
-                    d.cycles, d.transient_cycles
+                    "damper.cycles ({}) must exceed damper.transient_cycles ({}); e.g. cycles = {}",
+                    d.cycles,
+                    d.transient_cycles,
+                    d.transient_cycles + 15
                 ));
             }
         }
         if let Some(f) = &self.fields {
             if self.damper.is_none() {
-                return Err("fields: a [damper] section is needed".into());
+                return Err(
+                    "fields: a [damper] section is needed; add one with container_body, \
+                     container_mass_kg and direction"
+                        .into(),
+                );
             }
             f.frequencies_hz.validate("fields.frequencies_hz")?;
             match f.amplitude_axis() {
@@ -902,17 +1030,60 @@ impl Scenario {
                 }
             }
         }
+        if let Some(st) = &self.settle {
+            if !(st.max_duration_s.is_finite() && st.max_duration_s >= 0.0) {
+                return Err(format!(
+                    "settle.max_duration_s must be >= 0 (seconds), got {}",
+                    st.max_duration_s
+                ));
+            }
+            if !(st.kinetic_energy_per_particle_j.is_finite()
+                && st.kinetic_energy_per_particle_j >= 0.0)
+            {
+                return Err(format!(
+                    "settle.kinetic_energy_per_particle_j must be >= 0 (J), got {}",
+                    st.kinetic_energy_per_particle_j
+                ));
+            }
+            if let Some(g) = st.gravity_m_s2
+                && g.iter().any(|x| !x.is_finite())
+            {
+                return Err(format!("settle.gravity_m_s2 must be finite, got {g:?}"));
+            }
+        }
+        if self.particles.is_empty() && (self.damper.is_some() || self.settle.is_some()) {
+            return Err(
+                "particles: no [[particles]] group; a damper or settling needs particles".into(),
+            );
+        }
         for (g, grp) in self.particles.iter().enumerate() {
             self.material_index(&grp.material, &format!("particles[{g}].material"))?;
-            grp.resolved_count()
+            let n = grp
+                .resolved_count()
                 .map_err(|e| format!("particles[{g}].{e}"))?;
+            if n == 0 {
+                return Err(format!(
+                    "particles[{g}].count: the group has no particles; give count >= 1 or remove it"
+                ));
+            }
             grp.size
                 .validate()
-                .map_err(|e| format!("particles[{g}].size: {e}"))?;
+                .map_err(|e| format!("particles[{g}].size.{e}"))?;
             grp.placement
                 .region
                 .validate()
-                .map_err(|e| format!("particles[{g}].placement.region: {e}"))?;
+                .map_err(|e| format!("particles[{g}].placement.region.{e}"))?;
+            if !(grp.placement.gap_m.is_finite() && grp.placement.gap_m >= 0.0) {
+                return Err(format!(
+                    "particles[{g}].placement.gap_m must be >= 0 (metres), got {}",
+                    grp.placement.gap_m
+                ));
+            }
+            if grp.initial_velocity_m_s.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "particles[{g}].initial_velocity_m_s must be finite"
+                ));
+            }
         }
         Ok(())
     }
@@ -993,6 +1164,7 @@ impl Scenario {
             Vec3::z()
         };
         let mut placed: Vec<(Vec3, f64)> = Vec::new();
+        let mut group_of: Vec<usize> = Vec::new();
         for (g, grp) in self.particles.iter().enumerate() {
             let mat = self.material_index(&grp.material, "particles")?;
             let count = grp
@@ -1019,14 +1191,21 @@ impl Scenario {
                     )
                 }
             }
-            .map_err(|e| format!("particles[{g}].placement: {e}"))?;
+            .map_err(|e| {
+                format!(
+                    "particles[{g}].placement.region: {e}; enlarge the region, or lower the \
+                     particle count, the radius or placement.gap_m"
+                )
+            })?;
             for (x, r) in pos.iter().zip(&radii) {
                 let id = world.add_particle(*x, *r, mat);
                 world.particles.velocity[id] = Vec3::from(grp.initial_velocity_m_s);
                 placed.push((*x, *r));
+                group_of.push(g);
             }
         }
-        check_initial_overlaps(&world)?;
+        check_initial_overlaps(&world, &group_of)?;
+        check_inside_walls(&world, &group_of, self)?;
         if let Some(skin) = self.simulation.skin_m {
             world.set_skin(skin);
         }
@@ -1053,7 +1232,7 @@ impl Scenario {
 }
 
 /// Fails if two particles overlap by more than 1e-9 of the smaller radius at the start.
-fn check_initial_overlaps(world: &World) -> Result<(), String> {
+fn check_initial_overlaps(world: &World, group_of: &[usize]) -> Result<(), String> {
     let p = &world.particles;
     let n = p.len();
     if n < 2 {
@@ -1071,14 +1250,57 @@ fn check_initial_overlaps(world: &World) -> Result<(), String> {
             let d = (p.position[i] - p.position[j]).norm();
             let ov = p.radius[i] + p.radius[j] - d;
             if ov > 1e-9 * p.radius[i].min(p.radius[j]) {
+                let (i, j) = (i.min(j), i.max(j));
+                let (gi, gj) = (group_of[i], group_of[j]);
+                let fix = if gi != gj {
+                    format!(
+                        "the placement regions of particles[{gi}] and particles[{gj}] overlap; \
+                         make them disjoint"
+                    )
+                } else {
+                    "increase placement.gap_m or use another placement method".to_string()
+                };
                 return Err(format!(
-                    "particles: initial overlap of {:.3e} m between particle {} at {:?} and particle {} at {:?}",
+                    "particles[{gj}].placement: initial overlap of {:.3e} m between particle {} at {:?} and particle {} at {:?}; {fix}",
                     ov,
                     i,
                     p.position[i].as_slice(),
                     j,
                     p.position[j].as_slice()
                 ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Fails if a particle starts overlapping a wall or outside a closed container (boxes and
+/// cylinders report a particle outside as a deep overlap; open meshes cannot tell).
+fn check_inside_walls(world: &World, group_of: &[usize], sc: &Scenario) -> Result<(), String> {
+    let p = &world.particles;
+    let mut contacts = Vec::new();
+    for (bi, b) in world.bodies.iter().enumerate() {
+        let pose = pdamp_dem::BodyState::at_rest(Vec3::from(sc.bodies[bi].position_m));
+        for (wi, w) in b.walls.iter().enumerate() {
+            for i in 0..p.len() {
+                contacts.clear();
+                let x = pose.to_body(&p.position[i]);
+                w.geometry
+                    .sphere_contacts(&x, p.radius[i], 0.0, &mut contacts);
+                if let Some(c) = contacts.iter().find(|c| c.overlap_m > 1e-9 * p.radius[i]) {
+                    let g = group_of[i];
+                    let outside = c.overlap_m > p.radius[i];
+                    return Err(format!(
+                        "particles[{g}].placement.region: particle {i} at {:?} m {} wall '{}' of body '{}' (bodies[{bi}].walls[{wi}]) by {:.3e} m; \
+                         keep the region inside the container, at least one radius ({:.3e} m) away from its walls",
+                        p.position[i].as_slice(),
+                        if outside { "lies outside" } else { "overlaps" },
+                        w.name,
+                        b.name,
+                        c.overlap_m,
+                        p.radius[i]
+                    ));
+                }
             }
         }
     }

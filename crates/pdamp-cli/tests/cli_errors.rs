@@ -1,0 +1,57 @@
+//! Bad input through the CLI: non-zero exit status, a message naming file, key, line and fix,
+//! and no output directory created.
+
+use std::process::Command;
+
+fn pdamp() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_pdamp"))
+}
+
+#[test]
+fn bad_scenario_exits_nonzero_and_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("pdamp-cli-err-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let ex = pdamp()
+        .args(["example", "--particles", "50", "--duration-s", "0.01"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(ex.stdout)
+        .unwrap()
+        .replace("poisson_ratio = 0.3", "poisson_ratio = 0.7");
+    let scn = dir.join("bad.toml");
+    std::fs::write(&scn, &text).unwrap();
+    let line = text[..text.find("poisson_ratio = 0.7").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    for cmd in ["run", "fields", "check"] {
+        let out = dir.join(format!("out_{cmd}"));
+        let mut c = pdamp();
+        c.arg(cmd).arg(&scn);
+        if cmd != "check" {
+            c.arg("--out").arg(&out);
+        }
+        let o = c.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{cmd}: {err}");
+        assert!(err.contains("bad.toml"), "{cmd}: {err}");
+        assert!(
+            err.contains(&format!(
+                "line {line}, column 1: materials[0].poisson_ratio"
+            )),
+            "{cmd}: {err}"
+        );
+        assert!(err.contains("(-1, 0.5)"), "{cmd}: {err}");
+        assert!(!out.exists(), "{cmd}: no output directory on bad input");
+    }
+    let o = pdamp()
+        .args(["run", "no_such.toml", "--out"])
+        .arg(dir.join("x"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read scenario 'no_such.toml'"));
+    assert!(!dir.join("x").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
