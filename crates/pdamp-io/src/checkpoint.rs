@@ -125,17 +125,18 @@ pub fn load<T: for<'de> Deserialize<'de>>(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(format!("checkpoint {}: {e}", path.display())),
     };
-    decode(&bytes, kind, scenario_digest)
+    decode(&bytes, kind, Some(scenario_digest))
         .map(Some)
         .map_err(|why| format!("checkpoint {}: {why}", path.display()))
 }
 
-/// Decodes the bytes of a checkpoint file (see [`load`]). Never panics and never allocates
-/// more than the input length suggests, whatever the bytes are.
+/// Decodes the bytes of a checkpoint file (see [`load`]; `scenario_digest = None` skips that
+/// check). Never panics and never allocates more than the input length suggests, whatever the
+/// bytes are.
 pub fn decode<T: for<'de> Deserialize<'de>>(
     bytes: &[u8],
     kind: &str,
-    scenario_digest: &str,
+    scenario_digest: Option<&str>,
 ) -> Result<T, String> {
     use bincode::Options;
     if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
@@ -162,7 +163,7 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
             f.header.kind
         ));
     }
-    if f.header.scenario_digest != scenario_digest {
+    if scenario_digest.is_some_and(|d| d != f.header.scenario_digest) {
         return Err(
             "written for a different scenario (the file changed since); start afresh without \
              --resume or use another --out directory"

@@ -8,6 +8,7 @@ pub mod bench;
 pub mod checkpoint;
 pub mod csv;
 pub mod examples;
+pub mod fuzz;
 pub mod restitution;
 pub mod run;
 pub mod scenario;

@@ -361,6 +361,13 @@ impl RunCheckpoint {
     }
 }
 
+/// Decodes a `run` checkpoint file of any scenario and returns its simulated time, s (for
+/// inspection and fuzzing; never panics).
+pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, String> {
+    let c: RunCheckpoint = crate::checkpoint::decode(bytes, RUN_KIND, None)?;
+    Ok(c.world.map_or(0.0, |w| w.time_s()))
+}
+
 /// Kind tag of `run` checkpoints.
 const RUN_KIND: &str = "run";
 
