@@ -10,6 +10,8 @@ use pdamp_dem::contact::NormalLaw;
 use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
 use std::path::PathBuf;
 
+mod cor;
+
 #[derive(Parser)]
 #[command(
     name = "pdamp",
@@ -95,6 +97,10 @@ enum Command {
         #[arg(long)]
         velocity_m_s: f64,
     },
+    /// Coefficient of restitution ε(v) from impact models (FE, Hertz, Thornton, viscoelastic);
+    /// writes DIR/cor.csv (velocity_m_s,restitution,contact_time_s,max_force_n), a gonthier-table
+    /// snippet and a plot.
+    Cor(cor::CorArgs),
     /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
     Bench {
         /// Number of particles.
@@ -239,6 +245,7 @@ fn run_cli() -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }
+        Command::Cor(args) => cor::run(args),
         Command::Bench { particles, steps } => {
             let r =
                 pdamp_io::bench::shaken_box_bench(particles, steps).map_err(anyhow::Error::msg)?;

@@ -331,37 +331,41 @@ fn j2_update(
     let (y0, _) = hardening(curve, *ep);
     let mut diss = 0.0;
     if q_tr > y0 {
-        let rate = zeta_dt.is_finite();
-        let f = |x: f64| -> (f64, f64) {
+        // rate-independent solution: q_tr − 3GΔ = σ_y(ε̄+Δ) (piecewise linear: Newton, ≤ a few steps)
+        let mut x = 0.0;
+        for _ in 0..50 {
             let (h, hp) = hardening(curve, *ep + x);
-            if rate && x > 0.0 {
-                let r = (x / zeta_dt).powf(lambda);
-                (
-                    q_tr - 3.0 * g * x - h * (1.0 + r),
-                    -3.0 * g - hp * (1.0 + r) - h * lambda * r / x,
-                )
-            } else {
-                (q_tr - 3.0 * g * x - h, -3.0 * g - hp)
-            }
-        };
-        let (mut lo, mut hi) = (0.0, q_tr / (3.0 * g));
-        let (_, hp0) = hardening(curve, *ep);
-        let mut x = ((q_tr - y0) / (3.0 * g + hp0)).min(hi);
-        for _ in 0..80 {
-            let (fx, dfx) = f(x);
-            if fx > 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
-            if fx.abs() <= 1e-12 * q_tr || hi - lo <= 1e-15 * (hi + lo) {
+            let dx = (q_tr - 3.0 * g * x - h) / (3.0 * g + hp);
+            x += dx;
+            if dx.abs() <= 1e-14 * x {
                 break;
             }
-            let mut xn = x - fx / dfx;
-            if !(xn > lo && xn < hi) || !xn.is_finite() {
-                xn = 0.5 * (lo + hi);
+        }
+        if zeta_dt.is_finite() {
+            // Perzyna [D Eq. 4.2] in inverse form: φ(Δ) = Δ − ζΔt·u^{1/λ} = 0 with
+            // u = (q_tr − 3GΔ)/σ_y(ε̄+Δ) − 1 ≥ 0. φ is concave and increasing on [0, Δ_ri], so
+            // Newton from Δ = 0 converges monotonically (no overshoot).
+            let x_ri = x;
+            let inv_l = 1.0 / lambda;
+            let mut y = 0.0;
+            for _ in 0..100 {
+                let (h, hp) = hardening(curve, *ep + y);
+                let u = ((q_tr - 3.0 * g * y) / h - 1.0).max(0.0);
+                let du = (-3.0 * g * h - (q_tr - 3.0 * g * y) * hp) / (h * h);
+                let pw = u.powf(inv_l);
+                let phi = y - zeta_dt * pw;
+                let dphi = 1.0 - zeta_dt * inv_l * if u > 0.0 { pw / u } else { 0.0 } * du;
+                let mut yn = y - phi / dphi;
+                if !(yn.is_finite()) || yn > x_ri {
+                    yn = 0.5 * (y + x_ri);
+                }
+                let done = (yn - y).abs() <= 1e-13 * x_ri;
+                y = yn.max(0.0);
+                if done {
+                    break;
+                }
             }
-            x = xn;
+            x = y;
         }
         let scale = 1.0 - 3.0 * g * x / q_tr;
         for c in &mut s {
