@@ -11,6 +11,7 @@ use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
 use std::path::PathBuf;
 
 mod cor;
+mod structure;
 
 #[derive(Parser)]
 #[command(
@@ -101,6 +102,11 @@ enum Command {
     /// writes DIR/cor.csv (velocity_m_s,restitution,contact_time_s,max_force_n), a gonthier-table
     /// snippet and a plot.
     Cor(cor::CorArgs),
+    /// Structural level: `pdamp structure modes STRUCTURE.toml` writes modes.csv.
+    Structure(structure::StructureArgs),
+    /// Particle dampers coupled to a structure (full DEM, effective fields or formulas): free
+    /// decay (decay.csv, damping.csv), sweeps or steady-state FRFs (frf.csv), summary.json, plots.
+    Couple(structure::CoupleArgs),
     /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
     Bench {
         /// Number of particles.
@@ -246,6 +252,8 @@ fn run_cli() -> Result<()> {
             Ok(())
         }
         Command::Cor(args) => cor::run(args),
+        Command::Structure(args) => structure::run_structure(args),
+        Command::Couple(args) => structure::run_couple(args),
         Command::Bench { particles, steps } => {
             let r =
                 pdamp_io::bench::shaken_box_bench(particles, steps).map_err(anyhow::Error::msg)?;

@@ -376,8 +376,11 @@ pub struct ModeCoupling {
 }
 
 /// Iteration scheme of D Fig. 3.7: start with Ẽ = 0, m̄ = 0; then repeatedly
-/// Q = R/(2mζω̄²) (Eq. 3.48), X = φ_pd Q (Eq. 3.50), Ẽ and m̄ at (ω̄, X) with Ẽ averaged with
-/// the previous iterate, ω̄ (Eq. 3.33), d̄ (Eq. 3.39), ζ (Eq. 3.49), until ζ converges.
+/// Q = R/(2mζω̄²) (Eq. 3.48), X = φ_pd Q (Eq. 3.50), Ẽ and m̄ at (ω̄, X), ω̄ (Eq. 3.33),
+/// d̄ (Eq. 3.39), ζ (Eq. 3.49), until ζ converges. D relaxes by averaging Ẽ of successive
+/// iterates; that diverges when X changes by orders of magnitude between the first iterates
+/// (the first X is set by the structural damping alone), so the mean of successive ζ is taken
+/// instead (same fixed point).
 pub fn resonance_equilibrium(
     mode: &ModeCoupling,
     model: &dyn EffectiveDamper,
@@ -392,7 +395,7 @@ pub fn resonance_equilibrium(
     } = *mode;
     let p2 = phi_pd * phi_pd;
     let r = phi_ex * force_amplitude_n;
-    let (mut e, mut mbar) = (0.0, 0.0);
+    let mut mbar = 0.0;
     let mut zeta = zk;
     let mut w = wk;
     let mut x = 0.0;
@@ -406,11 +409,7 @@ pub fn resonance_equilibrium(
         let q = r / (2.0 * m * zeta * w * w);
         x = (phi_pd * q).abs();
         let s = model.evaluate(x, w);
-        e = if n == 0 {
-            s.dissipated_energy_per_cycle_j
-        } else {
-            0.5 * (e + s.dissipated_energy_per_cycle_j)
-        };
+        let e = s.dissipated_energy_per_cycle_j;
         mbar = s.effective_mass_kg;
         let m = 1.0 + p2 * mbar;
         w = wk / m.sqrt();
@@ -419,7 +418,7 @@ pub fn resonance_equilibrium(
         let v = x * w;
         eta = e / (PI * model.bed_mass_kg() * v * v);
         let done = (z_new - zeta).abs() <= 1e-9 * z_new;
-        zeta = z_new;
+        zeta = if n == 0 { z_new } else { 0.5 * (zeta + z_new) };
         if done {
             converged = true;
             break;

@@ -28,6 +28,7 @@ pub mod free;
 pub mod integrate;
 pub mod matrix_market;
 pub mod modal;
+pub mod report;
 pub mod scenario;
 
 pub use modal::{ModalPoint, ModalStructure, Mode};

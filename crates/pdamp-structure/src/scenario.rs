@@ -1,1 +1,853 @@
-//! placeholder
+//! TOML input of `pdamp structure modes` and `pdamp couple` (see docs/structure.md). SI units
+//! in every key name; unknown keys are errors.
+
+use crate::effective::{EffectiveDamper, FieldTable, ViscousDamper};
+use crate::fe::{BeamSection, Dof, FeModel, GroundSpring, PointMass};
+use crate::forced::SweepLaw;
+use crate::formulas::{
+    ConstantLossFactor, HorizontalDamper, LayeredDamper, RollingDamper, clearance_m,
+};
+use crate::free::UpdateRule;
+use crate::matrix_market;
+use crate::modal::{ModalPoint, ModalStructure, Mode, lowest_modes};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+/// A structure file: `[structure]` with one model section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureFile {
+    /// The structure.
+    pub structure: StructureSpec,
+}
+
+/// The structure model and its reduction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureSpec {
+    /// Number of modes kept (FE and Matrix Market models).
+    #[serde(default = "default_modes")]
+    pub n_modes: usize,
+    /// Modes below this frequency (rigid-body modes) are dropped, Hz.
+    #[serde(default = "default_min_frequency")]
+    pub min_frequency_hz: f64,
+    /// Single mode in damper coordinates [D Eq. 3.27/3.36].
+    #[serde(default)]
+    pub single_mode: Option<SingleModeSpec>,
+    /// Direct modal input.
+    #[serde(default)]
+    pub modal: Option<ModalSpec>,
+    /// Built-in straight beam.
+    #[serde(default)]
+    pub beam: Option<BeamSpec>,
+    /// Imported matrices.
+    #[serde(default)]
+    pub matrix_market: Option<MatrixMarketSpec>,
+    /// Structural damping (FE and Matrix Market models).
+    #[serde(default)]
+    pub damping: Option<DampingSpec>,
+    /// Named points (FE and Matrix Market models).
+    #[serde(default)]
+    pub points: Vec<PointSpec>,
+}
+
+fn default_modes() -> usize {
+    4
+}
+fn default_min_frequency() -> f64 {
+    1e-3
+}
+
+/// `[structure.single_mode]`: $M\ddot x + D\dot x + Kx = f$ at the damper [D Eq. 3.36].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SingleModeSpec {
+    /// M, kg.
+    pub mass_kg: f64,
+    /// K, N/m.
+    pub stiffness_n_m: f64,
+    /// D, N·s/m.
+    #[serde(default)]
+    pub damping_n_s_m: f64,
+}
+
+/// `[structure.modal]`: eigenfrequencies, damping ratios and mass-normalised shape values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModalSpec {
+    /// f_k, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// ζ_k (one per mode).
+    pub damping_ratios: Vec<f64>,
+    /// Points with their φ^(k) values (1/√kg).
+    pub points: Vec<ModalPoint>,
+}
+
+/// Structural damping of FE/imported models.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// Same ζ for all modes.
+    #[serde(default)]
+    pub ratio: Option<f64>,
+    /// ζ per mode.
+    #[serde(default)]
+    pub ratios: Option<Vec<f64>>,
+    /// Rayleigh α (mass-proportional), 1/s.
+    #[serde(default)]
+    pub rayleigh_alpha_1_s: Option<f64>,
+    /// Rayleigh β (stiffness-proportional), s.
+    #[serde(default)]
+    pub rayleigh_beta_s: Option<f64>,
+}
+
+/// `[structure.beam]`: a straight beam along x with planar (x–y) or 3D motion.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamSpec {
+    /// Length, m.
+    pub length_m: f64,
+    /// Number of elements.
+    pub elements: usize,
+    /// E, Pa.
+    pub youngs_modulus_pa: f64,
+    /// ν.
+    pub poisson_ratio: f64,
+    /// ρ, kg/m³.
+    pub density_kg_m3: f64,
+    /// Cross-section area, m² (or give width_m/height_m).
+    #[serde(default)]
+    pub area_m2: Option<f64>,
+    /// Second moment for bending in x–y (deflection along y), m⁴.
+    #[serde(default)]
+    pub second_moment_m4: Option<f64>,
+    /// Second moment for bending in x–z, m⁴ (default: as second_moment_m4).
+    #[serde(default)]
+    pub second_moment_z_m4: Option<f64>,
+    /// Torsion constant, m⁴ (default: sum of the second moments).
+    #[serde(default)]
+    pub torsion_constant_m4: Option<f64>,
+    /// Rectangle width (z extent), m.
+    #[serde(default)]
+    pub width_m: Option<f64>,
+    /// Rectangle height (y extent, bending direction), m.
+    #[serde(default)]
+    pub height_m: Option<f64>,
+    /// Timoshenko elements (κ = 5/6).
+    #[serde(default = "yes")]
+    pub timoshenko: bool,
+    /// Only in-plane (x–y) motion: uz, θx, θy fixed everywhere.
+    #[serde(default = "yes")]
+    pub planar: bool,
+    /// Supports.
+    #[serde(default)]
+    pub supports: Vec<SupportSpec>,
+    /// Lumped masses.
+    #[serde(default)]
+    pub masses: Vec<MassSpec>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Support kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportKind {
+    /// All six dof fixed.
+    Clamped,
+    /// Translations fixed.
+    Pinned,
+    /// Transverse spring (y) of `stiffness_n_m`.
+    Spring,
+}
+
+/// A support at a position along the beam.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// Position along the beam, m.
+    pub position_m: f64,
+    /// Kind.
+    pub kind: SupportKind,
+    /// Spring stiffness, N/m (kind = "spring").
+    #[serde(default)]
+    pub stiffness_n_m: f64,
+}
+
+/// A lumped mass on the beam.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    /// Position along the beam, m.
+    pub position_m: f64,
+    /// Mass, kg.
+    pub mass_kg: f64,
+    /// Rotary inertia about z, kg·m².
+    #[serde(default)]
+    pub rotary_inertia_kg_m2: f64,
+    /// Offset of the mass centre from the beam axis along y, m (rigid attachment).
+    #[serde(default)]
+    pub offset_y_m: f64,
+}
+
+/// `[structure.matrix_market]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixMarketSpec {
+    /// Stiffness matrix file.
+    pub stiffness: PathBuf,
+    /// Mass matrix file.
+    pub mass: PathBuf,
+    /// Dof map file (`row node dof`).
+    pub dof_map: PathBuf,
+}
+
+/// A named point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSpec {
+    /// Name.
+    pub name: String,
+    /// Position along the beam, m (built-in beam).
+    #[serde(default)]
+    pub position_m: Option<f64>,
+    /// Node id (Matrix Market model).
+    #[serde(default)]
+    pub node: Option<i64>,
+    /// Direction dof: `uy` (default), `uz`, `ux`, …
+    #[serde(default = "default_dof")]
+    pub dof: String,
+}
+
+fn default_dof() -> String {
+    "uy".into()
+}
+
+/// Result of building a structure.
+#[derive(Debug, Clone)]
+pub struct BuiltStructure {
+    /// The reduced structure.
+    pub modal: ModalStructure,
+    /// Total mass of an FE model, kg.
+    pub total_mass_kg: Option<f64>,
+    /// Active dof of an FE/imported model.
+    pub dof_count: Option<usize>,
+}
+
+fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}
+
+impl StructureSpec {
+    /// Builds and reduces the structure (paths relative to `base_dir`).
+    ///
+    /// # Errors
+    /// Not exactly one model section, invalid values, unknown points, solver errors.
+    pub fn build(&self, base_dir: &Path) -> Result<BuiltStructure, String> {
+        let count = [
+            self.single_mode.is_some(),
+            self.modal.is_some(),
+            self.beam.is_some(),
+            self.matrix_market.is_some(),
+        ]
+        .iter()
+        .filter(|b| **b)
+        .count();
+        if count != 1 {
+            return Err(
+                "[structure]: give exactly one of single_mode, modal, beam, matrix_market".into(),
+            );
+        }
+        if let Some(s) = &self.single_mode {
+            if !(s.mass_kg > 0.0 && s.stiffness_n_m > 0.0 && s.damping_n_s_m >= 0.0) {
+                return Err("single_mode: mass_kg, stiffness_n_m > 0, damping_n_s_m ≥ 0".into());
+            }
+            return Ok(BuiltStructure {
+                modal: ModalStructure::single_mode(s.mass_kg, s.stiffness_n_m, s.damping_n_s_m),
+                total_mass_kg: None,
+                dof_count: None,
+            });
+        }
+        if let Some(m) = &self.modal {
+            if m.damping_ratios.len() != m.frequencies_hz.len() {
+                return Err("modal: damping_ratios needs one value per frequency".into());
+            }
+            let s = ModalStructure {
+                modes: m
+                    .frequencies_hz
+                    .iter()
+                    .zip(&m.damping_ratios)
+                    .map(|(&f, &z)| Mode {
+                        frequency_hz: f,
+                        damping_ratio: z,
+                    })
+                    .collect(),
+                points: m.points.clone(),
+            };
+            s.validate()?;
+            return Ok(BuiltStructure {
+                modal: s,
+                total_mass_kg: None,
+                dof_count: None,
+            });
+        }
+        let (k, m, rows, total): (_, _, Vec<Option<usize>>, Option<f64>) =
+            if let Some(b) = &self.beam {
+                let (fe, positions) = b.model()?;
+                let a = fe.assemble()?;
+                let mut rows = Vec::new();
+                for p in &self.points {
+                    let x = p
+                        .position_m
+                        .ok_or_else(|| format!("point '{}': needs position_m", p.name))?;
+                    let dof = Dof::parse(&p.dof)
+                        .ok_or_else(|| format!("point '{}': unknown dof '{}'", p.name, p.dof))?;
+                    let node = nearest(&positions, x);
+                    rows.push(a.row(node, dof));
+                }
+                let total = fe.total_mass_kg();
+                (a.stiffness, a.mass, rows, Some(total))
+            } else {
+                let mm = self.matrix_market.as_ref().expect("counted");
+                let k = matrix_market::read_matrix_market(&resolve(base_dir, &mm.stiffness))
+                    .map_err(|e| e.to_string())?;
+                let m = matrix_market::read_matrix_market(&resolve(base_dir, &mm.mass))
+                    .map_err(|e| e.to_string())?;
+                if k.nrows != m.nrows || k.nrows != k.ncols || m.nrows != m.ncols {
+                    return Err(format!(
+                        "K is {}×{}, M is {}×{}",
+                        k.nrows, k.ncols, m.nrows, m.ncols
+                    ));
+                }
+                if k.nrows > 4000 {
+                    return Err(format!(
+                        "{} dof: the dense modal solver is limited to 4000 dof",
+                        k.nrows
+                    ));
+                }
+                let map = matrix_market::read_dof_map(&resolve(base_dir, &mm.dof_map), k.nrows)
+                    .map_err(|e| e.to_string())?;
+                let mut rows = Vec::new();
+                for p in &self.points {
+                    let node = p
+                        .node
+                        .ok_or_else(|| format!("point '{}': needs node", p.name))?;
+                    let dof = Dof::parse(&p.dof)
+                        .ok_or_else(|| format!("point '{}': unknown dof '{}'", p.name, p.dof))?;
+                    rows.push(Some(map.row(node, dof).ok_or_else(|| {
+                        format!("point '{}': node {node} {dof:?} not in the dof map", p.name)
+                    })?));
+                }
+                (k.to_dense(), m.to_dense(), rows, None)
+            };
+        let n = k.nrows();
+        let basis = lowest_modes(&k, &m, self.n_modes, self.min_frequency_hz)?;
+        let mut modal = ModalStructure {
+            modes: basis
+                .omega_rad_s
+                .iter()
+                .map(|w| Mode {
+                    frequency_hz: w / TAU,
+                    damping_ratio: 0.0,
+                })
+                .collect(),
+            points: self
+                .points
+                .iter()
+                .zip(&rows)
+                .map(|(p, r)| ModalPoint {
+                    name: p.name.clone(),
+                    shape: match r {
+                        Some(r) => basis.shapes.row(*r).iter().copied().collect(),
+                        None => vec![0.0; basis.omega_rad_s.len()], // fixed dof
+                    },
+                })
+                .collect(),
+        };
+        if let Some(d) = &self.damping {
+            if let Some(z) = d.ratio {
+                modal.modes.iter_mut().for_each(|m| m.damping_ratio = z);
+            }
+            if let Some(zs) = &d.ratios {
+                for (m, z) in modal.modes.iter_mut().zip(zs) {
+                    m.damping_ratio = *z;
+                }
+            }
+            if d.rayleigh_alpha_1_s.is_some() || d.rayleigh_beta_s.is_some() {
+                modal.set_rayleigh(
+                    d.rayleigh_alpha_1_s.unwrap_or(0.0),
+                    d.rayleigh_beta_s.unwrap_or(0.0),
+                );
+            }
+        }
+        modal.validate()?;
+        Ok(BuiltStructure {
+            modal,
+            total_mass_kg: total,
+            dof_count: Some(n),
+        })
+    }
+}
+
+fn nearest(positions: &[f64], x: f64) -> usize {
+    positions
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
+        .map(|(i, _)| i)
+        .unwrap_or(0)
+}
+
+impl BeamSpec {
+    /// The FE model and the axial position of every node.
+    ///
+    /// # Errors
+    /// Missing section data.
+    pub fn model(&self) -> Result<(FeModel, Vec<f64>), String> {
+        let g = self.youngs_modulus_pa / (2.0 * (1.0 + self.poisson_ratio));
+        let section = match (self.width_m, self.height_m) {
+            (Some(w), Some(h)) => BeamSection::rectangle(
+                w,
+                h,
+                self.youngs_modulus_pa,
+                self.poisson_ratio,
+                self.density_kg_m3,
+                self.timoshenko,
+            ),
+            _ => {
+                let a = self
+                    .area_m2
+                    .ok_or("beam: give width_m and height_m, or area_m2 and second_moment_m4")?;
+                let iz = self
+                    .second_moment_m4
+                    .ok_or("beam: second_moment_m4 missing")?;
+                let iy = self.second_moment_z_m4.unwrap_or(iz);
+                BeamSection {
+                    youngs_modulus_pa: self.youngs_modulus_pa,
+                    shear_modulus_pa: g,
+                    density_kg_m3: self.density_kg_m3,
+                    area_m2: a,
+                    iy_m4: iy,
+                    iz_m4: iz,
+                    torsion_constant_m4: self.torsion_constant_m4.unwrap_or(iy + iz),
+                    shear_coefficient: self.timoshenko.then_some(5.0 / 6.0),
+                }
+            }
+        };
+        section.validate()?;
+        if self.elements == 0 || self.length_m <= 0.0 {
+            return Err("beam: elements ≥ 1 and length_m > 0".into());
+        }
+        // Nodes at the element ends plus exact nodes at supports, masses and points are not
+        // inserted: positions snap to the nearest node (use element counts that hit them).
+        let mut fe = FeModel::straight_beam(
+            [0.0; 3],
+            [self.length_m, 0.0, 0.0],
+            self.elements,
+            section,
+            [0.0, 1.0, 0.0],
+        );
+        let positions: Vec<f64> = fe.nodes.iter().map(|p| p[0]).collect();
+        if self.planar {
+            fe.fix_all_nodes(&[Dof::Uz, Dof::Rx, Dof::Ry]);
+        }
+        for s in &self.supports {
+            let n = nearest(&positions, s.position_m);
+            match s.kind {
+                SupportKind::Clamped => fe.fix(n, &Dof::ALL),
+                SupportKind::Pinned => fe.fix(n, &Dof::TRANSLATIONS),
+                SupportKind::Spring => fe.springs.push(GroundSpring {
+                    node: n,
+                    dof: Dof::Uy,
+                    stiffness: s.stiffness_n_m,
+                }),
+            }
+        }
+        for m in &self.masses {
+            fe.point_masses.push(PointMass {
+                node: nearest(&positions, m.position_m),
+                mass_kg: m.mass_kg,
+                inertia_kg_m2: [
+                    m.rotary_inertia_kg_m2,
+                    m.rotary_inertia_kg_m2,
+                    m.rotary_inertia_kg_m2,
+                ],
+                offset_m: [0.0, m.offset_y_m, 0.0],
+            });
+        }
+        Ok((fe, positions))
+    }
+}
+
+/// Loads a structure file.
+///
+/// # Errors
+/// I/O and TOML errors.
+pub fn load_structure(path: &Path) -> Result<StructureFile, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// A `pdamp couple` scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoupleScenario {
+    /// Structure file (relative to the scenario), or give `[structure]` inline.
+    #[serde(default)]
+    pub structure_file: Option<PathBuf>,
+    /// Inline structure.
+    #[serde(default)]
+    pub structure: Option<StructureSpec>,
+    /// Dampers.
+    #[serde(default)]
+    pub dampers: Vec<DamperSpec>,
+    /// The analysis.
+    pub analysis: AnalysisSpec,
+}
+
+/// A damper model at a structure point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DamperSpec {
+    /// Viscous reference: Ẽ = πcΩX², constant mass.
+    Viscous {
+        /// Structure point.
+        point: String,
+        /// c, N·s/m.
+        damping_n_s_m: f64,
+        /// Coupled mass, kg.
+        #[serde(default)]
+        mass_kg: f64,
+    },
+    /// Approach 2: effective field from fields.csv.
+    Fields {
+        /// Structure point.
+        point: String,
+        /// fields.csv (relative to the scenario).
+        path: PathBuf,
+        /// Bed mass m_bed, kg.
+        bed_mass_kg: f64,
+    },
+    /// Approach 3: rolling/scattered layers (D Eq. 5.1–5.14).
+    Rolling {
+        /// Structure point.
+        point: String,
+        /// Layers.
+        layers: Vec<RollingLayerSpec>,
+        /// Smoothing of the X_opt jump (logistic width in ln X).
+        #[serde(default)]
+        smoothing_log_width: Option<f64>,
+    },
+    /// Approach 3: combined horizontal rolling/bouncing model (D Eq. 6.12).
+    Horizontal {
+        /// Structure point.
+        point: String,
+        /// Bed mass, kg.
+        bed_mass_kg: f64,
+        /// h_rol, m.
+        rolling_clearance_m: f64,
+        /// h_bou, m.
+        bouncing_clearance_m: f64,
+        /// m̄/m_bed for A ≥ g.
+        #[serde(default = "one")]
+        bouncing_mass_ratio: f64,
+    },
+    /// Fixed η̄ and m̄/m_bed.
+    Constant {
+        /// Structure point.
+        point: String,
+        /// Bed mass, kg.
+        bed_mass_kg: f64,
+        /// η̄.
+        effective_loss_factor: f64,
+        /// m̄/m_bed.
+        effective_mass_ratio: f64,
+    },
+    /// Approach 1: full DEM damper from a damper scenario (`[damper]` section).
+    Dem {
+        /// Structure point.
+        point: String,
+        /// Damper scenario (relative to this scenario).
+        scenario: PathBuf,
+        /// Subtract the static bed weight.
+        #[serde(default = "yes")]
+        compensate_static_weight: bool,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// One layer of a rolling damper: give `clearance_m` or `container_length_m` with
+/// `particles` and `particles_per_layer` (Eq. 5.1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollingLayerSpec {
+    /// Bed mass of the layer, kg.
+    pub bed_mass_kg: f64,
+    /// Clearance h_rol, m.
+    #[serde(default)]
+    pub clearance_m: Option<f64>,
+    /// Container length L, m.
+    #[serde(default)]
+    pub container_length_m: Option<f64>,
+    /// n_p.
+    #[serde(default)]
+    pub particles: Option<f64>,
+    /// n_p^max.
+    #[serde(default)]
+    pub particles_per_layer: Option<f64>,
+}
+
+impl DamperSpec {
+    /// Structure point of the damper.
+    pub fn point(&self) -> &str {
+        match self {
+            DamperSpec::Viscous { point, .. }
+            | DamperSpec::Fields { point, .. }
+            | DamperSpec::Rolling { point, .. }
+            | DamperSpec::Horizontal { point, .. }
+            | DamperSpec::Constant { point, .. }
+            | DamperSpec::Dem { point, .. } => point,
+        }
+    }
+
+    /// The equivalent model of approaches 2/3 (`None` for DEM).
+    ///
+    /// # Errors
+    /// Invalid layer data, unreadable fields.csv.
+    pub fn effective_model(
+        &self,
+        base_dir: &Path,
+    ) -> Result<Option<Box<dyn EffectiveDamper>>, String> {
+        Ok(Some(match self {
+            DamperSpec::Viscous {
+                damping_n_s_m,
+                mass_kg,
+                ..
+            } => Box::new(ViscousDamper {
+                damping_n_s_m: *damping_n_s_m,
+                mass_kg: *mass_kg,
+            }),
+            DamperSpec::Fields {
+                path, bed_mass_kg, ..
+            } => Box::new(FieldTable::read(&resolve(base_dir, path), *bed_mass_kg)?),
+            DamperSpec::Rolling {
+                layers,
+                smoothing_log_width,
+                ..
+            } => {
+                let mut v: Vec<Box<dyn EffectiveDamper>> = Vec::new();
+                for l in layers {
+                    let h = match (l.clearance_m, l.container_length_m, l.particles, l.particles_per_layer) {
+                        (Some(h), _, _, _) => h,
+                        (None, Some(len), Some(n), Some(nmax)) => clearance_m(len, n, nmax),
+                        _ => return Err("rolling layer: give clearance_m or container_length_m + particles + particles_per_layer".into()),
+                    };
+                    v.push(Box::new(RollingDamper {
+                        bed_mass_kg: l.bed_mass_kg,
+                        clearance_m: h,
+                        smoothing_log_width: *smoothing_log_width,
+                    }));
+                }
+                if v.len() == 1 {
+                    v.pop().expect("one")
+                } else {
+                    Box::new(LayeredDamper { layers: v })
+                }
+            }
+            DamperSpec::Horizontal {
+                bed_mass_kg,
+                rolling_clearance_m,
+                bouncing_clearance_m,
+                bouncing_mass_ratio,
+                ..
+            } => Box::new(HorizontalDamper {
+                rolling: RollingDamper {
+                    bed_mass_kg: *bed_mass_kg,
+                    clearance_m: *rolling_clearance_m,
+                    smoothing_log_width: None,
+                },
+                bouncing_clearance_m: *bouncing_clearance_m,
+                bouncing_mass_ratio: *bouncing_mass_ratio,
+            }),
+            DamperSpec::Constant {
+                bed_mass_kg,
+                effective_loss_factor,
+                effective_mass_ratio,
+                ..
+            } => Box::new(ConstantLossFactor {
+                bed_mass_kg: *bed_mass_kg,
+                effective_loss_factor: *effective_loss_factor,
+                effective_mass_ratio: *effective_mass_ratio,
+            }),
+            DamperSpec::Dem { .. } => return Ok(None),
+        }))
+    }
+}
+
+/// Excitation force: a force amplitude, or a base amplitude U of a single-mode structure
+/// (R' = UK, D Sect. 5.2.2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    /// F, N.
+    #[serde(default)]
+    pub force_amplitude_n: Option<f64>,
+    /// U, m (single_mode structures: F = U K).
+    #[serde(default)]
+    pub base_amplitude_m: Option<f64>,
+}
+
+/// The analysis of a `pdamp couple` scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum AnalysisSpec {
+    /// Free vibration from an initial condition [D Sect. 3.3.1].
+    Free {
+        /// Simulated time, s.
+        duration_s: f64,
+        /// Time step, s (DEM dampers use their scenario's step).
+        time_step_s: f64,
+        /// Mode carrying the initial condition (1-based).
+        #[serde(default = "one_usize")]
+        mode: usize,
+        /// Point of the initial condition.
+        initial_point: String,
+        /// Initial displacement, m.
+        initial_displacement_m: f64,
+        /// Initial velocity, m/s.
+        #[serde(default)]
+        initial_velocity_m_s: f64,
+        /// Output point.
+        output_point: String,
+        /// Update rule for approaches 2/3.
+        #[serde(default)]
+        update: UpdateRule,
+        /// Store every n-th step.
+        #[serde(default = "one_usize")]
+        sample_every: usize,
+    },
+    /// Sine sweep in the time domain [D Sect. 3.3.2].
+    Sweep {
+        /// Start frequency, Hz.
+        start_hz: f64,
+        /// End frequency, Hz.
+        end_hz: f64,
+        /// Duration, s.
+        duration_s: f64,
+        /// Linear or logarithmic.
+        #[serde(default)]
+        law: SweepLaw,
+        /// Force amplitude F, N.
+        #[serde(default)]
+        force_amplitude_n: Option<f64>,
+        /// Base amplitude U of a single-mode structure (F = U K), m.
+        #[serde(default)]
+        base_amplitude_m: Option<f64>,
+        /// Excitation point.
+        excitation_point: String,
+        /// Output point.
+        output_point: String,
+        /// Time step, s.
+        time_step_s: f64,
+        /// Store every n-th step.
+        #[serde(default = "one_usize")]
+        sample_every: usize,
+        /// Cycles per FRF window.
+        #[serde(default = "four")]
+        window_cycles: usize,
+        /// Mode analysed by Eq. 3.47 (1-based).
+        #[serde(default = "one_usize")]
+        mode: usize,
+    },
+    /// Steady-state FRF of approaches 2/3 by the iteration of D Fig. 3.7 / Eq. 3.44, one mode.
+    SteadyState {
+        /// Start frequency, Hz.
+        start_hz: f64,
+        /// End frequency, Hz.
+        end_hz: f64,
+        /// Number of frequencies.
+        #[serde(default = "thousand")]
+        points: usize,
+        /// Force amplitude F, N.
+        #[serde(default)]
+        force_amplitude_n: Option<f64>,
+        /// Base amplitude U of a single-mode structure (F = U K), m.
+        #[serde(default)]
+        base_amplitude_m: Option<f64>,
+        /// Excitation point.
+        excitation_point: String,
+        /// Output point.
+        output_point: String,
+        /// Mode (1-based).
+        #[serde(default = "one_usize")]
+        mode: usize,
+    },
+}
+
+fn one_usize() -> usize {
+    1
+}
+fn four() -> usize {
+    4
+}
+fn thousand() -> usize {
+    1000
+}
+
+impl ForceSpec {
+    /// The force amplitude, N (needs the single-mode stiffness for `base_amplitude_m`).
+    pub fn force_n(&self, structure: &StructureSpec) -> Result<f64, String> {
+        match (self.force_amplitude_n, self.base_amplitude_m) {
+            (Some(f), None) => Ok(f),
+            (None, Some(u)) => structure
+                .single_mode
+                .map(|s| u * s.stiffness_n_m)
+                .ok_or_else(|| "base_amplitude_m needs a single_mode structure (R' = U K)".into()),
+            _ => Err("give exactly one of force_amplitude_n and base_amplitude_m".into()),
+        }
+    }
+}
+
+impl CoupleScenario {
+    /// Loads a scenario; returns it with the structure spec resolved.
+    ///
+    /// # Errors
+    /// I/O, TOML, missing structure.
+    pub fn load(path: &Path) -> Result<(Self, StructureSpec), String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let s: CoupleScenario =
+            toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let structure = match (&s.structure, &s.structure_file) {
+            (Some(st), None) => st.clone(),
+            (None, Some(f)) => load_structure(&resolve(base, f))?.structure,
+            _ => return Err("give exactly one of structure_file and [structure]".into()),
+        };
+        Ok((s, structure))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_are_rejected() {
+        let bad =
+            "[structure]\n[structure.single_mode]\nmass_kg = 1.0\nstiffness_n_m = 1.0\nmass = 3\n";
+        assert!(toml::from_str::<StructureFile>(bad).is_err());
+        let good = "[structure]\n[structure.single_mode]\nmass_kg = 1.0\nstiffness_n_m = 1.0\n";
+        let s: StructureFile = toml::from_str(good).unwrap();
+        assert!(s.structure.build(Path::new(".")).is_ok());
+    }
+}

@@ -1,0 +1,524 @@
+//! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
+
+use crate::dem::{DemCoupling, run_dem_free, run_dem_sweep};
+use crate::design::damping_ratio_modal;
+use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
+use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
+use crate::modal::ModalStructure;
+use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, ForceSpec, load_structure};
+use pdamp_io::csv::write_csv_atomic;
+use pdamp_plot::{Axis, FrfPlot, FrfSeries, LinePlot, Marker, Series, frf_plot_with, line_plot};
+use serde_json::json;
+use std::f64::consts::TAU;
+use std::path::Path;
+
+fn io<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// `pdamp structure modes`: builds and reduces the structure, writes `modes.csv`
+/// (`mode,frequency_hz,damping_ratio,phi_<point>…`) and returns a JSON summary.
+///
+/// # Errors
+/// Input, solver and I/O errors.
+pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value, String> {
+    let file = load_structure(structure_path)?;
+    let base = structure_path.parent().unwrap_or(Path::new("."));
+    let built = file.structure.build(base)?;
+    std::fs::create_dir_all(out).map_err(io)?;
+    let s = &built.modal;
+    let names: Vec<String> = s
+        .points
+        .iter()
+        .map(|p| format!("phi_{}_per_sqrt_kg", p.name))
+        .collect();
+    let mut header: Vec<&str> = vec!["mode", "frequency_hz", "damping_ratio"];
+    header.extend(names.iter().map(|s| s.as_str()));
+    let rows: Vec<Vec<f64>> = s
+        .modes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let mut r = vec![(k + 1) as f64, m.frequency_hz, m.damping_ratio];
+            r.extend(s.points.iter().map(|p| p.shape[k]));
+            r
+        })
+        .collect();
+    write_csv_atomic(out.join("modes.csv"), &header, &rows).map_err(io)?;
+    let summary = json!({
+        "modes": s.modes,
+        "points": s.points,
+        "total_mass_kg": built.total_mass_kg,
+        "active_dof": built.dof_count,
+    });
+    pdamp_io::atomic::write_atomic(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .map_err(io)?
+            .as_bytes(),
+    )
+    .map_err(io)?;
+    Ok(summary)
+}
+
+/// `pdamp couple`: runs the scenario's analysis and writes its outputs to `out`.
+///
+/// # Errors
+/// Input, simulation and I/O errors.
+pub fn run_couple(
+    path: &Path,
+    out: &Path,
+    progress: &mut dyn FnMut(f64),
+) -> Result<serde_json::Value, String> {
+    let (scn, structure_spec) = CoupleScenario::load(path)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let structure = structure_spec.build(base)?.modal;
+    std::fs::create_dir_all(out).map_err(io)?;
+    let dem_count = scn
+        .dampers
+        .iter()
+        .filter(|d| matches!(d, DamperSpec::Dem { .. }))
+        .count();
+    if dem_count > 1 || (dem_count == 1 && scn.dampers.len() > 1) {
+        return Err("a DEM damper (approach 1) must be the only damper of a scenario".into());
+    }
+    let dem = match scn.dampers.first() {
+        Some(DamperSpec::Dem {
+            point,
+            scenario,
+            compensate_static_weight,
+        }) => {
+            let p = if scenario.is_absolute() {
+                scenario.clone()
+            } else {
+                base.join(scenario)
+            };
+            let sc = pdamp_io::scenario::Scenario::load(&p)
+                .map_err(|e| format!("{}: {e}", p.display()))?;
+            let d = pdamp_design::Damper::from_scenario(
+                &sc,
+                p.parent().unwrap_or(Path::new(".")),
+                |_| {},
+            )?;
+            Some((
+                point.clone(),
+                d,
+                DemCoupling {
+                    compensate_static_weight: *compensate_static_weight,
+                },
+            ))
+        }
+        _ => None,
+    };
+    let mut dampers = Vec::new();
+    for d in &scn.dampers {
+        if let Some(m) = d.effective_model(base)? {
+            dampers.push(CoupledDamper {
+                point: d.point().to_string(),
+                model: m,
+            });
+        }
+    }
+    let approach = if dem.is_some() {
+        "1 (full DEM)"
+    } else if scn
+        .dampers
+        .iter()
+        .any(|d| matches!(d, DamperSpec::Fields { .. }))
+    {
+        "2 (effective fields)"
+    } else if scn.dampers.is_empty() {
+        "none (bare structure)"
+    } else {
+        "2/3 (equivalent damper)"
+    };
+    let started = std::time::Instant::now();
+    let mut summary = match &scn.analysis {
+        AnalysisSpec::Free {
+            duration_s,
+            time_step_s,
+            mode,
+            initial_point,
+            initial_displacement_m,
+            initial_velocity_m_s,
+            output_point,
+            update,
+            sample_every,
+        } => {
+            let spec = FreeVibrationSpec {
+                duration_s: *duration_s,
+                time_step_s: *time_step_s,
+                mode: mode.saturating_sub(1),
+                initial_point: initial_point.clone(),
+                initial_displacement_m: *initial_displacement_m,
+                initial_velocity_m_s: *initial_velocity_m_s,
+                output_point: output_point.clone(),
+                update: *update,
+                sample_every: *sample_every,
+            };
+            let hist = match &dem {
+                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, *o, progress)?,
+                None => free::run_free_vibration(&structure, &dampers, &spec)?,
+            };
+            free_outputs(&structure, &scn, &spec, &hist, out)?
+        }
+        AnalysisSpec::Sweep {
+            start_hz,
+            end_hz,
+            duration_s,
+            law,
+            force_amplitude_n,
+            base_amplitude_m,
+            excitation_point,
+            output_point,
+            time_step_s,
+            sample_every,
+            window_cycles,
+            mode,
+        } => {
+            let f = ForceSpec {
+                force_amplitude_n: *force_amplitude_n,
+                base_amplitude_m: *base_amplitude_m,
+            }
+            .force_n(&structure_spec)?;
+            let sweep = Sweep {
+                start_hz: *start_hz,
+                end_hz: *end_hz,
+                duration_s: *duration_s,
+                law: *law,
+            };
+            let spec = SweepSpec {
+                sweep,
+                force_amplitude_n: f,
+                excitation_point: excitation_point.clone(),
+                output_point: output_point.clone(),
+                time_step_s: *time_step_s,
+                sample_every: *sample_every,
+            };
+            let hist = match &dem {
+                Some((p, d, o)) => run_dem_sweep(&structure, d, p, &spec, *o, progress)?,
+                None => forced::run_sweep(&structure, &dampers, &spec)?,
+            };
+            sweep_outputs(
+                &structure,
+                &spec,
+                &hist,
+                *window_cycles,
+                mode.saturating_sub(1),
+                out,
+            )?
+        }
+        AnalysisSpec::SteadyState {
+            start_hz,
+            end_hz,
+            points,
+            force_amplitude_n,
+            base_amplitude_m,
+            excitation_point,
+            output_point,
+            mode,
+        } => {
+            if dampers.len() != 1 {
+                return Err(
+                    "steady_state needs exactly one equivalent damper (approach 2 or 3)".into(),
+                );
+            }
+            let f = ForceSpec {
+                force_amplitude_n: *force_amplitude_n,
+                base_amplitude_m: *base_amplitude_m,
+            }
+            .force_n(&structure_spec)?;
+            let k = mode.saturating_sub(1);
+            let m = structure.modes.get(k).ok_or("mode does not exist")?;
+            let mc = ModeCoupling {
+                omega_rad_s: m.omega_rad_s(),
+                damping_ratio: m.damping_ratio,
+                phi_pd: structure.point(&dampers[0].point)?[k],
+                phi_ex: structure.point(excitation_point)?[k],
+                force_amplitude_n: f,
+            };
+            let phi_out = structure.point(output_point)?[k];
+            let n = (*points).max(3);
+            let freqs: Vec<f64> = (0..n)
+                .map(|i| start_hz + (end_hz - start_hz) * i as f64 / (n - 1) as f64)
+                .collect();
+            let pts = forced::steady_state_frf(&mc, dampers[0].model.as_ref(), &freqs);
+            let rows: Vec<Vec<f64>> = pts
+                .iter()
+                .map(|p| {
+                    vec![
+                        p.frequency_hz,
+                        p.modal_amplitude * phi_out.abs() / f,
+                        -p.phase_rad,
+                        p.amplitude_m,
+                        p.modal_mass,
+                        p.converged as u8 as f64,
+                    ]
+                })
+                .collect();
+            write_csv_atomic(
+                out.join("frf.csv"),
+                &[
+                    "frequency_hz",
+                    "magnitude_m_per_n",
+                    "phase_rad",
+                    "damper_amplitude_m",
+                    "modal_mass",
+                    "converged",
+                ],
+                &rows,
+            )
+            .map_err(io)?;
+            let (zeta, f_r, x_peak) = forced::steady_state_damping(&mc, &pts).ok_or("empty FRF")?;
+            let eq = forced::resonance_equilibrium(&mc, dampers[0].model.as_ref(), 200);
+            let mag: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+            let ph: Vec<f64> = rows.iter().map(|r| r[2].to_degrees()).collect();
+            let mut plot = FrfPlot::new(
+                freqs.clone(),
+                vec![FrfSeries::new(
+                    "steady state (Fig. 3.7 / Eq. 3.44)",
+                    mag,
+                    ph,
+                )],
+            );
+            plot.magnitude_title = "|H| (m/N)".into();
+            frf_plot_with(out.join("frf"), &plot).map_err(io)?;
+            json!({
+                "damping_ratio_eq_3_47": zeta,
+                "resonance_frequency_hz": f_r,
+                "peak_damper_amplitude_m": x_peak,
+                "non_converged_points": pts.iter().filter(|p| !p.converged).count(),
+                "resonance_equilibrium_fig_3_7": eq,
+                "force_amplitude_n": f,
+                "undamped_frequency_hz": m.frequency_hz,
+            })
+        }
+    };
+    let obj = summary.as_object_mut().expect("object");
+    obj.insert("approach".into(), json!(approach));
+    obj.insert("modes".into(), json!(structure.modes));
+    obj.insert("wall_time_s".into(), json!(started.elapsed().as_secs_f64()));
+    // Efficiency ζ(η̄ = 1) of each damper per mode [D Eq. 3.51] with m̄ ≈ m_bed.
+    let mut eff = Vec::new();
+    for d in &dampers {
+        let phi = structure.point(&d.point)?;
+        let mb = d.model.bed_mass_kg();
+        let z: Vec<f64> = phi
+            .iter()
+            .map(|p| damping_ratio_modal(*p, mb, mb, 1.0))
+            .collect();
+        eff.push(json!({"point": d.point, "bed_mass_kg": mb, "damping_ratio_at_unit_loss_factor_per_mode": z}));
+    }
+    obj.insert("efficiency_eq_3_51".into(), json!(eff));
+    pdamp_io::atomic::write_atomic(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .map_err(io)?
+            .as_bytes(),
+    )
+    .map_err(io)?;
+    Ok(summary)
+}
+
+fn free_outputs(
+    structure: &ModalStructure,
+    _scn: &CoupleScenario,
+    spec: &FreeVibrationSpec,
+    hist: &TimeHistory,
+    out: &Path,
+) -> Result<serde_json::Value, String> {
+    let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
+        .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.velocity_m_s[i]])
+        .collect();
+    write_csv_atomic(
+        out.join("decay.csv"),
+        &["time_s", "displacement_m", "velocity_m_s"],
+        &rows,
+    )
+    .map_err(io)?;
+    let f_k = structure.modes[spec.mode].frequency_hz;
+    let peaks = free::decay_peaks(hist, 0.5 / f_k)?;
+    let cyc = free::damping_per_cycle(&peaks);
+    let drows: Vec<[f64; 4]> = cyc
+        .iter()
+        .map(|c| {
+            [
+                c.mean_amplitude_m,
+                c.damping_ratio,
+                c.frequency_hz,
+                c.time_s,
+            ]
+        })
+        .collect();
+    write_csv_atomic(
+        out.join("damping.csv"),
+        &[
+            "mean_amplitude_m",
+            "damping_ratio",
+            "frequency_hz",
+            "time_s",
+        ],
+        &drows,
+    )
+    .map_err(io)?;
+    let urows: Vec<[f64; 6]> = hist
+        .updates
+        .iter()
+        .map(|u| {
+            [
+                u.time_s,
+                u.damper as f64,
+                u.amplitude_m,
+                u.frequency_hz,
+                u.effective_mass_kg,
+                u.damping_n_s_m,
+            ]
+        })
+        .collect();
+    write_csv_atomic(
+        out.join("updates.csv"),
+        &[
+            "time_s",
+            "damper",
+            "amplitude_m",
+            "frequency_hz",
+            "effective_mass_kg",
+            "damping_n_s_m",
+        ],
+        &urows,
+    )
+    .map_err(io)?;
+    // Plots: decay with envelope (positive peaks) and the bare structure's envelope.
+    let z = structure.modes[spec.mode].damping_ratio;
+    let w = TAU * f_k;
+    let x0 = spec.initial_displacement_m.abs();
+    let env: Vec<f64> = hist
+        .time_s
+        .iter()
+        .map(|t| x0 * (-z * w * t).exp())
+        .collect();
+    let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("displacement (m)"));
+    p.series.push(Series::new(
+        "output point",
+        hist.time_s.clone(),
+        hist.displacement_m.clone(),
+    ));
+    p.series.push(
+        Series::new(
+            "envelope (positive peaks)",
+            peaks.iter().map(|p| p.0).collect(),
+            peaks.iter().map(|p| p.1).collect(),
+        )
+        .with_marker(Marker::Circle),
+    );
+    let mut bare = Series::new("structure only", hist.time_s.clone(), env);
+    bare.dashed = true;
+    p.series.push(bare);
+    line_plot(out.join("decay"), &p).map_err(io)?;
+    let mut q = LinePlot::new(
+        Axis::linear("mean amplitude (m)"),
+        Axis::linear("damping ratio ζ (-)"),
+    );
+    q.series.push(
+        Series::new(
+            "log decrement (Eq. 3.41)",
+            cyc.iter().map(|c| c.mean_amplitude_m).collect(),
+            cyc.iter().map(|c| c.damping_ratio).collect(),
+        )
+        .with_marker(Marker::Circle),
+    );
+    line_plot(out.join("damping"), &q).map_err(io)?;
+    let last = hist.displacement_m.len().saturating_sub(1);
+    let max_z = cyc.iter().map(|c| c.damping_ratio).fold(f64::NAN, f64::max);
+    Ok(json!({
+        "analysis": "free",
+        "cycles": cyc.len(),
+        "initial_amplitude_m": x0,
+        "final_peak_amplitude_m": peaks.last().map(|p| p.1),
+        "final_time_s": hist.time_s.get(last),
+        "max_damping_ratio": max_z,
+        "first_cycle": cyc.first(),
+        "last_cycle": cyc.last(),
+        "updates": hist.updates.len(),
+    }))
+}
+
+fn sweep_outputs(
+    structure: &ModalStructure,
+    spec: &SweepSpec,
+    hist: &TimeHistory,
+    window_cycles: usize,
+    mode: usize,
+    out: &Path,
+) -> Result<serde_json::Value, String> {
+    let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
+        .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.force_n[i]])
+        .collect();
+    write_csv_atomic(
+        out.join("response.csv"),
+        &["time_s", "displacement_m", "force_n"],
+        &rows,
+    )
+    .map_err(io)?;
+    let frf = forced::sweep_frf(hist, &spec.sweep, window_cycles);
+    let frows: Vec<[f64; 3]> = frf
+        .iter()
+        .map(|p| [p.frequency_hz, p.h_m_per_n.norm(), p.h_m_per_n.arg()])
+        .collect();
+    write_csv_atomic(
+        out.join("frf.csv"),
+        &["frequency_hz", "magnitude_m_per_n", "phase_rad"],
+        &frows,
+    )
+    .map_err(io)?;
+    let f: Vec<f64> = frf.iter().map(|p| p.frequency_hz).collect();
+    let mag: Vec<f64> = frf.iter().map(|p| p.h_m_per_n.norm()).collect();
+    let mut plot = FrfPlot::new(
+        f.clone(),
+        vec![FrfSeries::new(
+            "sweep FRF (Eq. 3.42)",
+            mag.clone(),
+            frows.iter().map(|r| r[2].to_degrees()).collect(),
+        )],
+    );
+    plot.magnitude_title = "|H| (m/N)".into();
+    if f.len() >= 2 {
+        frf_plot_with(out.join("frf"), &plot).map_err(io)?;
+    }
+    let hp = pdamp_signal::frf::half_power_damping(&f, &mag, None).ok();
+    let rfp = hp.and_then(|h| {
+        let band: Vec<_> = frf
+            .iter()
+            .copied()
+            .filter(|p| p.h_m_per_n.norm() > 0.5 * h.peak_magnitude)
+            .collect();
+        forced::rfp_single_mode(&band)
+    });
+    let k = mode.min(structure.modes.len() - 1);
+    let phi_ex = structure.point(&spec.excitation_point)?[k];
+    let phi_out = structure.point(&spec.output_point)?[k];
+    let pk = forced::peak_damping(
+        hist,
+        &spec.sweep,
+        spec.force_amplitude_n,
+        phi_ex,
+        phi_out,
+        structure.modes[k].omega_rad_s(),
+        None,
+    );
+    let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("displacement (m)"));
+    p.series.push(Series::new(
+        "output point",
+        hist.time_s.clone(),
+        hist.displacement_m.clone(),
+    ));
+    line_plot(out.join("response"), &p).map_err(io)?;
+    Ok(json!({
+        "analysis": "sweep",
+        "force_amplitude_n": spec.force_amplitude_n,
+        "half_power": hp,
+        "rational_fraction_polynomial": rfp,
+        "peak_damping_eq_3_47": pk,
+        "frf_points": frf.len(),
+    }))
+}
