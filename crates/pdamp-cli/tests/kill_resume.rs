@@ -240,3 +240,78 @@ fn resume_refuses_a_changed_scenario() {
     assert!(err.contains("different scenario"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pdamp fields` stopped by SIGINT keeps its finished points; running it again computes only
+/// the others, and the field equals an uninterrupted one (all columns but the wall time).
+#[test]
+fn fields_sigint_then_rerun_gives_the_same_field() {
+    let dir = scratch("fields");
+    let src =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/damper_cylinder_small.toml");
+    let text = std::fs::read_to_string(src).unwrap();
+    let text = text
+        .replace("cycles = 8\ntransient_cycles = 3", "cycles = 4\ntransient_cycles = 1")
+        .replace(
+            "frequencies_hz = { from = 40.0, to = 160.0, count = 3, spacing = \"log\" }\nintensities = { from = 2.0, to = 20.0, count = 3, spacing = \"log\" }",
+            "frequencies_hz = [150.0, 200.0, 250.0]\nintensities = [5.0, 10.0]",
+        );
+    assert!(text.contains("cycles = 4") && text.contains("[150.0, 200.0, 250.0]"));
+    let scn = dir.join("fields.toml");
+    std::fs::write(&scn, text).unwrap();
+    let fields = |out: &Path| {
+        let mut c = pdamp();
+        c.args(["--threads", "2", "fields"])
+            .arg(&scn)
+            .arg("--out")
+            .arg(out)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped());
+        c
+    };
+    let reference = dir.join("reference");
+    assert!(fields(&reference).status().unwrap().success());
+    let out = dir.join("stopped");
+    let child = fields(&out).spawn().unwrap();
+    let t0 = Instant::now();
+    let count = || {
+        std::fs::read_dir(out.join("points"))
+            .map(|d| {
+                d.filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .path()
+                        .extension()
+                        .is_some_and(|x| x == "json")
+                })
+                .count()
+            })
+            .unwrap_or(0)
+    };
+    while count() < 2 && t0.elapsed() < Duration::from_secs(120) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if o.status.success() {
+        eprintln!("finished before the signal; nothing to resume");
+    } else {
+        assert_eq!(o.status.code(), Some(130), "{err}");
+        assert!(err.contains("points are finished"), "{err}");
+        assert!(!out.join("fields.csv").exists(), "no partial fields.csv");
+        assert!(fields(&out).status().unwrap().success());
+    }
+    let table = |d: &Path| {
+        std::fs::read_to_string(d.join("fields.csv"))
+            .unwrap()
+            .lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (table(&reference), table(&out));
+    assert_eq!(a.len(), 7);
+    assert_eq!(a, b, "same field apart from wall_time_s");
+    let _ = std::fs::remove_dir_all(&dir);
+}

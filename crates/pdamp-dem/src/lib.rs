@@ -12,6 +12,7 @@ pub mod contact;
 pub mod energy;
 mod forces;
 pub mod generate;
+pub mod health;
 pub mod integrate;
 pub mod interaction;
 pub mod material;

@@ -228,13 +228,39 @@ impl Damper {
                 sample(&w, &mut times, &mut force, &mut velocity);
             }
             let evaluating = cycle >= self.transient_cycles;
-            w.run_until(t_end, |w| {
+            let mut health = None;
+            w.run_until_or_break(t_end, |w| {
                 if evaluating {
                     sample(w, &mut times, &mut force, &mut velocity);
                 }
                 let phase = (omega * w.time_s).rem_euclid(2.0 * PI);
                 observer.on_step(w, cycle, phase, self);
+                if w.counters
+                    .steps
+                    .is_multiple_of(pdamp_io::run::HEALTH_CHECK_STEPS)
+                    && let Err(e) = w.check_health()
+                {
+                    health = Some(e);
+                    return std::ops::ControlFlow::Break(());
+                }
+                if pdamp_io::checkpoint::stop_requested() {
+                    return std::ops::ControlFlow::Break(());
+                }
+                std::ops::ControlFlow::Continue(())
             });
+            if let Some(h) = health {
+                return Err(format!(
+                    "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m, cycle {}: {h}",
+                    cycle + 1
+                ));
+            }
+            if pdamp_io::checkpoint::stop_requested() {
+                return Err(format!(
+                    "{}: point f = {frequency_hz} Hz, X = {amplitude_m:.4e} m stopped in cycle {}",
+                    pdamp_io::checkpoint::INTERRUPTED,
+                    cycle + 1
+                ));
+            }
             if !w.ledger.kinetic_j.is_finite() {
                 return Err(format!(
                     "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m: the simulation became unstable in cycle {} \

@@ -165,6 +165,7 @@ pub fn run_fields(
     out_dir: &Path,
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, String> {
+    let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
     let io = |e: std::io::Error| format!("output: {e}");
     std::fs::create_dir_all(out_dir.join("points")).map_err(io)?;
     let points = grid.points();
@@ -197,16 +198,27 @@ pub fn run_fields(
         })
         .collect();
     let mut failed = Vec::new();
+    let mut interrupted = 0;
     for (k, r) in fresh {
         match r {
             Ok(r) => results[k] = Some(r),
             Err(e) if e.starts_with("output:") => return Err(e),
+            Err(e) if e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => interrupted += 1,
             Err(e) => {
                 let (_, _, f, x) = points[k];
                 failed.push((f, x, e));
                 results[k] = Some(failed_point(f, x));
             }
         }
+    }
+    if interrupted > 0 {
+        let finished = results.iter().filter(|r| r.is_some()).count();
+        return Err(format!(
+            "{}: {finished} of {total} points are finished and stored in {}; run the same \
+             command again to compute the other {interrupted}",
+            pdamp_io::checkpoint::INTERRUPTED,
+            out_dir.join("points").display()
+        ));
     }
     let points: Vec<PointResult> = results.into_iter().map(|r| r.unwrap()).collect();
     write_fields_csv(&out_dir.join("fields.csv"), &points)?;

@@ -19,10 +19,42 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 pub const CHECKPOINT_FORMAT: u32 = 1;
 
 static STOP: AtomicBool = AtomicBool::new(false);
+static STOPPABLE: AtomicBool = AtomicBool::new(false);
 
 /// Asks running loops to write a checkpoint and stop (async-signal-safe: one atomic store).
 pub fn request_stop() {
     STOP.store(true, Ordering::SeqCst);
+}
+
+/// What the CLI's SIGINT/SIGTERM handler does: inside a loop that can stop cleanly (see
+/// [`StoppableSection`]) the first signal asks it to checkpoint and stop; otherwise, or on a
+/// second signal, the process exits at once with status 130.
+pub fn on_signal() {
+    if STOPPABLE.load(Ordering::SeqCst) && !STOP.load(Ordering::SeqCst) {
+        request_stop();
+        eprintln!("\nstopping after the next checkpoint (press Ctrl-C again to abort at once)");
+    } else {
+        std::process::exit(130);
+    }
+}
+
+/// Marks a region of code that polls [`stop_requested`] and stops cleanly; while one is alive
+/// a signal asks for a stop instead of ending the process.
+#[derive(Debug)]
+pub struct StoppableSection(());
+
+impl StoppableSection {
+    /// Enters the section.
+    pub fn enter() -> Self {
+        STOPPABLE.store(true, Ordering::SeqCst);
+        Self(())
+    }
+}
+
+impl Drop for StoppableSection {
+    fn drop(&mut self) {
+        STOPPABLE.store(false, Ordering::SeqCst);
+    }
 }
 
 /// True once [`request_stop`] was called.

@@ -368,6 +368,32 @@ pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, String> {
     Ok(c.world.map_or(0.0, |w| w.time_s()))
 }
 
+/// Steps between numerical health checks ([`World::check_health`]).
+pub const HEALTH_CHECK_STEPS: u64 = 500;
+
+/// Writes `failure.json` next to the outputs written so far and returns the error text.
+fn report_failure(out_dir: &Path, phase: &str, h: &pdamp_dem::health::HealthError) -> String {
+    let json = serde_json::json!({
+        "pdamp_version": env!("CARGO_PKG_VERSION"),
+        "phase": phase,
+        "time_s": h.time_s,
+        "particle": h.particle,
+        "position_m": h.position_m,
+        "message": h.message,
+    });
+    let _ = std::fs::create_dir_all(out_dir);
+    let _ = crate::atomic::write_atomic(
+        out_dir.join("failure.json"),
+        serde_json::to_string_pretty(&json)
+            .unwrap_or_default()
+            .as_bytes(),
+    );
+    format!(
+        "{h} (during {phase}; outputs written so far are kept in {}, see failure.json)",
+        out_dir.display()
+    )
+}
+
 /// Kind tag of `run` checkpoints.
 const RUN_KIND: &str = "run";
 
@@ -421,6 +447,8 @@ pub fn run_scenario(
         .to_string()
     };
     let main_gravity = Vec3::from(scenario.simulation.gravity_m_s2);
+    let _stoppable = ck::StoppableSection::enter();
+    let mut health: Option<pdamp_dem::health::HealthError> = None;
 
     // Settling (fresh, or resumed in the middle of it).
     let mut state = match resumed {
@@ -442,6 +470,10 @@ pub fn run_scenario(
             let max = spec.max_duration_s;
             let r = settle_with_or_break(&mut world, spec, main_gravity, |w| {
                 progress("settling", w.time_s / max);
+                if let Err(e) = w.check_health() {
+                    health = Some(e);
+                    return ControlFlow::Break(());
+                }
                 let stop = ck::stop_requested();
                 if stop || timer.due() {
                     if let Err(e) =
@@ -458,6 +490,9 @@ pub fn run_scenario(
             });
             if let Some(e) = err {
                 return Err(e);
+            }
+            if let Some(h) = health.take() {
+                return Err(report_failure(out_dir, "settling", &h));
             }
             match r {
                 Some(t) => t,
@@ -522,6 +557,12 @@ pub fn run_scenario(
     let mut err: Option<String> = None;
     let mut stopped = false;
     world.run_until_or_break(t_end, |w| {
+        if w.counters.steps.is_multiple_of(HEALTH_CHECK_STEPS)
+            && let Err(e) = w.check_health()
+        {
+            health = Some(e);
+            return ControlFlow::Break(());
+        }
         if w.time_s >= next_e - 1e-12 {
             if let Err(e) = csv.write_row(&ledger_row(w)) {
                 err = Some(format!("output: {e}"));
@@ -579,6 +620,10 @@ pub fn run_scenario(
     });
     if let Some(e) = err {
         return Err(e);
+    }
+    if let Some(h) = health {
+        csv.sync().map_err(csvio)?;
+        return Err(report_failure(out_dir, "running", &h));
     }
     if stopped {
         return Err(interrupted(world.time_s));
