@@ -94,3 +94,46 @@ fn blow_up_is_diagnosed_and_outputs_are_kept() {
     assert!(out.join("scenario.toml").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn outputs_carry_version_scenario_and_seed() {
+    let dir = std::env::temp_dir().join(format!("pdamp-cli-prov-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let ex = pdamp()
+        .args(["example", "--particles", "30", "--duration-s", "0.002"])
+        .output()
+        .unwrap();
+    let scn = dir.join("s.toml");
+    std::fs::write(&scn, ex.stdout).unwrap();
+    let out = dir.join("out");
+    let o = pdamp()
+        .arg("run")
+        .arg(&scn)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let prov: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
+            .unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(prov["pdamp_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(prov["seed"], 1);
+    assert_eq!(summary["seed"], 1);
+    assert_eq!(prov["scenario_digest"], summary["scenario_digest"]);
+    assert_eq!(prov["scenario_digest"].as_str().unwrap().len(), 16);
+    assert!(
+        prov["command"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|a| a == "run")
+    );
+    // The canonical scenario copy reproduces the run.
+    let copy = std::fs::read_to_string(out.join("scenario.toml")).unwrap();
+    assert!(copy.contains("seed = 1"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -59,7 +59,7 @@ fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
                 continue;
             }
             let name = p.strip_prefix(dir).unwrap().to_string_lossy().to_string();
-            if name == "checkpoint.bin" || name.contains(".tmp-") {
+            if name == "checkpoint.bin" || name == "provenance.json" || name.contains(".tmp-") {
                 continue;
             }
             let mut bytes = std::fs::read(&p).unwrap();

@@ -15,6 +15,10 @@ pub struct DamperRunSummary {
     pub pdamp_version: String,
     /// Scenario title.
     pub title: String,
+    /// Digest of the scenario (see `provenance.json`).
+    pub scenario_digest: String,
+    /// Random seed.
+    pub seed: u64,
     /// Number of particles.
     pub particles: usize,
     /// Bed mass m_bed, kg.
@@ -62,8 +66,8 @@ pub fn run_damper_scenario(
         .amplitude_at(f)
         .ok_or("damper: give one of amplitude_m, acceleration_m_s2, intensity")?;
     let io = |e: std::io::Error| format!("output: {e}");
-    std::fs::create_dir_all(out).map_err(io)?;
-    pdamp_io::atomic::write_atomic(out.join("scenario.toml"), sc.to_toml().as_bytes())
+    pdamp_io::provenance::Provenance::of(sc)
+        .write(sc, out)
         .map_err(io)?;
     let damper = Damper::from_scenario(sc, base_dir, |p| progress("settling", p))?;
     let omega = 2.0 * std::f64::consts::PI * f;
@@ -114,6 +118,8 @@ pub fn run_damper_scenario(
     let summary = DamperRunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: sc.title.clone(),
+        scenario_digest: pdamp_io::run::scenario_digest(sc),
+        seed: sc.simulation.seed,
         particles: damper.settled.particles.len(),
         bed_mass_kg: damper.bed_mass_kg,
         container_mass_kg: damper.container_mass_kg,
@@ -202,8 +208,8 @@ pub fn run_fields_scenario(
         .ok_or("scenario has no [fields] section")?;
     let grid = FieldGrid::from_spec(spec)?;
     let io = |e: std::io::Error| format!("output: {e}");
-    std::fs::create_dir_all(out).map_err(io)?;
-    pdamp_io::atomic::write_atomic(out.join("scenario.toml"), sc.to_toml().as_bytes())
+    pdamp_io::provenance::Provenance::of(sc)
+        .write(sc, out)
         .map_err(io)?;
     // Stored points are reused only for the same physics: everything but the grid itself and
     // the single-point excitation must match.

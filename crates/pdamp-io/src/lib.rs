@@ -9,6 +9,7 @@ pub mod checkpoint;
 pub mod csv;
 pub mod examples;
 pub mod fuzz;
+pub mod provenance;
 pub mod restitution;
 pub mod run;
 pub mod scenario;

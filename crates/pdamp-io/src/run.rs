@@ -432,8 +432,8 @@ pub fn run_scenario(
         let text = std::fs::read_to_string(out_dir.join("summary.json")).map_err(io)?;
         return serde_json::from_str(&text).map_err(|e| format!("summary.json: {e}"));
     }
-    std::fs::create_dir_all(out_dir).map_err(io)?;
-    crate::atomic::write_atomic(out_dir.join("scenario.toml"), scenario.to_toml().as_bytes())
+    crate::provenance::Provenance::of(scenario)
+        .write(scenario, out_dir)
         .map_err(io)?;
     let start = std::time::Instant::now();
     let wall_before = resumed.as_ref().map_or(0.0, |c| c.wall_time_s);

@@ -1,0 +1,54 @@
+//! Where an output comes from: `provenance.json` in every output directory (next to the
+//! `scenario.toml` copy) names the pdamp version, the command line, the scenario digest, the
+//! seed and the thread count, so every figure can be traced and reproduced.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Contents of `provenance.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// pdamp version that wrote the outputs.
+    pub pdamp_version: String,
+    /// Command line (program arguments).
+    pub command: Vec<String>,
+    /// Scenario title.
+    pub scenario_title: String,
+    /// Digest of the canonical scenario (FNV-1a 64 of `scenario.toml`).
+    pub scenario_digest: String,
+    /// Random seed of the scenario.
+    pub seed: u64,
+    /// Worker threads (results do not depend on it; see docs/reliability.md).
+    pub threads: usize,
+    /// Start of the run, seconds since the Unix epoch (UTC).
+    pub started_unix_s: u64,
+}
+
+impl Provenance {
+    /// Provenance of a run of `scenario` by this process.
+    pub fn of(scenario: &crate::scenario::Scenario) -> Self {
+        Self {
+            pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+            command: std::env::args().collect(),
+            scenario_title: scenario.title.clone(),
+            scenario_digest: crate::run::scenario_digest(scenario),
+            seed: scenario.simulation.seed,
+            threads: rayon::current_num_threads(),
+            started_unix_s: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+        }
+    }
+
+    /// Writes `dir/scenario.toml` (canonical) and `dir/provenance.json`, atomically.
+    pub fn write(
+        &self,
+        scenario: &crate::scenario::Scenario,
+        dir: &Path,
+    ) -> Result<(), std::io::Error> {
+        std::fs::create_dir_all(dir)?;
+        crate::atomic::write_atomic(dir.join("scenario.toml"), scenario.to_toml().as_bytes())?;
+        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        crate::atomic::write_atomic(dir.join("provenance.json"), json.as_bytes())
+    }
+}
