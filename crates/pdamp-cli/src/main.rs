@@ -135,7 +135,7 @@ enum LawArg {
 
 fn main() -> std::process::ExitCode {
     // Ctrl-C / SIGTERM: long runs write a checkpoint and stop (see `--resume`).
-    let _ = ctrlc::set_handler(pdamp_io::checkpoint::request_stop);
+    let _ = ctrlc::set_handler(pdamp_io::checkpoint::on_signal);
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
@@ -286,7 +286,8 @@ fn cmd_run(
         )
     } else {
         let path = PathBuf::from(scenario);
-        let sc = pdamp_io::scenario::Scenario::load(&path)?;
+        // Everything is checked (and the world built once) before any output is written.
+        let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(&path)?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         (sc, base)
     };
@@ -316,7 +317,7 @@ fn cmd_run(
 }
 
 fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
-    let sc = pdamp_io::scenario::Scenario::load(scenario)?;
+    let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     if sc.fields.is_none() {
         bail!(
             "{}: `pdamp fields` needs a [fields] section (and [damper])",
@@ -370,12 +371,7 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
 }
 
 fn cmd_check(scenario: &std::path::Path) -> Result<()> {
-    let sc = pdamp_io::scenario::Scenario::load(scenario)?;
-    let base = scenario
-        .parent()
-        .map(|p| p.to_path_buf())
-        .unwrap_or_default();
-    let world = sc.build_world(&base).map_err(anyhow::Error::msg)?;
+    let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     let p = &world.particles;
     let bed_mass: f64 = p.mass.iter().sum();
     let (rmin, rmax) = p
