@@ -222,8 +222,8 @@ impl Kernel {
                 // equilibrium spring
                 for c in 0..4 {
                     st[c] += 2.0 * g_inf * dd[c];
-                    s[c] = st[c];
                 }
+                s.copy_from_slice(&st[..4]);
                 st[4] += k_inf * dth;
                 p = st[4];
                 for (b, h) in branches.iter().zip(st[5..].chunks_exact_mut(5)) {

@@ -192,12 +192,7 @@ pub fn effective_pair(
         } else {
             modulus(e2, tc)
         };
-        let e1_eff = if rigid_partner {
-            // sphere on the symmetry plane: only its own compliance
-            e1
-        } else {
-            e1
-        };
+        let e1_eff = e1; // on the symmetry plane only the sphere's own compliance counts
         pair.e_eff = effective_modulus(e1_eff, sphere.poisson_ratio, e2v, nu2);
         tc = pair.contact_time(v_eff);
     }
@@ -667,9 +662,7 @@ impl FeImpact {
             .map(|i| self.mass[i] * self.uz[i])
             .sum::<f64>()
             / self.sphere_mass;
-        let tc_est = self
-            .hertz
-            .contact_time(v_s.max(1e-9) * if self.rigid_plane { 1.0 } else { 1.0 });
+        let tc_est = self.hertz.contact_time(v_s.max(1e-9));
         let t_max = self.opts.max_time_over_contact_time * tc_est;
         let sample_every =
             ((tc_est / self.dt) / self.opts.history_samples as f64).max(1.0) as usize;

@@ -298,11 +298,11 @@ impl Material {
                     return bad("initial yield stress must be > 0".into());
                 }
                 if let Some(z) = perzyna_zeta_1_s
-                    && !(*z > 0.0)
+                    && (z.is_nan() || *z <= 0.0)
                 {
                     return bad(format!("perzyna_zeta_1_s must be > 0, got {z}"));
                 }
-                if !(*perzyna_lambda > 0.0) {
+                if perzyna_lambda.is_nan() || *perzyna_lambda <= 0.0 {
                     return bad(format!("perzyna_lambda must be > 0, got {perzyna_lambda}"));
                 }
             }

@@ -294,9 +294,9 @@ pub fn build(
     let n = b.r.len();
     let mut fix_r = vec![false; n];
     let mut fix_z = vec![false; n];
-    for i in 0..n {
-        if b.r[i].abs() < 1e-12 * rr {
-            fix_r[i] = true;
+    for (f, r) in fix_r.iter_mut().zip(&b.r) {
+        if r.abs() < 1e-12 * rr {
+            *f = true;
         }
     }
     for &i in &fix_r_nodes {
