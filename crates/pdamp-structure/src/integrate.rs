@@ -1,8 +1,9 @@
 //! Time integration of the reduced structure [D Eq. 3.21] with attached equivalent dampers
-//! [D Eq. 3.29–3.31]: $(E + \sum \bar m\,\phi\phi^T)\ddot q + (D + \sum \bar d\,\phi\phi^T)\dot q
-//! + \Omega q = \Phi^T f$, by the Newmark average-acceleration rule ($\gamma = 1/2$,
-//! $\beta = 1/4$: unconditionally stable, no numerical damping, period error
-//! $\approx (\omega\Delta t)^2/12$).
+//! [D Eq. 3.29–3.31],
+//! $$(E + \sum \bar m\,\phi\phi^T)\ddot q + (D + \sum \bar d\,\phi\phi^T)\dot q
+//! \;+\; \Omega q = \Phi^T f,$$
+//! by the Newmark average-acceleration rule (γ = 1/2, β = 1/4: unconditionally stable, no
+//! numerical damping, period error ≈ (ωΔt)²/12).
 
 use crate::modal::ModalStructure;
 use nalgebra::{DMatrix, DVector};
@@ -121,6 +122,25 @@ impl ModalIntegrator {
         self.q = q_pred + &a1 * (b * h * h);
         self.a = a1;
         self.time_s += h;
+    }
+
+    /// First half of an explicit velocity-Verlet step (used for the DEM coupling, where the
+    /// combined structure + particle system is then one symplectic explicit scheme, stable
+    /// for $\omega_{max}\Delta t < 2$): $\dot q_{n+1/2} = \dot q_n + \tfrac{\Delta t}{2}\ddot q_n$,
+    /// $q_{n+1} = q_n + \Delta t\,\dot q_{n+1/2}$.
+    pub fn verlet_drift(&mut self) {
+        let h = self.dt_s;
+        self.v += &self.a * (0.5 * h);
+        self.q += &self.v * h;
+        self.time_s += h;
+    }
+
+    /// Second half of the velocity-Verlet step with the generalized force at $t_{n+1}$:
+    /// $\ddot q_{n+1} = M^{-1}(p - D\dot q_{n+1/2} - \Omega q_{n+1})$,
+    /// $\dot q_{n+1} = \dot q_{n+1/2} + \tfrac{\Delta t}{2}\ddot q_{n+1}$ (damping explicit).
+    pub fn verlet_kick(&mut self, p: &DVector<f64>) {
+        self.make_consistent(p);
+        self.v += &self.a * (0.5 * self.dt_s);
     }
 
     /// Physical displacement $x = \phi^T q$ at a point [D Eq. 3.22/3.24].

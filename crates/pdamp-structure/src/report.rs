@@ -271,6 +271,24 @@ pub fn run_couple(
             .map_err(io)?;
             let (zeta, f_r, x_peak) = forced::steady_state_damping(&mc, &pts).ok_or("empty FRF")?;
             let eq = forced::resonance_equilibrium(&mc, dampers[0].model.as_ref(), 200);
+            // Fig. 3.7 equilibrium of every mode (D Sect. 8.2.3 treats modes one at a time).
+            let mut per_mode = Vec::new();
+            for (j, mj) in structure.modes.iter().enumerate() {
+                let cj = ModeCoupling {
+                    omega_rad_s: mj.omega_rad_s(),
+                    damping_ratio: mj.damping_ratio,
+                    phi_pd: structure.point(&dampers[0].point)?[j],
+                    phi_ex: structure.point(excitation_point)?[j],
+                    force_amplitude_n: f,
+                };
+                let e = forced::resonance_equilibrium(&cj, dampers[0].model.as_ref(), 400);
+                per_mode.push(json!({
+                    "mode": j + 1,
+                    "undamped_frequency_hz": mj.frequency_hz,
+                    "frequency_reduction_percent": 100.0 * (1.0 - e.frequency_hz / mj.frequency_hz),
+                    "equilibrium": e,
+                }));
+            }
             let mag: Vec<f64> = rows.iter().map(|r| r[1]).collect();
             let ph: Vec<f64> = rows.iter().map(|r| r[2].to_degrees()).collect();
             let mut plot = FrfPlot::new(
@@ -289,6 +307,7 @@ pub fn run_couple(
                 "peak_damper_amplitude_m": x_peak,
                 "non_converged_points": pts.iter().filter(|p| !p.converged).count(),
                 "resonance_equilibrium_fig_3_7": eq,
+                "resonance_equilibrium_all_modes": per_mode,
                 "force_amplitude_n": f,
                 "undamped_frequency_hz": m.frequency_hz,
             })

@@ -121,8 +121,8 @@ pub fn matrices(
         }
         let j_inv = j.try_inverse().ok_or("hex8: singular Jacobian")?;
         let mut b = SMatrix::<f64, 6, 24>::zeros();
-        for a in 0..8 {
-            let gl = j_inv * Vector3::from(dn[a]);
+        for (a, dna) in dn.iter().enumerate() {
+            let gl = j_inv * Vector3::from(*dna);
             b.fixed_view_mut::<6, 3>(0, 3 * a).copy_from(&b_block(gl));
         }
         k += b.transpose() * d * b * det;
