@@ -284,6 +284,45 @@ pub fn read_dof_map(path: &Path, n: usize) -> Result<DofMap, MatrixMarketError> 
     parse_dof_map(&text, n)
 }
 
+/// Matrix Market text (`coordinate real symmetric`, lower triangle, 17 significant digits) of a
+/// symmetric matrix; entries with |a_ij| ≤ `drop_below` are omitted.
+pub fn format_symmetric(m: &DMatrix<f64>, drop_below: f64) -> String {
+    let mut entries = Vec::new();
+    for j in 0..m.ncols() {
+        for i in j..m.nrows() {
+            let v = m[(i, j)];
+            if v.abs() > drop_below {
+                entries.push(format!("{} {} {:.17e}", i + 1, j + 1, v));
+            }
+        }
+    }
+    format!(
+        "%%MatrixMarket matrix coordinate real symmetric\n% written by pdamp-structure\n{} {} {}\n{}\n",
+        m.nrows(),
+        m.ncols(),
+        entries.len(),
+        entries.join("\n")
+    )
+}
+
+/// Dof map text (`row node dof`, 1-based rows, ANSYS dof names) for rows given as
+/// (node id, dof).
+pub fn format_dof_map(rows: &[(i64, Dof)]) -> String {
+    let name = |d: Dof| match d {
+        Dof::Ux => "UX",
+        Dof::Uy => "UY",
+        Dof::Uz => "UZ",
+        Dof::Rx => "ROTX",
+        Dof::Ry => "ROTY",
+        Dof::Rz => "ROTZ",
+    };
+    let mut s = String::from("# row node dof\n");
+    for (i, (n, d)) in rows.iter().enumerate() {
+        s.push_str(&format!("{} {} {}\n", i + 1, n, name(*d)));
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
