@@ -61,3 +61,153 @@ pub const TARGETS: [(&str, fn(&[u8])); 5] = [
     ("restitution_table", restitution_table),
     ("checkpoint", checkpoint),
 ];
+
+/// Deterministic xorshift64* generator for the mutation fuzzer.
+#[derive(Debug, Clone)]
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Next 64 random bits.
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in `0..n` (0 for n = 0).
+    pub fn below(&mut self, n: usize) -> usize {
+        if n == 0 {
+            0
+        } else {
+            (self.next() % n as u64) as usize
+        }
+    }
+}
+
+/// Tokens the mutator inserts: extreme numbers, separators, TOML/STL/CSV keywords.
+pub const TOKENS: &[&[u8]] = &[
+    b"NaN",
+    b"inf",
+    b"-inf",
+    b"1e308",
+    b"-1e-320",
+    b"0",
+    b"-1",
+    b"4294967295",
+    b"18446744073709551616",
+    b",",
+    b"\n",
+    b"\r\n",
+    b"\"",
+    b"[",
+    b"]",
+    b"{",
+    b"}",
+    b"=",
+    b"%",
+    b"%%MatrixMarket matrix coordinate real symmetric\n",
+    b"[[particles]]",
+    b"solid",
+    b"endsolid",
+    b"facet normal",
+    b"vertex",
+    b"\xff\xfe",
+    b"count = 99999999999",
+    b"radius_m = 0",
+    b"law = \"gonthier-table\"",
+];
+
+/// One to four random edits of `seed`: bit flips, byte changes, truncation, token insertion,
+/// deletion, splicing with another corpus entry, extreme little-endian integers.
+pub fn mutate(rng: &mut Rng, seed: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
+    let mut b = seed.to_vec();
+    for _ in 0..1 + rng.below(4) {
+        match rng.below(7) {
+            0 if !b.is_empty() => {
+                let i = rng.below(b.len());
+                b[i] ^= 1 << rng.below(8);
+            }
+            1 if !b.is_empty() => {
+                let i = rng.below(b.len());
+                b[i] = rng.next() as u8;
+            }
+            2 => {
+                let n = rng.below(b.len() + 1);
+                b.truncate(n);
+            }
+            3 => {
+                let t = TOKENS[rng.below(TOKENS.len())];
+                let i = rng.below(b.len() + 1);
+                b.splice(i..i, t.iter().copied());
+            }
+            4 if !b.is_empty() => {
+                let i = rng.below(b.len());
+                let n = rng.below((b.len() - i).min(64) + 1);
+                b.drain(i..i + n);
+            }
+            5 if !corpus.is_empty() => {
+                let other = &corpus[rng.below(corpus.len())];
+                let i = rng.below(b.len() + 1);
+                let j = rng.below(other.len() + 1);
+                b.truncate(i);
+                b.extend_from_slice(&other[j..]);
+            }
+            _ if b.len() >= 4 => {
+                let i = rng.below(b.len() - 3);
+                let v: u32 = [0, 1, u32::MAX, 0x7fff_ffff, 1 << 24][rng.below(5)];
+                b[i..i + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            _ => b.push(rng.next() as u8),
+        }
+    }
+    b
+}
+
+/// Outcome of [`mutation_fuzz`].
+#[derive(Debug, Clone, Default)]
+pub struct FuzzReport {
+    /// Inputs tried (seeds included).
+    pub runs: u64,
+    /// Inputs that panicked (at most 3 are kept).
+    pub panics: Vec<Vec<u8>>,
+    /// Slowest single input, s.
+    pub slowest_s: f64,
+}
+
+/// Runs `reader` on every seed, then on mutations of them for `seconds` (stops after 3
+/// panics). Panics are caught (install a silent panic hook to keep the output clean).
+pub fn mutation_fuzz(reader: fn(&[u8]), seeds: &[Vec<u8>], seconds: f64, seed: u64) -> FuzzReport {
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    let mut rng = Rng(seed | 1);
+    let mut rep = FuzzReport::default();
+    let mut run = |input: &[u8], rep: &mut FuzzReport| {
+        let t = std::time::Instant::now();
+        if catch_unwind(AssertUnwindSafe(|| reader(input))).is_err() {
+            rep.panics.push(input.to_vec());
+        }
+        rep.slowest_s = rep.slowest_s.max(t.elapsed().as_secs_f64());
+        rep.runs += 1;
+    };
+    for s in seeds {
+        run(s, &mut rep);
+    }
+    let t0 = std::time::Instant::now();
+    while !seeds.is_empty() && t0.elapsed().as_secs_f64() < seconds && rep.panics.len() < 3 {
+        let base = &seeds[rng.below(seeds.len())];
+        let input = mutate(&mut rng, base, seeds);
+        run(&input, &mut rep);
+    }
+    rep
+}
+
+/// Reads up to 200 files of a corpus directory (sorted by name).
+pub fn read_corpus(dir: &std::path::Path) -> std::io::Result<Vec<Vec<u8>>> {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    files.truncate(200);
+    files.iter().map(std::fs::read).collect()
+}
