@@ -25,6 +25,7 @@ pub mod fe;
 pub mod forced;
 pub mod formulas;
 pub mod free;
+pub mod fuzz;
 pub mod integrate;
 pub mod matrix_market;
 pub mod modal;

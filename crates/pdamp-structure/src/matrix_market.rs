@@ -233,7 +233,10 @@ pub fn parse_dof_map(text: &str, n: usize) -> Result<DofMap, MatrixMarketError> 
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|s| !s.is_empty())
             .collect();
-        if f[0].parse::<i64>().is_err() && f[0].parse::<f64>().is_err() {
+        let Some(first) = f.first() else {
+            continue; // only separators (found by fuzzing: a line "," used to panic)
+        };
+        if first.parse::<i64>().is_err() && first.parse::<f64>().is_err() {
             continue; // header line such as "Matrix Eqn  Node  DOF"
         }
         let bad = |reason: String| MatrixMarketError::Entry { line, reason };
