@@ -35,6 +35,13 @@ pub struct CoupleArgs {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
+    /// Continue a full-DEM coupling (approach 1) from DIR/checkpoint.bin; the result equals an
+    /// uninterrupted run.
+    #[arg(long)]
+    resume: bool,
+    /// Wall-clock seconds between checkpoints of a full-DEM coupling (0 = only on Ctrl-C).
+    #[arg(long, default_value_t = 60.0)]
+    checkpoint_interval_s: f64,
 }
 
 /// Runs `pdamp structure …`.
@@ -52,7 +59,11 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
 /// Runs `pdamp couple`.
 pub fn run_couple(args: CoupleArgs) -> Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
-    let s = pdamp_structure::report::run_couple(&args.scenario, &args.out, &mut |f| {
+    let options = pdamp_io::run::RunOptions {
+        checkpoint_interval_s: args.checkpoint_interval_s,
+        resume: args.resume,
+    };
+    let s = pdamp_structure::report::run_couple(&args.scenario, &args.out, options, &mut |f| {
         bar.set_position((f * 1000.0) as u64)
     })
     .map_err(|e| anyhow!(e))?;

@@ -315,3 +315,68 @@ fn fields_sigint_then_rerun_gives_the_same_field() {
     assert_eq!(a, b, "same field apart from wall_time_s");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pdamp couple` with a full-DEM damper (approach 1) killed with SIGKILL and resumed ends
+/// with the same decay, damping and summary as an uninterrupted run.
+#[test]
+fn couple_dem_sigkill_then_resume_gives_identical_outputs() {
+    let dir = scratch("couple");
+    let ex = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(ex.join("couple_ch5_free_dem_small.toml"))
+        .unwrap()
+        .replace(
+            "structure_file = \"structure_ch5_beam.toml\"",
+            &format!("structure_file = {:?}", ex.join("structure_ch5_beam.toml")),
+        )
+        .replace(
+            "scenario = \"damper_ch5_small.toml\"",
+            &format!("scenario = {:?}", ex.join("damper_ch5_small.toml")),
+        )
+        .replace("duration_s = 4.0", "duration_s = 1.5");
+    assert!(text.contains("duration_s = 1.5") && text.contains("examples/damper_ch5_small"));
+    let scn = dir.join("couple.toml");
+    std::fs::write(&scn, text).unwrap();
+    let couple = |out: &Path, extra: &[&str]| {
+        let mut c = pdamp();
+        c.args(["--threads", "2", "couple"])
+            .arg(&scn)
+            .arg("--out")
+            .arg(out)
+            .args(extra)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped());
+        c
+    };
+    let reference = dir.join("reference");
+    let t0 = Instant::now();
+    assert!(couple(&reference, &[]).status().unwrap().success());
+    let full = t0.elapsed().as_secs_f64();
+    let out = dir.join("killed");
+    let mut rng = 0x1234_5678_9abc_def1u64 ^ std::process::id() as u64;
+    let mut kills = 0;
+    for attempt in 0..6 {
+        let args: &[&str] = if attempt == 0 {
+            &["--checkpoint-interval-s", "0.05"]
+        } else {
+            &["--checkpoint-interval-s", "0.05", "--resume"]
+        };
+        let mut child = couple(&out, args).spawn().unwrap();
+        std::thread::sleep(Duration::from_secs_f64(full * (0.3 + 0.3 * next(&mut rng))));
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        child.kill().unwrap();
+        child.wait().unwrap();
+        kills += 1;
+    }
+    assert!(couple(&out, &["--resume"]).status().unwrap().success());
+    eprintln!("couple: {kills} SIGKILLs; full run {full:.2} s");
+    assert!(kills >= 2, "killed several times ({kills})");
+    for f in ["decay.csv", "damping.csv"] {
+        assert!(
+            std::fs::read(reference.join(f)).unwrap() == std::fs::read(out.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -181,7 +181,7 @@ pub fn mutation_fuzz(reader: fn(&[u8]), seeds: &[Vec<u8>], seconds: f64, seed: u
     use std::panic::{AssertUnwindSafe, catch_unwind};
     let mut rng = Rng(seed | 1);
     let mut rep = FuzzReport::default();
-    let mut run = |input: &[u8], rep: &mut FuzzReport| {
+    let run = |input: &[u8], rep: &mut FuzzReport| {
         let t = std::time::Instant::now();
         if catch_unwind(AssertUnwindSafe(|| reader(input))).is_err() {
             rep.panics.push(input.to_vec());

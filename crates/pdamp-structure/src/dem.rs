@@ -21,9 +21,45 @@ use crate::free::{FreeVibrationSpec, TimeHistory};
 use crate::integrate::{ModalIntegrator, generalized_force};
 use crate::modal::ModalStructure;
 use nalgebra::DVector;
-use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3};
+use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3, WorldState};
 use pdamp_design::Damper;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 use std::sync::Arc;
+
+/// Checkpointing of a coupled DEM run (see docs/reliability.md): the modal state, the DEM
+/// state and the response so far are written to `path` every `interval_s` of wall-clock time
+/// and on Ctrl-C; with `resume`, the run continues from the file and ends bit for bit as an
+/// uninterrupted run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CouplingCheckpoint {
+    /// Checkpoint file.
+    pub path: PathBuf,
+    /// Digest of the inputs (coupling and damper scenarios); a file of other inputs is refused.
+    pub inputs_digest: String,
+    /// Wall-clock seconds between checkpoints (≤ 0: only on Ctrl-C).
+    pub interval_s: f64,
+    /// Continue from `path` if it exists.
+    pub resume: bool,
+}
+
+/// Kind tag of coupled-DEM checkpoints.
+const COUPLE_KIND: &str = "couple-dem";
+
+/// State of [`coupled_run`] after a step.
+#[derive(Serialize, Deserialize)]
+struct CoupledState {
+    step: usize,
+    time_s: f64,
+    q: DVector<f64>,
+    v: DVector<f64>,
+    a: DVector<f64>,
+    world: WorldState,
+    time: Vec<f64>,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+    force: Vec<f64>,
+}
 
 /// Container motion over one step: the structure's state at `t1` extrapolated quadratically.
 #[derive(Debug, Clone, Copy)]
@@ -71,7 +107,9 @@ fn coupled_run(
     sample_every: usize,
     load: Load,
     progress: &mut dyn FnMut(f64),
+    ck: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
+    use pdamp_io::checkpoint as cp;
     structure.validate()?;
     let pd = structure.point(damper_point)?.to_vec();
     let out = structure.point(output_point)?.to_vec();
@@ -129,10 +167,25 @@ fn coupled_run(
         h.force_n.push(f_ex_scalar(it.time_s));
     };
     push(&it, &mut hist);
+    let mut first = 1;
+    let header = ck.map(|c| cp::CheckpointHeader::new(COUPLE_KIND, &c.inputs_digest));
+    if let Some(c) = ck.filter(|c| c.resume)
+        && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)?
+    {
+        w.restore_state(st.world)?;
+        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
+        hist.time_s = st.time;
+        hist.displacement_m = st.displacement;
+        hist.velocity_m_s = st.velocity;
+        hist.force_n = st.force;
+        first = st.step + 1;
+    }
+    let _stoppable = ck.map(|_| cp::StoppableSection::enter());
+    let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
     let n_steps = (duration_s / dt).round() as usize;
     let every = sample_every.max(1);
     let report = (n_steps / 200).max(1);
-    for step in 1..=n_steps {
+    for step in first..=n_steps {
         let t1 = step as f64 * dt;
         it.verlet_drift();
         w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
@@ -155,6 +208,31 @@ fn coupled_run(
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);
         }
+        if let (Some(c), Some(h)) = (ck, &header) {
+            let stop = cp::stop_requested();
+            if stop || timer.due() {
+                let st = CoupledState {
+                    step,
+                    time_s: it.time_s,
+                    q: it.q.clone(),
+                    v: it.v.clone(),
+                    a: it.a.clone(),
+                    world: w.save_state(),
+                    time: hist.time_s.clone(),
+                    displacement: hist.displacement_m.clone(),
+                    velocity: hist.velocity_m_s.clone(),
+                    force: hist.force_n.clone(),
+                };
+                cp::save(&c.path, h, &st)?;
+                if stop {
+                    return Err(cp::Interrupted {
+                        time_s: it.time_s,
+                        path: c.path.clone(),
+                    }
+                    .to_string());
+                }
+            }
+        }
     }
     Ok(hist)
 }
@@ -170,6 +248,7 @@ pub fn run_dem_free(
     spec: &FreeVibrationSpec,
     opts: DemCoupling,
     progress: &mut dyn FnMut(f64),
+    checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
     let init = structure.point(&spec.initial_point)?;
     let k = spec.mode;
@@ -197,6 +276,7 @@ pub fn run_dem_free(
         spec.sample_every,
         Load::Free,
         progress,
+        checkpoint,
     )
 }
 
@@ -212,6 +292,7 @@ pub fn run_dem_sweep(
     spec: &SweepSpec,
     opts: DemCoupling,
     progress: &mut dyn FnMut(f64),
+    checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
     spec.sweep.validate()?;
     let ex = structure.point(&spec.excitation_point)?.to_vec();
@@ -228,5 +309,6 @@ pub fn run_dem_sweep(
         spec.sample_every,
         Load::Sweep(spec, ex),
         progress,
+        checkpoint,
     )
 }

@@ -1,6 +1,6 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
-use crate::dem::{DemCoupling, run_dem_free, run_dem_sweep};
+use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_free, run_dem_sweep};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
@@ -61,6 +61,22 @@ pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value,
     Ok(summary)
 }
 
+/// [`run_couple`] without checkpoints.
+///
+/// # Errors
+/// See [`run_couple`].
+pub fn run_couple_default(
+    path: &Path,
+    out: &Path,
+    progress: &mut dyn FnMut(f64),
+) -> Result<serde_json::Value, String> {
+    let options = pdamp_io::run::RunOptions {
+        checkpoint_interval_s: 0.0,
+        resume: false,
+    };
+    run_couple(path, out, options, progress)
+}
+
 /// `pdamp couple`: runs the scenario's analysis and writes its outputs to `out`.
 ///
 /// # Errors
@@ -68,9 +84,11 @@ pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value,
 pub fn run_couple(
     path: &Path,
     out: &Path,
+    options: pdamp_io::run::RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<serde_json::Value, String> {
     let (scn, structure_spec) = CoupleScenario::load(path)?;
+    let mut inputs = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let structure = structure_spec.build(base)?.modal;
     std::fs::create_dir_all(out).map_err(io)?;
@@ -95,6 +113,7 @@ pub fn run_couple(
             };
             let sc = pdamp_io::scenario::Scenario::load(&p)
                 .map_err(|e| format!("{}: {e}", p.display()))?;
+            inputs.extend_from_slice(sc.to_toml().as_bytes());
             let d = pdamp_design::Damper::from_scenario(
                 &sc,
                 p.parent().unwrap_or(Path::new(".")),
@@ -109,6 +128,12 @@ pub fn run_couple(
             ))
         }
         _ => None,
+    };
+    let ck = CouplingCheckpoint {
+        path: out.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
+        inputs_digest: pdamp_io::checkpoint::digest(&inputs),
+        interval_s: options.checkpoint_interval_s,
+        resume: options.resume,
     };
     let mut dampers = Vec::new();
     for d in &scn.dampers {
@@ -157,7 +182,7 @@ pub fn run_couple(
                 sample_every: *sample_every,
             };
             let hist = match &dem {
-                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, *o, progress)?,
+                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, *o, progress, Some(&ck))?,
                 None => free::run_free_vibration(&structure, &dampers, &spec)?,
             };
             free_outputs(&structure, &scn, &spec, &hist, out)?
@@ -196,7 +221,7 @@ pub fn run_couple(
                 sample_every: *sample_every,
             };
             let hist = match &dem {
-                Some((p, d, o)) => run_dem_sweep(&structure, d, p, &spec, *o, progress)?,
+                Some((p, d, o)) => run_dem_sweep(&structure, d, p, &spec, *o, progress, Some(&ck))?,
                 None => forced::run_sweep(&structure, &dampers, &spec)?,
             };
             sweep_outputs(

@@ -37,7 +37,7 @@ fn modes_of_the_small_cantilever() {
 #[test]
 fn layered_design_reaches_the_design_damping_ratio() {
     let out = out_dir("ch6");
-    let s = pdamp_structure::report::run_couple(
+    let s = pdamp_structure::report::run_couple_default(
         &examples().join("couple_ch6_free_layers.toml"),
         &out,
         &mut |_| {},
@@ -80,7 +80,7 @@ fn layered_design_reaches_the_design_damping_ratio() {
 #[test]
 fn table_5_2_example_through_the_cli_entry_point() {
     let out = out_dir("ch5u05");
-    let s = pdamp_structure::report::run_couple(
+    let s = pdamp_structure::report::run_couple_default(
         &examples().join("couple_ch5_forced_u0p5mm.toml"),
         &out,
         &mut |_| {},

@@ -60,6 +60,7 @@ fn clamped_particle_is_an_added_mass() {
             compensate_static_weight: false,
         },
         &mut |_| {},
+        None,
     )
     .unwrap();
     let peaks = free::decay_peaks(&h, 0.1).unwrap();
