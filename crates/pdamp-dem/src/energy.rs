@@ -123,4 +123,14 @@ impl EnergyLedger {
             - (self.elastic_j - self.initial_elastic_j)
             - self.dissipated_j()
     }
+
+    /// Energy turnover the residual is measured against: the largest of |W_wall|, |ΔE_kin|,
+    /// |ΔE_pot| and |D|, J.
+    pub fn turnover_j(&self) -> f64 {
+        self.wall_work_j
+            .abs()
+            .max((self.kinetic_j - self.initial_kinetic_j).abs())
+            .max((self.potential_j - self.initial_potential_j).abs())
+            .max(self.dissipated_j().abs())
+    }
 }

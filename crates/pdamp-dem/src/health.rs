@@ -145,11 +145,7 @@ impl World {
         }
         let l = &self.ledger;
         let scale = l
-            .wall_work_j
-            .abs()
-            .max((l.kinetic_j - l.initial_kinetic_j).abs())
-            .max((l.potential_j - l.initial_potential_j).abs())
-            .max(l.dissipated_j().abs())
+            .turnover_j()
             .max(l.initial_kinetic_j.abs() + l.initial_elastic_j.abs());
         let closure = l.closure_error_j();
         if !closure.is_finite() || (scale > 0.0 && closure.abs() > MAX_CLOSURE_ERROR * scale) {
@@ -201,7 +197,7 @@ mod tests {
         let mut w = pair(5e-8, 1.0);
         for _ in 0..4_000 {
             w.step();
-            if w.counters.steps % 100 == 0 {
+            if w.counters.steps.is_multiple_of(100) {
                 w.check_health().unwrap();
             }
         }

@@ -53,8 +53,11 @@ pub fn checkpoint(bytes: &[u8]) {
     }
 }
 
+/// A named fuzz entry point.
+pub type Target = (&'static str, fn(&[u8]));
+
 /// All readers by name (for the harnesses).
-pub const TARGETS: [(&str, fn(&[u8])); 5] = [
+pub const TARGETS: [Target; 5] = [
     ("stl", stl),
     ("scenario", scenario),
     ("csv", csv),
@@ -68,7 +71,7 @@ pub struct Rng(pub u64);
 
 impl Rng {
     /// Next 64 random bits.
-    pub fn next(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
@@ -80,7 +83,7 @@ impl Rng {
         if n == 0 {
             0
         } else {
-            (self.next() % n as u64) as usize
+            (self.next_u64() % n as u64) as usize
         }
     }
 }
@@ -130,7 +133,7 @@ pub fn mutate(rng: &mut Rng, seed: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
             }
             1 if !b.is_empty() => {
                 let i = rng.below(b.len());
-                b[i] = rng.next() as u8;
+                b[i] = rng.next_u64() as u8;
             }
             2 => {
                 let n = rng.below(b.len() + 1);
@@ -158,7 +161,7 @@ pub fn mutate(rng: &mut Rng, seed: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
                 let v: u32 = [0, 1, u32::MAX, 0x7fff_ffff, 1 << 24][rng.below(5)];
                 b[i..i + 4].copy_from_slice(&v.to_le_bytes());
             }
-            _ => b.push(rng.next() as u8),
+            _ => b.push(rng.next_u64() as u8),
         }
     }
     b
@@ -210,4 +213,57 @@ pub fn read_corpus(dir: &std::path::Path) -> std::io::Result<Vec<Vec<u8>>> {
     files.sort();
     files.truncate(200);
     files.iter().map(std::fs::read).collect()
+}
+
+/// Runs [`mutation_fuzz`] on every `(name, reader)` with the seeds of `corpus_root/name`, for
+/// `seconds` each, printing one line per reader; returns the failures (panics with their
+/// inputs, inputs slower than 5 s, missing corpora). Panics are silenced while it runs.
+pub fn fuzz_all(
+    targets: &[Target],
+    corpus_root: &std::path::Path,
+    seconds: f64,
+    seed: u64,
+) -> Vec<String> {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut failures = Vec::new();
+    for &(name, reader) in targets {
+        let seeds = match read_corpus(&corpus_root.join(name)) {
+            Ok(s) if !s.is_empty() => s,
+            _ => {
+                failures.push(format!(
+                    "{name}: no seeds in {}",
+                    corpus_root.join(name).display()
+                ));
+                continue;
+            }
+        };
+        let rep = mutation_fuzz(reader, &seeds, seconds, seed ^ name.len() as u64);
+        eprintln!(
+            "{name}: {} inputs, {} panics, slowest {:.3} s",
+            rep.runs,
+            rep.panics.len(),
+            rep.slowest_s
+        );
+        for p in &rep.panics {
+            failures.push(format!(
+                "{name} panicked on {} bytes: {:?}",
+                p.len(),
+                String::from_utf8_lossy(&p[..p.len().min(400)])
+            ));
+        }
+        if rep.slowest_s > 5.0 {
+            failures.push(format!("{name}: one input took {:.1} s", rep.slowest_s));
+        }
+    }
+    std::panic::set_hook(hook);
+    failures
+}
+
+/// `PDAMP_FUZZ_SECONDS` (default 2 s per reader) for the CI fuzz tests.
+pub fn seconds_from_env() -> f64 {
+    std::env::var("PDAMP_FUZZ_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2.0)
 }

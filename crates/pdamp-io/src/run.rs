@@ -632,13 +632,7 @@ pub fn run_scenario(
     let wall_s = wall(&start);
     let steps = world.counters.steps - steps0;
     let l = world.ledger;
-    let scale = l
-        .wall_work_j
-        .abs()
-        .max((l.kinetic_j - l.initial_kinetic_j).abs())
-        .max((l.potential_j - l.initial_potential_j).abs())
-        .max(l.dissipated_j().abs())
-        .max(1e-300);
+    let scale = l.turnover_j().max(1e-300);
     let summary = RunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: scenario.title.clone(),

@@ -1282,13 +1282,12 @@ fn check_inside_walls(world: &World, group_of: &[usize], sc: &Scenario) -> Resul
     for (bi, b) in world.bodies.iter().enumerate() {
         let pose = pdamp_dem::BodyState::at_rest(Vec3::from(sc.bodies[bi].position_m));
         for (wi, w) in b.walls.iter().enumerate() {
-            for i in 0..p.len() {
+            for (i, &g) in group_of.iter().enumerate() {
                 contacts.clear();
                 let x = pose.to_body(&p.position[i]);
                 w.geometry
                     .sphere_contacts(&x, p.radius[i], 0.0, &mut contacts);
                 if let Some(c) = contacts.iter().find(|c| c.overlap_m > 1e-9 * p.radius[i]) {
-                    let g = group_of[i];
                     let outside = c.overlap_m > p.radius[i];
                     return Err(format!(
                         "particles[{g}].placement.region: particle {i} at {:?} m {} wall '{}' of body '{}' (bodies[{bi}].walls[{wi}]) by {:.3e} m; \

@@ -38,7 +38,7 @@ pub fn fields_table(bytes: &[u8]) {
 }
 
 /// The readers by name.
-pub const TARGETS: [(&str, fn(&[u8])); 2] = [
+pub const TARGETS: [pdamp_io::fuzz::Target; 2] = [
     ("matrix_market", matrix_market),
     ("fields_table", fields_table),
 ];
