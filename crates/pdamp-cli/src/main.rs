@@ -43,6 +43,8 @@ enum Command {
         /// Wall-clock seconds between checkpoints (0 = only on Ctrl-C).
         #[arg(long, default_value_t = 60.0)]
         checkpoint_interval_s: f64,
+        #[command(flatten)]
+        point: PointArgs,
     },
     /// Effective fields of a damper scenario over its [fields] grid (resumable): writes
     /// DIR/fields.csv and PNG/SVG maps of η̄, m̄_bed/m_bed and the dissipated energy.
@@ -118,6 +120,57 @@ enum Command {
     },
 }
 
+/// Excitation of a damper scenario given on the command line (overrides `[damper]`).
+#[derive(clap::Args, Debug, Clone, Copy, Default)]
+struct PointArgs {
+    /// Excitation frequency f, Hz (damper scenarios).
+    #[arg(long)]
+    frequency_hz: Option<f64>,
+    /// Displacement amplitude X, m (damper scenarios; one of X, A, Γ).
+    #[arg(long, conflicts_with_all = ["acceleration_m_s2", "intensity"])]
+    amplitude_m: Option<f64>,
+    /// Acceleration amplitude A, m/s² (damper scenarios).
+    #[arg(long, conflicts_with = "intensity")]
+    acceleration_m_s2: Option<f64>,
+    /// Intensity Γ = A/g (damper scenarios).
+    #[arg(long)]
+    intensity: Option<f64>,
+}
+
+impl PointArgs {
+    fn any(&self) -> bool {
+        self.frequency_hz.is_some()
+            || self.amplitude_m.is_some()
+            || self.acceleration_m_s2.is_some()
+            || self.intensity.is_some()
+    }
+
+    /// Puts the point into the scenario's `[damper]` and validates it again.
+    fn apply(&self, sc: &mut pdamp_io::scenario::Scenario) -> Result<()> {
+        if !self.any() {
+            return Ok(());
+        }
+        let Some(d) = sc.damper.as_mut() else {
+            bail!(
+                "--frequency-hz/--amplitude-m/--acceleration-m-s2/--intensity need a scenario with a [damper] section"
+            );
+        };
+        if let Some(f) = self.frequency_hz {
+            d.frequency_hz = Some(f);
+        }
+        if self.amplitude_m.is_some()
+            || self.acceleration_m_s2.is_some()
+            || self.intensity.is_some()
+        {
+            d.amplitude_m = self.amplitude_m;
+            d.acceleration_m_s2 = self.acceleration_m_s2;
+            d.intensity = self.intensity;
+        }
+        sc.validate()
+            .map_err(|e| anyhow::anyhow!("command-line excitation: {e}"))
+    }
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum PartnerArg {
     Wall,
@@ -162,6 +215,7 @@ fn run_cli() -> Result<()> {
             out,
             resume,
             checkpoint_interval_s,
+            point,
         } => cmd_run(
             &scenario,
             &out,
@@ -169,6 +223,7 @@ fn run_cli() -> Result<()> {
                 checkpoint_interval_s,
                 resume,
             },
+            point,
         ),
         Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
         Command::Check { scenario } => cmd_check(&scenario),
@@ -278,8 +333,9 @@ fn cmd_run(
     scenario: &str,
     out: &std::path::Path,
     options: pdamp_io::run::RunOptions,
+    point: PointArgs,
 ) -> Result<()> {
-    let (sc, base) = if scenario == "builtin:shaken-box" {
+    let (mut sc, base) = if scenario == "builtin:shaken-box" {
         (
             pdamp_io::examples::shaken_box(2000, 0.5),
             PathBuf::from("."),
@@ -291,6 +347,7 @@ fn cmd_run(
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         (sc, base)
     };
+    point.apply(&mut sc)?;
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template(

@@ -137,3 +137,48 @@ fn outputs_carry_version_scenario_and_seed() {
     assert!(copy.contains("seed = 1"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pdamp run` on a damper scenario takes the excitation point from the command line.
+#[test]
+fn damper_point_from_the_command_line() {
+    let dir = std::env::temp_dir().join(format!("pdamp-cli-point-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let ex = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    // Not a damper scenario: refused before any output.
+    let o = pdamp()
+        .arg("run")
+        .arg(ex.join("shaken_box.toml"))
+        .args(["--frequency-hz", "50"])
+        .arg("--out")
+        .arg(dir.join("a"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("need a scenario with a [damper] section"));
+    assert!(!dir.join("a").exists());
+    // Two amplitude measures at once: a usage error.
+    let o = pdamp()
+        .arg("run")
+        .arg(ex.join("damper_cylinder_small.toml"))
+        .args(["--amplitude-m", "1e-3", "--intensity", "5"])
+        .arg("--out")
+        .arg(dir.join("b"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    // Out of range: the message names the key.
+    let o = pdamp()
+        .arg("run")
+        .arg(ex.join("damper_cylinder_small.toml"))
+        .arg("--frequency-hz=-5")
+        .arg("--out")
+        .arg(dir.join("c"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("damper.frequency_hz must be > 0"), "{err}");
+    assert!(!dir.join("c").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
