@@ -117,12 +117,13 @@ impl World {
             ));
         }
         // Particle–wall overlaps (from the last force evaluation).
+        let mut out = Vec::new();
         for (i, slots) in self.wall_slots.iter().enumerate() {
             for s in slots {
                 let b = &self.bodies[s.body as usize];
                 let wall = &b.walls[s.wall as usize];
                 let x = b.state.to_body(&p.position[i]);
-                let mut out = Vec::new();
+                out.clear();
                 wall.geometry
                     .sphere_contacts(&x, p.radius[i], 0.0, &mut out);
                 if let Some(c) = out

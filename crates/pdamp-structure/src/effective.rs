@@ -291,16 +291,8 @@ pub fn tabulate(
     frequencies_hz: &[f64],
     amplitudes_m: &[f64],
 ) -> (Vec<&'static str>, Vec<Vec<f64>>) {
-    let header = vec![
-        "frequency_hz",
-        "amplitude_m",
-        "acceleration_m_s2",
-        "intensity",
-        "dissipated_energy_per_cycle_j",
-        "loss_factor",
-        "effective_loss_factor",
-        "effective_mass_ratio",
-    ];
+    // The leading columns of the single-damper `fields.csv`, so the table reads back in.
+    let header = pdamp_design::fields::FIELD_COLUMNS[..8].to_vec();
     let mut rows = Vec::new();
     let mb = model.bed_mass_kg();
     for &f in frequencies_hz {
