@@ -102,6 +102,36 @@ fn next(state: &mut u64) -> f64 {
     (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
 }
 
+/// Waits `wait`, then (unless `any_time`) until the child has written a checkpoint newer than
+/// `before`, then kills it with SIGKILL. Returns false when the child finished first.
+fn kill_after_checkpoint(
+    child: &mut std::process::Child,
+    ckpt: &Path,
+    before: Option<std::time::SystemTime>,
+    wait: Duration,
+    any_time: bool,
+) -> bool {
+    std::thread::sleep(wait);
+    let stamp = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            return false;
+        }
+        if any_time || stamp(ckpt) != before || Instant::now() > deadline {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    true
+}
+
+fn checkpoint_stamp(p: &Path) -> Option<std::time::SystemTime> {
+    std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}
+
 #[test]
 fn sigkill_at_random_moments_then_resume_gives_identical_outputs() {
     let dir = scratch("sigkill");
@@ -116,23 +146,24 @@ fn sigkill_at_random_moments_then_resume_gives_identical_outputs() {
     let mut rng = 0x9e37_79b9_7f4a_7c15u64 ^ std::process::id() as u64;
     let mut kills = 0;
     let mut resumed_from_checkpoint = 0;
+    let ckpt = out.join("checkpoint.bin");
     for attempt in 0..8 {
         let args: &[&str] = if attempt == 0 {
             &["--checkpoint-interval-s", "0.05"]
         } else {
             &["--checkpoint-interval-s", "0.05", "--resume"]
         };
+        let before = checkpoint_stamp(&ckpt);
         let mut child = run(&scn, &out, "2", args).spawn().unwrap();
-        // Kill somewhere in the first 5–45 % of a full run's duration.
-        let wait = full * (0.05 + 0.4 * next(&mut rng));
-        std::thread::sleep(Duration::from_secs_f64(wait));
-        if child.try_wait().unwrap().is_some() {
+        // Kill at a random moment in the first 2–20 % of a full run's duration, but (after the
+        // first attempt) not before this process has written a checkpoint of its own, so that
+        // every attempt makes progress and the test does not depend on machine load.
+        let wait = Duration::from_secs_f64(full * (0.02 + 0.18 * next(&mut rng)));
+        if !kill_after_checkpoint(&mut child, &ckpt, before, wait, attempt == 0) {
             break;
         }
-        child.kill().unwrap(); // SIGKILL
-        child.wait().unwrap();
         kills += 1;
-        if out.join("checkpoint.bin").exists() {
+        if ckpt.exists() {
             resumed_from_checkpoint += 1;
         }
     }
@@ -163,7 +194,7 @@ fn sigint_writes_checkpoint_and_exits_130() {
     let child = run(&scn, &out, "2", &["--checkpoint-interval-s", "0"])
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_secs_f64(full * 0.5));
+    std::thread::sleep(Duration::from_secs_f64(full * 0.3));
     let k = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -360,13 +391,13 @@ fn couple_dem_sigkill_then_resume_gives_identical_outputs() {
         } else {
             &["--checkpoint-interval-s", "0.05", "--resume"]
         };
+        let ckpt = out.join("checkpoint.bin");
+        let before = checkpoint_stamp(&ckpt);
         let mut child = couple(&out, args).spawn().unwrap();
-        std::thread::sleep(Duration::from_secs_f64(full * (0.3 + 0.3 * next(&mut rng))));
-        if child.try_wait().unwrap().is_some() {
+        let wait = Duration::from_secs_f64(full * (0.1 + 0.15 * next(&mut rng)));
+        if !kill_after_checkpoint(&mut child, &ckpt, before, wait, false) {
             break;
         }
-        child.kill().unwrap();
-        child.wait().unwrap();
         kills += 1;
     }
     assert!(couple(&out, &["--resume"]).status().unwrap().success());
