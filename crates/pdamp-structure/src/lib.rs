@@ -13,7 +13,8 @@
 //!   and 3 (analytical formulas, [`formulas`]);
 //! - analyses: free vibration and log decrement ([`free`], D Eq. 3.40–3.41), sine sweeps, FRF,
 //!   resonance-peak damping and the steady-state iteration ([`forced`], D Eq. 3.42–3.50,
-//!   Fig. 3.7), efficiency and design formulas ([`design`], D Eq. 3.51–3.52, 5.15–5.23);
+//!   Fig. 3.7), modal parameter extraction from FRFs ([`modal_fit`]: rational fraction
+//!   polynomial, half-power bandwidth), efficiency and design formulas ([`design`], D Eq. 3.51–3.52, 5.15–5.23);
 //! - [`scenario`]: the TOML input of `pdamp structure` and `pdamp couple`.
 //!
 //! [D] is the dissertation on the particle damper design toolchain.
@@ -29,6 +30,7 @@ pub mod fuzz;
 pub mod integrate;
 pub mod matrix_market;
 pub mod modal;
+pub mod modal_fit;
 pub mod report;
 pub mod scenario;
 

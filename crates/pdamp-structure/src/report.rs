@@ -5,6 +5,7 @@ use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
 use crate::modal::ModalStructure;
+use crate::modal_fit;
 use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, ForceSpec, load_structure};
 use pdamp_io::csv::write_csv_atomic;
 use pdamp_plot::{Axis, FrfPlot, FrfSeries, LinePlot, Marker, Series, frf_plot_with, line_plot};
@@ -326,8 +327,14 @@ pub fn run_couple(
             );
             plot.magnitude_title = "|H| (m/N)".into();
             frf_plot_with(out.join("frf"), &plot).map_err(io)?;
+            let hc: Vec<_> = rows
+                .iter()
+                .map(|r| pdamp_signal::Complex64::from_polar(r[1], r[2]))
+                .collect();
+            let modal_parameters = extract_modal_parameters(&structure, &freqs, &hc);
             json!({
                 "damping_ratio_eq_3_47": zeta,
+                "modal_parameters": modal_parameters,
                 "resonance_frequency_hz": f_r,
                 "peak_damper_amplitude_m": x_peak,
                 "non_converged_points": pts.iter().filter(|p| !p.converged).count(),
@@ -487,6 +494,57 @@ fn free_outputs(
     }))
 }
 
+/// Modal parameters of an FRF for `summary.json`: global rational fraction polynomial fit
+/// ([`modal_fit::rfp_fit`]) with as many modes as the structure has inside the band (at least
+/// one), and the half-power bandwidth around each identified resonance.
+fn extract_modal_parameters(
+    structure: &ModalStructure,
+    frequencies_hz: &[f64],
+    h: &[pdamp_signal::Complex64],
+) -> serde_json::Value {
+    if frequencies_hz.len() < 8 {
+        return json!(null);
+    }
+    let (lo, hi) = frequencies_hz
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &f| (a.min(f), b.max(f)));
+    let n = structure
+        .modes
+        .iter()
+        .filter(|m| m.frequency_hz >= 0.9 * lo && m.frequency_hz <= 1.1 * hi)
+        .count()
+        .max(1);
+    let mag: Vec<f64> = h.iter().map(|c| c.norm()).collect();
+    match modal_fit::rfp_fit(frequencies_hz, h, n) {
+        Ok(fit) => {
+            let centers: Vec<f64> = fit.modes.iter().map(|m| m.frequency_hz).collect();
+            let hp = modal_fit::half_power_per_mode(frequencies_hz, &mag, &centers);
+            let modes: Vec<_> = fit
+                .modes
+                .iter()
+                .zip(&hp)
+                .map(|(m, h)| {
+                    json!({
+                        "frequency_hz": m.frequency_hz,
+                        "damping_ratio": m.damping_ratio,
+                        "modal_constant_re": m.modal_constant_re,
+                        "modal_constant_im": m.modal_constant_im,
+                        "half_power_frequency_hz": h.map(|r| r.resonance_frequency_hz),
+                        "half_power_damping_ratio": h.map(|r| r.damping_ratio),
+                    })
+                })
+                .collect();
+            json!({
+                "method": fit.method,
+                "model_modes": fit.model_modes,
+                "relative_error": fit.relative_error,
+                "modes": modes,
+            })
+        }
+        Err(e) => json!({ "error": e }),
+    }
+}
+
 fn sweep_outputs(
     structure: &ModalStructure,
     spec: &SweepSpec,
@@ -557,11 +615,14 @@ fn sweep_outputs(
         hist.displacement_m.clone(),
     ));
     line_plot(out.join("response"), &p).map_err(io)?;
+    let hc: Vec<_> = frf.iter().map(|p| p.h_m_per_n).collect();
+    let modal_parameters = extract_modal_parameters(structure, &f, &hc);
     Ok(json!({
         "analysis": "sweep",
         "force_amplitude_n": spec.force_amplitude_n,
         "half_power": hp,
         "rational_fraction_polynomial": rfp,
+        "modal_parameters": modal_parameters,
         "peak_damping_eq_3_47": pk,
         "frf_points": frf.len(),
     }))
