@@ -33,5 +33,6 @@ pub mod modal;
 pub mod modal_fit;
 pub mod report;
 pub mod scenario;
+pub mod sparse;
 
 pub use modal::{ModalPoint, ModalStructure, Mode};

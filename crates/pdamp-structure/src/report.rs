@@ -51,6 +51,7 @@ pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value,
         "points": s.points,
         "total_mass_kg": built.total_mass_kg,
         "active_dof": built.dof_count,
+        "eigen_solver": built.solver,
     });
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),

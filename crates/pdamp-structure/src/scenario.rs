@@ -32,6 +32,11 @@ pub struct StructureSpec {
     /// Modes below this frequency (rigid-body modes) are dropped, Hz.
     #[serde(default = "default_min_frequency")]
     pub min_frequency_hz: f64,
+    /// Eigen solver of FE and Matrix Market models: `auto` (dense up to
+    /// [`crate::sparse::AUTO_SPARSE_ABOVE_DOF`] active dof, sparse above), `dense` or `sparse`
+    /// (shift-invert subspace iteration, [`crate::sparse`]).
+    #[serde(default)]
+    pub solver: EigenSolver,
     /// Single mode in damper coordinates [D Eq. 3.27/3.36].
     #[serde(default)]
     pub single_mode: Option<SingleModeSpec>,
@@ -51,6 +56,22 @@ pub struct StructureSpec {
     #[serde(default)]
     pub points: Vec<PointSpec>,
 }
+
+/// Eigen solver selection (`[structure] solver`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum EigenSolver {
+    /// Dense up to [`crate::sparse::AUTO_SPARSE_ABOVE_DOF`] dof, sparse above.
+    #[default]
+    Auto,
+    /// Dense Cholesky + symmetric eigen solver ([`crate::modal::lowest_modes`]).
+    Dense,
+    /// Sparse shift-invert subspace iteration ([`crate::sparse::lowest_modes_sparse`]).
+    Sparse,
+}
+
+/// Dense solver limit (memory n² and time n³).
+pub const DENSE_MAX_DOF: usize = 4000;
 
 fn default_modes() -> usize {
     4
@@ -235,6 +256,8 @@ pub struct BuiltStructure {
     pub total_mass_kg: Option<f64>,
     /// Active dof of an FE/imported model.
     pub dof_count: Option<usize>,
+    /// Eigen solver used ("dense", "sparse"; `None` for modal/single-mode input).
+    pub solver: Option<&'static str>,
 }
 
 fn resolve(base: &Path, p: &Path) -> PathBuf {
@@ -273,6 +296,7 @@ impl StructureSpec {
                 modal: ModalStructure::single_mode(s.mass_kg, s.stiffness_n_m, s.damping_n_s_m),
                 total_mass_kg: None,
                 dof_count: None,
+                solver: None,
             });
         }
         if let Some(m) = &self.modal {
@@ -296,24 +320,55 @@ impl StructureSpec {
                 modal: s,
                 total_mass_kg: None,
                 dof_count: None,
+                solver: None,
             });
         }
-        let (k, m, rows, total): (_, _, Vec<Option<usize>>, Option<f64>) =
+        let want_sparse = |n: usize| match self.solver {
+            EigenSolver::Auto => n > crate::sparse::AUTO_SPARSE_ABOVE_DOF,
+            EigenSolver::Dense => false,
+            EigenSolver::Sparse => true,
+        };
+        let dense_limit = |n: usize| {
+            if n > DENSE_MAX_DOF {
+                Err(format!(
+                    "{n} dof: the dense modal solver is limited to {DENSE_MAX_DOF} dof (use \
+                     solver = \"sparse\" or \"auto\")"
+                ))
+            } else {
+                Ok(())
+            }
+        };
+        let (basis, n, rows, total, solver): (_, usize, Vec<Option<usize>>, Option<f64>, _) =
             if let Some(b) = &self.beam {
                 let (fe, positions) = b.model()?;
-                let a = fe.assemble()?;
-                let mut rows = Vec::new();
+                let total = fe.total_mass_kg();
+                let mut wanted = Vec::new();
                 for p in &self.points {
                     let x = p
                         .position_m
                         .ok_or_else(|| format!("point '{}': needs position_m", p.name))?;
                     let dof = Dof::parse(&p.dof)
                         .ok_or_else(|| format!("point '{}': unknown dof '{}'", p.name, p.dof))?;
-                    let node = nearest(&positions, x);
-                    rows.push(a.row(node, dof));
+                    wanted.push((nearest(&positions, x), dof));
                 }
-                let total = fe.total_mass_kg();
-                (a.stiffness, a.mass, rows, Some(total))
+                let a = fe.assemble_sparse()?;
+                let n = a.dofs.len();
+                let rows: Vec<Option<usize>> = wanted.iter().map(|&(nd, d)| a.row(nd, d)).collect();
+                if want_sparse(n) {
+                    let basis = crate::sparse::lowest_modes_sparse(
+                        &a.stiffness,
+                        &a.mass,
+                        self.n_modes,
+                        self.min_frequency_hz,
+                    )?;
+                    (basis, n, rows, Some(total), "sparse")
+                } else {
+                    dense_limit(n)?;
+                    let a = fe.assemble()?;
+                    let basis =
+                        lowest_modes(&a.stiffness, &a.mass, self.n_modes, self.min_frequency_hz)?;
+                    (basis, n, rows, Some(total), "dense")
+                }
             } else {
                 let mm = self.matrix_market.as_ref().expect("counted");
                 let k = matrix_market::read_matrix_market(&resolve(base_dir, &mm.stiffness))
@@ -324,12 +379,6 @@ impl StructureSpec {
                     return Err(format!(
                         "K is {}×{}, M is {}×{}",
                         k.nrows, k.ncols, m.nrows, m.ncols
-                    ));
-                }
-                if k.nrows > 4000 {
-                    return Err(format!(
-                        "{} dof: the dense modal solver is limited to 4000 dof",
-                        k.nrows
                     ));
                 }
                 let map = matrix_market::read_dof_map(&resolve(base_dir, &mm.dof_map), k.nrows)
@@ -345,10 +394,28 @@ impl StructureSpec {
                         format!("point '{}': node {node} {dof:?} not in the dof map", p.name)
                     })?));
                 }
-                (k.to_dense(), m.to_dense(), rows, None)
+                let n = k.nrows;
+                if want_sparse(n) {
+                    let ks = crate::sparse::SparseSym::from_triplets(n, &k.entries, false)?;
+                    let ms = crate::sparse::SparseSym::from_triplets(n, &m.entries, false)?;
+                    let basis = crate::sparse::lowest_modes_sparse(
+                        &ks,
+                        &ms,
+                        self.n_modes,
+                        self.min_frequency_hz,
+                    )?;
+                    (basis, n, rows, None, "sparse")
+                } else {
+                    dense_limit(n)?;
+                    let basis = lowest_modes(
+                        &k.to_dense(),
+                        &m.to_dense(),
+                        self.n_modes,
+                        self.min_frequency_hz,
+                    )?;
+                    (basis, n, rows, None, "dense")
+                }
             };
-        let n = k.nrows();
-        let basis = lowest_modes(&k, &m, self.n_modes, self.min_frequency_hz)?;
         let mut modal = ModalStructure {
             modes: basis
                 .omega_rad_s
@@ -392,6 +459,7 @@ impl StructureSpec {
             modal,
             total_mass_kg: total,
             dof_count: Some(n),
+            solver: Some(solver),
         })
     }
 }

@@ -6,6 +6,7 @@
 pub mod beam;
 pub mod hex8;
 
+use crate::sparse::SparseSym;
 use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -128,6 +129,24 @@ pub struct Assembled {
     pub mass: DMatrix<f64>,
     /// (node, dof) of each row.
     pub dofs: Vec<(usize, Dof)>,
+}
+
+/// Sparse assembled matrices on the active dof.
+#[derive(Debug, Clone)]
+pub struct AssembledSparse {
+    /// Stiffness matrix K, N/m.
+    pub stiffness: SparseSym,
+    /// Mass matrix M, kg.
+    pub mass: SparseSym,
+    /// (node, dof) of each row.
+    pub dofs: Vec<(usize, Dof)>,
+}
+
+impl AssembledSparse {
+    /// Row of a (node, dof), if active.
+    pub fn row(&self, node: usize, dof: Dof) -> Option<usize> {
+        self.dofs.iter().position(|&d| d == (node, dof))
+    }
 }
 
 impl Assembled {
@@ -294,13 +313,14 @@ impl FeModel {
         beams + solids + self.point_masses.iter().map(|p| p.mass_kg).sum::<f64>()
     }
 
-    /// Assembles K and M [D Eq. 3.19] and removes fixed dof and dof without stiffness and mass.
+    /// Element contributions to K and M [D Eq. 3.19] as (row, column, value) triplets on the
+    /// full 6-dof-per-node numbering (duplicates to be summed).
     ///
     /// # Errors
     /// Invalid node indices, degenerate elements or invalid properties.
-    pub fn assemble(&self) -> Result<Assembled, String> {
-        let n = 6 * self.nodes.len();
-        if n == 0 {
+    #[allow(clippy::type_complexity)]
+    fn triplets(&self) -> Result<(Vec<(usize, usize, f64)>, Vec<(usize, usize, f64)>), String> {
+        if self.nodes.is_empty() {
             return Err("FE model has no nodes".into());
         }
         let check = |i: usize, what: &str| -> Result<(), String> {
@@ -313,8 +333,8 @@ impl FeModel {
                 Ok(())
             }
         };
-        let mut k = DMatrix::<f64>::zeros(n, n);
-        let mut m = DMatrix::<f64>::zeros(n, n);
+        let mut k = Vec::new();
+        let mut m = Vec::new();
         for (e, b) in self.beams.iter().enumerate() {
             b.section.validate().map_err(|s| format!("beam {e}: {s}"))?;
             check(b.nodes[0], "beam")?;
@@ -331,8 +351,8 @@ impl FeModel {
                     for i in 0..6 {
                         for j in 0..6 {
                             let (r, s) = (6 * b.nodes[a] + i, 6 * b.nodes[c] + j);
-                            k[(r, s)] += ke[(6 * a + i, 6 * c + j)];
-                            m[(r, s)] += me[(6 * a + i, 6 * c + j)];
+                            k.push((r, s, ke[(6 * a + i, 6 * c + j)]));
+                            m.push((r, s, me[(6 * a + i, 6 * c + j)]));
                         }
                     }
                 }
@@ -350,8 +370,8 @@ impl FeModel {
                     for i in 0..3 {
                         for j in 0..3 {
                             let (r, t) = (6 * s.nodes[a] + i, 6 * s.nodes[c] + j);
-                            k[(r, t)] += ke[(3 * a + i, 3 * c + j)];
-                            m[(r, t)] += me[(3 * a + i, 3 * c + j)];
+                            k.push((r, t, ke[(3 * a + i, 3 * c + j)]));
+                            m.push((r, t, me[(3 * a + i, 3 * c + j)]));
                         }
                     }
                 }
@@ -375,40 +395,105 @@ impl FeModel {
             }
             for i in 0..6 {
                 for j in 0..6 {
-                    m[(6 * p.node + i, 6 * p.node + j)] += mp[(i, j)];
+                    m.push((6 * p.node + i, 6 * p.node + j, mp[(i, j)]));
                 }
             }
         }
         for s in &self.springs {
             check(s.node, "spring")?;
-            k[(6 * s.node + s.dof.index(), 6 * s.node + s.dof.index())] += s.stiffness;
+            let i = 6 * s.node + s.dof.index();
+            k.push((i, i, s.stiffness));
         }
         for &(nd, _) in &self.fixed {
             check(nd, "support")?;
         }
-        let scale_k = (0..n).map(|i| k[(i, i)].abs()).fold(0.0, f64::max);
-        let scale_m = (0..n).map(|i| m[(i, i)].abs()).fold(0.0, f64::max);
+        Ok((k, m))
+    }
+
+    /// Active dof: not fixed and with stiffness or mass on the diagonal. Returns (dofs, the
+    /// full-numbering row of each, full row → active index).
+    #[allow(clippy::type_complexity)]
+    fn active_dofs(
+        &self,
+        k: &[(usize, usize, f64)],
+        m: &[(usize, usize, f64)],
+    ) -> (Vec<(usize, Dof)>, Vec<usize>, Vec<Option<usize>>) {
+        let n = 6 * self.nodes.len();
+        let diag = |t: &[(usize, usize, f64)]| {
+            let mut d = vec![0.0f64; n];
+            for &(i, j, v) in t {
+                if i == j {
+                    d[i] += v;
+                }
+            }
+            d
+        };
+        let (dk, dm) = (diag(k), diag(m));
+        let scale_k = dk.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let scale_m = dm.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let mut dofs = Vec::new();
         let mut rows = Vec::new();
+        let mut map = vec![None; n];
         for nd in 0..self.nodes.len() {
             for d in Dof::ALL {
                 let i = 6 * nd + d.index();
                 if self.fixed.contains(&(nd, d)) {
                     continue;
                 }
-                if k[(i, i)].abs() <= 1e-14 * scale_k && m[(i, i)].abs() <= 1e-14 * scale_m {
+                if dk[i].abs() <= 1e-14 * scale_k && dm[i].abs() <= 1e-14 * scale_m {
                     continue;
                 }
+                map[i] = Some(rows.len());
                 dofs.push((nd, d));
                 rows.push(i);
             }
         }
-        let sel = |a: &DMatrix<f64>| {
-            DMatrix::from_fn(rows.len(), rows.len(), |i, j| a[(rows[i], rows[j])])
+        (dofs, rows, map)
+    }
+
+    /// Assembles K and M [D Eq. 3.19] and removes fixed dof and dof without stiffness and mass
+    /// (dense; see [`FeModel::assemble_sparse`] for large models).
+    ///
+    /// # Errors
+    /// Invalid node indices, degenerate elements or invalid properties.
+    pub fn assemble(&self) -> Result<Assembled, String> {
+        let (k, m) = self.triplets()?;
+        let (dofs, rows, map) = self.active_dofs(&k, &m);
+        let na = rows.len();
+        let dense = |t: &[(usize, usize, f64)]| {
+            let mut a = DMatrix::<f64>::zeros(na, na);
+            for &(i, j, v) in t {
+                if let (Some(r), Some(c)) = (map[i], map[j]) {
+                    a[(r, c)] += v;
+                }
+            }
+            a
         };
         Ok(Assembled {
-            stiffness: sel(&k),
-            mass: sel(&m),
+            stiffness: dense(&k),
+            mass: dense(&m),
+            dofs,
+        })
+    }
+
+    /// Sparse assembly on the active dof (as [`FeModel::assemble`]).
+    ///
+    /// # Errors
+    /// As [`FeModel::assemble`].
+    pub fn assemble_sparse(&self) -> Result<AssembledSparse, String> {
+        let (k, m) = self.triplets()?;
+        let (dofs, rows, map) = self.active_dofs(&k, &m);
+        let sel = |t: &[(usize, usize, f64)]| {
+            let v: Vec<(usize, usize, f64)> = t
+                .iter()
+                .filter_map(|&(i, j, v)| Some((map[i]?, map[j]?, v)))
+                .filter(|e| e.2 != 0.0)
+                .collect();
+            SparseSym::from_triplets(rows.len(), &v, false)
+        };
+        Ok(AssembledSparse {
+            stiffness: sel(&k)?,
+            mass: sel(&m)?,
             dofs,
         })
     }
