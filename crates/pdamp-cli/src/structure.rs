@@ -1,4 +1,4 @@
-//! `pdamp structure modes` and `pdamp couple`: the structural level [D Sect. 3.3] (library:
+//! `pdamp structure modes|optimize-layers|coated-wall` and `pdamp couple`: the structural level [D Sect. 3.3] (library:
 //! `pdamp-structure`, inputs in docs/structure.md).
 
 use std::path::PathBuf;
@@ -24,6 +24,41 @@ enum StructureAction {
         /// Output directory.
         #[arg(long, default_value = "out/structure")]
         out: PathBuf,
+    },
+    /// Brute-force layer optimisation (D Sect. 5.2.1 / 7.2.3): every combination of particle
+    /// numbers per layer simulated in free vibration with the analytical formulas; writes
+    /// DIR/study.csv (best first) and DIR/summary.json.
+    OptimizeLayers {
+        /// Study file (TOML: scenario = "…free analysis…", [study]).
+        study: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Coated-wall damper design (D Sect. 8.1.5, Eq. 8.3–8.12): coating Young's modulus and
+    /// bouncing clearance for a desired frequency; prints JSON.
+    CoatedWall {
+        /// Desired frequency f_d of high loss factor at Γ = 1, Hz.
+        #[arg(long)]
+        frequency_hz: f64,
+        /// Particle radius, m.
+        #[arg(long)]
+        particle_radius_m: f64,
+        /// Particle density, kg/m³.
+        #[arg(long, default_value_t = 7900.0)]
+        particle_density_kg_m3: f64,
+        /// Particle Young's modulus, Pa.
+        #[arg(long, default_value_t = 208e9)]
+        particle_youngs_modulus_pa: f64,
+        /// Particle Poisson's ratio.
+        #[arg(long, default_value_t = 0.3)]
+        particle_poisson_ratio: f64,
+        /// Coating Poisson's ratio.
+        #[arg(long, default_value_t = 0.5)]
+        wall_poisson_ratio: f64,
+        /// Particles in one line along the excitation (n_p^line).
+        #[arg(long)]
+        particles_per_line: f64,
     },
 }
 
@@ -51,6 +86,43 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
             let s = pdamp_structure::report::run_modes(&structure, &out).map_err(|e| anyhow!(e))?;
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("modes.csv").display());
+            Ok(())
+        }
+        StructureAction::OptimizeLayers { study, out } => {
+            let s = pdamp_structure::study::run_layer_study_file(&study, &out)
+                .map_err(|e| anyhow!(e))?;
+            println!("{}", serde_json::to_string_pretty(&s)?);
+            eprintln!("wrote {}", out.join("study.csv").display());
+            Ok(())
+        }
+        StructureAction::CoatedWall {
+            frequency_hz,
+            particle_radius_m,
+            particle_density_kg_m3,
+            particle_youngs_modulus_pa,
+            particle_poisson_ratio,
+            wall_poisson_ratio,
+            particles_per_line,
+        } => {
+            let input = pdamp_structure::design::CoatedWallInput {
+                design_frequency_hz: frequency_hz,
+                particle_radius_m,
+                particle_density_kg_m3,
+                particle_youngs_modulus_pa,
+                particle_poisson_ratio,
+                wall_poisson_ratio,
+                particles_per_line,
+            };
+            if !(frequency_hz > 0.0 && particle_radius_m > 0.0 && particles_per_line > 0.0) {
+                return Err(anyhow!(
+                    "--frequency-hz, --particle-radius-m and --particles-per-line must be > 0"
+                ));
+            }
+            let d = pdamp_structure::design::coated_wall_design(&input);
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({"input": input, "design": d}))?
+            );
             Ok(())
         }
     }

@@ -34,5 +34,6 @@ pub mod modal_fit;
 pub mod report;
 pub mod scenario;
 pub mod sparse;
+pub mod study;
 
 pub use modal::{ModalPoint, ModalStructure, Mode};

@@ -627,6 +627,26 @@ pub enum DamperSpec {
         #[serde(default = "one")]
         bouncing_mass_ratio: f64,
     },
+    /// Approach 3: vertical single/double collect-and-collide bed (D Eq. 7.1–7.19).
+    Vertical {
+        /// Structure point.
+        point: String,
+        /// Bed mass, kg.
+        bed_mass_kg: f64,
+        /// Clearance h to the top wall, m (or give `container_length_m`, `particles`,
+        /// `max_particles` for Eq. 7.4).
+        #[serde(default)]
+        clearance_m: Option<f64>,
+        /// Inner container length L along the excitation, m (Eq. 7.4).
+        #[serde(default)]
+        container_length_m: Option<f64>,
+        /// Particle number n_p (Eq. 7.4).
+        #[serde(default)]
+        particles: Option<f64>,
+        /// n_p^max (Eq. 7.4).
+        #[serde(default)]
+        max_particles: Option<f64>,
+    },
     /// Fixed η̄ and m̄/m_bed.
     Constant {
         /// Structure point.
@@ -683,6 +703,7 @@ impl DamperSpec {
             | DamperSpec::Fields { point, .. }
             | DamperSpec::Rolling { point, .. }
             | DamperSpec::Horizontal { point, .. }
+            | DamperSpec::Vertical { point, .. }
             | DamperSpec::Constant { point, .. }
             | DamperSpec::Dem { point, .. } => point,
         }
@@ -747,6 +768,31 @@ impl DamperSpec {
                 bouncing_clearance_m: *bouncing_clearance_m,
                 bouncing_mass_ratio: *bouncing_mass_ratio,
             }),
+            DamperSpec::Vertical {
+                bed_mass_kg,
+                clearance_m: h,
+                container_length_m,
+                particles,
+                max_particles,
+                ..
+            } => {
+                let h = match (h, container_length_m, particles, max_particles) {
+                    (Some(h), None, None, None) => *h,
+                    (None, Some(l), Some(n), Some(nm)) => crate::formulas::clearance_m(*l, *n, *nm),
+                    _ => {
+                        return Err("vertical damper: give clearance_m, or container_length_m, \
+                                    particles and max_particles (Eq. 7.4)"
+                            .into());
+                    }
+                };
+                if !(h >= 0.0 && *bed_mass_kg > 0.0) {
+                    return Err("vertical damper: bed_mass_kg > 0 and clearance ≥ 0".into());
+                }
+                Box::new(crate::formulas::VerticalDamper {
+                    bed_mass_kg: *bed_mass_kg,
+                    clearance_m: h,
+                })
+            }
             DamperSpec::Constant {
                 bed_mass_kg,
                 effective_loss_factor,
