@@ -1,0 +1,289 @@
+//! The structural model: hex8 mesh + Saint Venant–Kirchhoff material + boundary conditions
+//! (clamped nodes = homogeneous Dirichlet, dead surface tractions with time ramps = Neumann,
+//! paper eq. 10) + body force, assembled into the semi-discrete eq. 11
+//! $\mathbf M\ddot{\mathbf d} + \mathbf F_{int}(\mathbf d) - \mathbf F_{ext} = 0$.
+//! Constrained dofs are eliminated; matrices live on the free dofs.
+
+use super::mesh::{Face, HexMesh};
+use super::sparse::CsrMatrix;
+use super::svk::{self, GaussPoint, SvkMaterial};
+
+/// Time history of a load factor.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadRamp {
+    /// Linear increase from 0 to 1 over this time [s] (paper Sect. 2.4: 5 ms).
+    pub rise_s: f64,
+    /// Time held at 1 after the rise [s] (paper: 1 ms); afterwards the load is removed.
+    /// `inf` keeps it on.
+    pub hold_s: f64,
+}
+
+impl LoadRamp {
+    /// Load factor at time `t` [s].
+    pub fn factor(&self, t: f64) -> f64 {
+        if t < 0.0 {
+            0.0
+        } else if t < self.rise_s {
+            t / self.rise_s
+        } else if t <= self.rise_s + self.hold_s {
+            1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A dead (reference-configuration) traction on a set of boundary faces.
+#[derive(Debug, Clone)]
+pub struct SurfaceLoad {
+    /// Loaded faces.
+    pub faces: Vec<Face>,
+    /// Traction vector [Pa] at load factor 1.
+    pub traction_pa: [f64; 3],
+    /// Time history.
+    pub ramp: LoadRamp,
+}
+
+/// Mass matrix kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MassKind {
+    /// Consistent mass $\int\rho N_aN_b\,dV$.
+    Consistent,
+    /// Row-sum lumped mass.
+    Lumped,
+}
+
+/// Assembled structure on the free dofs.
+pub struct Structure {
+    /// The mesh.
+    pub mesh: HexMesh,
+    /// Material.
+    pub material: SvkMaterial,
+    /// Gauss-point data.
+    pub gps: Vec<[GaussPoint; 8]>,
+    /// Global dof (3·node + dir) → free index, `usize::MAX` if clamped.
+    pub free: Vec<usize>,
+    /// Free index → global dof.
+    pub free_dofs: Vec<usize>,
+    /// Mass matrix on the free dofs (pattern equal to the stiffness pattern).
+    pub mass: CsrMatrix,
+    /// Tangent stiffness at the reference configuration (free dofs).
+    pub k0: CsrMatrix,
+    /// Surface loads.
+    pub loads: Vec<SurfaceLoad>,
+    /// Constant body-force vector (gravity) on all dofs [N].
+    pub body_force: Vec<f64>,
+    /// Per-element triplet positions are rebuilt on demand; the element dof lists.
+    elem_free: Vec<[usize; 24]>,
+    /// Scratch for element forces.
+    scratch: Vec<[f64; 24]>,
+}
+
+impl Structure {
+    /// Assembles mass and reference stiffness; `clamped` lists nodes with all three dofs fixed.
+    ///
+    /// # Panics
+    /// If an element is degenerate.
+    pub fn new(
+        mesh: HexMesh,
+        material: SvkMaterial,
+        clamped: &[usize],
+        mass_kind: MassKind,
+        gravity_m_s2: [f64; 3],
+    ) -> Self {
+        let gps = svk::precompute(&mesh);
+        let ndof = 3 * mesh.nodes.len();
+        let mut fixed = vec![false; ndof];
+        for &n in clamped {
+            for i in 0..3 {
+                fixed[3 * n + i] = true;
+            }
+        }
+        let mut free = vec![usize::MAX; ndof];
+        let mut free_dofs = Vec::new();
+        for d in 0..ndof {
+            if !fixed[d] {
+                free[d] = free_dofs.len();
+                free_dofs.push(d);
+            }
+        }
+        let elem_free: Vec<[usize; 24]> = mesh
+            .elements
+            .iter()
+            .map(|el| {
+                let mut f = [0; 24];
+                for a in 0..8 {
+                    for i in 0..3 {
+                        f[3 * a + i] = free[3 * el[a] + i];
+                    }
+                }
+                f
+            })
+            .collect();
+        let rho = material.density_kg_m3;
+        let mut tm = Vec::with_capacity(mesh.elements.len() * 576);
+        let mut body_force = vec![0.0; ndof];
+        for (e, g) in gps.iter().enumerate() {
+            let me = svk::element_mass(g, rho);
+            let ef = &elem_free[e];
+            for a in 0..8 {
+                let row_sum: f64 = me[a].iter().sum();
+                for i in 0..3 {
+                    body_force[3 * mesh.elements[e][a] + i] += row_sum * gravity_m_s2[i];
+                }
+                for b in 0..8 {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            let (r, c) = (ef[3 * a + i], ef[3 * b + j]);
+                            if r == usize::MAX || c == usize::MAX {
+                                continue;
+                            }
+                            let v = match mass_kind {
+                                MassKind::Consistent if i == j => me[a][b],
+                                MassKind::Lumped if i == j && a == b => row_sum,
+                                _ => 0.0,
+                            };
+                            tm.push((r, c, v));
+                        }
+                    }
+                }
+            }
+        }
+        let nfree = free_dofs.len();
+        let mass = CsrMatrix::from_triplets(nfree, tm);
+        let mut s = Structure {
+            mesh,
+            material,
+            gps,
+            free,
+            free_dofs,
+            mass,
+            k0: CsrMatrix::default(),
+            loads: Vec::new(),
+            body_force,
+            elem_free,
+            scratch: Vec::new(),
+        };
+        let zero = vec![0.0; ndof];
+        s.k0 = s.tangent(&zero);
+        s
+    }
+
+    /// Number of dofs (3 per node, including clamped ones).
+    pub fn n_dof(&self) -> usize {
+        3 * self.mesh.nodes.len()
+    }
+
+    /// Tangent stiffness at displacement `d` (all dofs) on the free dofs.
+    pub fn tangent(&self, d: &[f64]) -> CsrMatrix {
+        let (lam, mu) = self.material.lame();
+        let mut t = Vec::with_capacity(self.mesh.elements.len() * 576);
+        for (e, el) in self.mesh.elements.iter().enumerate() {
+            let mut u = [[0.0; 3]; 8];
+            for a in 0..8 {
+                u[a] = [d[3 * el[a]], d[3 * el[a] + 1], d[3 * el[a] + 2]];
+            }
+            let ke = svk::element_tangent(&self.gps[e], &u, lam, mu);
+            let ef = &self.elem_free[e];
+            for r in 0..24 {
+                if ef[r] == usize::MAX {
+                    continue;
+                }
+                for c in 0..24 {
+                    if ef[c] != usize::MAX {
+                        t.push((ef[r], ef[c], ke[r * 24 + c]));
+                    }
+                }
+            }
+        }
+        CsrMatrix::from_triplets(self.free_dofs.len(), t)
+    }
+
+    /// Internal forces (all dofs) and strain energy [J] at `d`.
+    pub fn internal_force(&mut self, d: &[f64], out: &mut [f64]) -> f64 {
+        svk::internal_force(
+            &self.mesh,
+            &self.gps,
+            d,
+            &self.material,
+            &mut self.scratch,
+            out,
+        )
+    }
+
+    /// External force at time `t` (surface loads + body force), all dofs [N].
+    pub fn external_force(&self, t: f64, out: &mut [f64]) {
+        out.copy_from_slice(&self.body_force);
+        for load in &self.loads {
+            let s = load.ramp.factor(t);
+            if s == 0.0 {
+                continue;
+            }
+            for f in &load.faces {
+                let w = face_weights(&self.mesh.nodes, f);
+                for (a, &n) in f.nodes.iter().enumerate() {
+                    for i in 0..3 {
+                        out[3 * n + i] += s * w[a] * load.traction_pa[i];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Total mass [kg].
+    pub fn total_mass(&self) -> f64 {
+        svk::element_volumes(&self.mesh).iter().sum::<f64>() * self.material.density_kg_m3
+    }
+}
+
+/// $\int_A N_a\,dA$ of a bilinear quad face (2 × 2 Gauss) [m²].
+pub fn face_weights(nodes: &[[f64; 3]], f: &Face) -> [f64; 4] {
+    let x: [[f64; 3]; 4] = [
+        nodes[f.nodes[0]],
+        nodes[f.nodes[1]],
+        nodes[f.nodes[2]],
+        nodes[f.nodes[3]],
+    ];
+    let g = 0.577_350_269_189_625_8;
+    let mut w = [0.0; 4];
+    for (s, t) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+        let n = [
+            (1.0 - s) * (1.0 - t) / 4.0,
+            (1.0 + s) * (1.0 - t) / 4.0,
+            (1.0 + s) * (1.0 + t) / 4.0,
+            (1.0 - s) * (1.0 + t) / 4.0,
+        ];
+        let ds = [
+            -(1.0 - t) / 4.0,
+            (1.0 - t) / 4.0,
+            (1.0 + t) / 4.0,
+            -(1.0 + t) / 4.0,
+        ];
+        let dt = [
+            -(1.0 - s) / 4.0,
+            -(1.0 + s) / 4.0,
+            (1.0 + s) / 4.0,
+            (1.0 - s) / 4.0,
+        ];
+        let mut a = [0.0; 3];
+        let mut b = [0.0; 3];
+        for k in 0..4 {
+            for i in 0..3 {
+                a[i] += ds[k] * x[k][i];
+                b[i] += dt[k] * x[k][i];
+            }
+        }
+        let c = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let j = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        for k in 0..4 {
+            w[k] += n[k] * j;
+        }
+    }
+    w
+}

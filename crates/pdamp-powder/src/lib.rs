@@ -1,0 +1,24 @@
+//! Two-way coupled DEM–FEM simulation of powder-filled cavities in deformable structures,
+//! after Praegla, Mair, Wimmer, Fuchs, Zaeh, Wall & Meier, *Additively manufactured structures
+//! with powder inclusions for controllable dissipation: the critical influence of packing
+//! density*, Powder Technology 2024 ("paper" below; equation numbers refer to it).
+//!
+//! - [`fe`]: nonlinear hex8 solids (Saint Venant–Kirchhoff, total Lagrangian), generalized-α
+//!   with Newton and faer's sparse Cholesky, meshes (structured box with cavity, Gmsh, Abaqus),
+//!   modes and a Timoshenko beam reference (Sect. 2.2).
+//! - [`dem`]: cohesive powder DEM (Sect. 2.1: linear spring–dashpot, Coulomb tangential spring
+//!   with return mapping, DMT adhesion, velocity Verlet), log-normal size distributions,
+//!   coarse-graining.
+//! - [`prep`]: powder preparation (grid, settling, plate compression to a packing density).
+//! - [`couple`]: Dirichlet–Neumann coupling with Aitken relaxation (Sect. 2.3, Algorithm 1).
+//! - [`cantilever`]: the cantilever study of Sect. 2.4, damping ratios as in Table 1.
+//! - [`analytic`]: the first-order shear and bending models of Sect. 4 (eq. 17–26).
+//!
+//! Details and measured results: `docs/powder.md`.
+
+pub mod cantilever;
+pub mod couple;
+pub mod damping;
+pub mod dem;
+pub mod fe;
+pub mod prep;
