@@ -581,19 +581,19 @@ impl Coupled {
         }
     }
 
-    /// Sum of the particle wall forces and of the nodal interface forces of the last evaluation
+    /// Sum of the particle wall forces and of the nodal interface forces of the committed step
     /// (interface equilibrium: their sum vanishes since $\sum_j N_j = 1$) [N].
     pub fn interface_force_sums(&self) -> ([f64; 3], [f64; 3]) {
         let mut fp = [0.0; 3];
-        for r in &self.results {
+        for f in &self.powder.wall_force {
             for k in 0..3 {
-                fp[k] += r.force[k];
+                fp[k] += f[k];
             }
         }
         let mut fs = [0.0; 3];
         for &a in &self.interface.nodes {
             for k in 0..3 {
-                fs[k] += self.f_trial[3 * a + k];
+                fs[k] += self.f_ps[3 * a + k];
             }
         }
         (fp, fs)

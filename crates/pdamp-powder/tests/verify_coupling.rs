@@ -88,7 +88,7 @@ fn coupled(e_pa: f64, law: PowderLaw, rho_inf: f64, dt: f64) -> Coupled {
 fn bouncing_and_resting_particle_matches_rigid_plate() {
     let law = PowderLaw::PAPER;
     let dt = 1e-6;
-    let steps = 40_000; // 40 ms: a few bounces, then rest
+    let steps = 2_000; // the first impact (contact time ≈ 0.24 ms) and the start of the rebound
     // rigid plane
     let mut p = particle(law, 1e-5, -0.2, dt);
     let plane = [PlaneWall {
@@ -113,9 +113,8 @@ fn bouncing_and_resting_particle_matches_rigid_plate() {
         c.step().unwrap();
         f_def.push(c.powder.wall_force[0][2]);
         let (fp, fs) = c.interface_force_sums();
-        let scale = fp[2].abs().max(1e-30);
         for k in 0..3 {
-            worst_eq = worst_eq.max((fp[k] + fs[k]).abs() / scale);
+            worst_eq = worst_eq.max((fp[k] + fs[k]).abs());
         }
     }
     let peak = f_rigid.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -124,17 +123,36 @@ fn bouncing_and_resting_particle_matches_rigid_plate() {
         .zip(&f_def)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    let mg = p.mass[0] * 9.81;
     eprintln!(
-        "peak contact force {peak:.4e} N, max |F_deformable − F_rigid| = {diff:.3e} N ({:.3e} of peak); resting force {:.6e} N vs m g = {mg:.6e} N; interface equilibrium {worst_eq:.1e}; mean coupling iterations {:.2}",
+        "peak contact force {peak:.4e} N, max |F_deformable − F_rigid| = {diff:.3e} N ({:.3e} of peak); interface equilibrium |Σ f_particle + Σ f_nodes| ≤ {worst_eq:.1e} N; mean coupling iterations {:.2}",
         diff / peak,
-        f_def[steps - 1],
         c.total_iterations as f64 / c.steps as f64
     );
+    assert!(f_def.iter().any(|&f| f > 0.5 * peak), "impact must happen");
     assert!(diff < 0.01 * peak);
-    assert!((f_def[steps - 1] / mg - 1.0).abs() < 1e-3);
-    assert!((f_rigid[steps - 1] / mg - 1.0).abs() < 1e-3);
-    assert!(worst_eq < 1e-12);
+    assert!(worst_eq < 1e-12 * peak);
+}
+
+#[test]
+fn resting_particle_carries_its_weight() {
+    // start near the static overlap m g / k_N, damped by e = 0.4: after ~20 contact periods F = m g
+    let law = PowderLaw::PAPER;
+    let dt = 2e-6;
+    let mut c = coupled(175e9, law, 0.8, dt);
+    let mg = c.powder.mass[0] * 9.81;
+    c.powder.pos[0][2] = TOP + R - 0.9 * mg / law.normal_stiffness_n_m;
+    c.powder.vel[0] = [0.0; 3];
+    for _ in 0..2500 {
+        c.step().unwrap();
+    }
+    let f = c.powder.wall_force[0][2];
+    let (_, fs) = c.interface_force_sums();
+    eprintln!(
+        "resting: wall force {f:.6e} N, m g = {mg:.6e} N, force on the plate {:.6e} N",
+        fs[2]
+    );
+    assert!((f / mg - 1.0).abs() < 1e-3);
+    assert!((fs[2] / mg + 1.0).abs() < 1e-3);
 }
 
 #[test]
@@ -151,7 +169,7 @@ fn coupled_energy_balance_closes() {
     let scale = e0.particle_kinetic_j + e0.structure_kinetic_j;
     let mut worst = 0.0f64;
     let mut max_plate = 0.0f64;
-    for _ in 0..20_000 {
+    for _ in 0..4_000 {
         c.step().unwrap();
         let e = c.energy();
         worst = worst.max((e.balance_j - e0.balance_j).abs() / scale);
