@@ -117,6 +117,15 @@ enum Command {
         /// Timed steps.
         #[arg(long, default_value_t = 2000)]
         steps: u64,
+        /// Reuse the settled bed stored in this file (settle and store it if missing).
+        #[arg(long)]
+        settled: Option<PathBuf>,
+        /// Also write a LIGGGHTS case of the same run into this folder (bench/peers).
+        #[arg(long)]
+        export_liggghts: Option<PathBuf>,
+        /// Print the energy balance of the timed steps too (peer comparison).
+        #[arg(long)]
+        peer: bool,
     },
 }
 
@@ -309,21 +318,38 @@ fn run_cli() -> Result<()> {
         Command::Cor(args) => cor::run(args),
         Command::Structure(args) => structure::run_structure(args),
         Command::Couple(args) => structure::run_couple(args),
-        Command::Bench { particles, steps } => {
-            let r =
-                pdamp_io::bench::shaken_box_bench(particles, steps).map_err(anyhow::Error::msg)?;
-            println!(
-                "{}",
-                serde_json::json!({
-                    "particles": r.particles,
-                    "steps": r.steps,
-                    "threads": rayon::current_num_threads(),
-                    "wall_time_s": r.wall_time_s,
-                    "particle_steps_per_s": r.particle_steps_per_s,
-                    "neighbor_builds": r.neighbor_builds,
-                    "contacts_pp": r.contacts_pp,
-                })
-            );
+        Command::Bench {
+            particles,
+            steps,
+            settled,
+            export_liggghts,
+            peer,
+        } => {
+            if !peer && settled.is_none() && export_liggghts.is_none() {
+                let r = pdamp_io::bench::shaken_box_bench(particles, steps)
+                    .map_err(anyhow::Error::msg)?;
+                println!(
+                    "{}",
+                    serde_json::json!({
+                        "particles": r.particles,
+                        "steps": r.steps,
+                        "threads": rayon::current_num_threads(),
+                        "wall_time_s": r.wall_time_s,
+                        "particle_steps_per_s": r.particle_steps_per_s,
+                        "neighbor_builds": r.neighbor_builds,
+                        "contacts_pp": r.contacts_pp,
+                    })
+                );
+                return Ok(());
+            }
+            let mut world = pdamp_io::bench::settled_shaken_box(particles, settled.as_deref())
+                .map_err(anyhow::Error::msg)?;
+            if let Some(dir) = &export_liggghts {
+                pdamp_io::bench::write_liggghts_case(&world, steps, dir)
+                    .map_err(anyhow::Error::msg)?;
+            }
+            let r = pdamp_io::bench::run_peer(&mut world, steps);
+            println!("{}", serde_json::to_string(&r)?);
             Ok(())
         }
     }

@@ -2,7 +2,7 @@
 //! step-size controller of Meyer & Seifried [D Sect. 2.5, Eq. 2.95–2.106, Tab. 2.2/2.3].
 
 use crate::energy::EnergyIncrements;
-use crate::forces::{PairState, WallSlot};
+use crate::forces::{PpContact, WallSlot};
 use crate::math::Vec3;
 use crate::world::World;
 use rayon::prelude::*;
@@ -60,7 +60,7 @@ pub struct GearState {
     trans: Vec<[Vec3; 5]>,
     rot: Vec<[Vec3; 5]>,
     dt_max_s: f64,
-    backup_pairs: Vec<PairState>,
+    backup_pairs: Vec<PpContact>,
     backup_walls: Vec<Vec<WallSlot>>,
     pred_trans: Vec<[Vec3; 5]>,
     pred_rot: Vec<[Vec3; 5]>,
@@ -71,6 +71,7 @@ pub struct GearState {
 impl World {
     pub(crate) fn step_velocity_verlet(&mut self) -> EnergyIncrements {
         let dt = self.dt_s;
+        let t = self.tick();
         let p = &mut self.particles;
         let half = 0.5 * dt;
         p.position
@@ -86,9 +87,11 @@ impl World {
                 *x += *v * dt;
             });
         self.advance_bodies(dt);
+        self.tock(t, |p| &mut p.integrate_s);
         self.update_neighbors();
         let inc = self.evaluate_forces(dt);
         self.counters.force_evaluations += 1;
+        let t = self.tick();
         let p = &mut self.particles;
         p.velocity
             .par_iter_mut()
@@ -100,6 +103,7 @@ impl World {
                 *v += f * (half / m);
                 *w += t * (half * ii);
             });
+        self.tock(t, |p| &mut p.integrate_s);
         inc
     }
 
@@ -147,7 +151,8 @@ impl World {
         }
         let mut gear = self.gear.take().unwrap();
         self.update_neighbors();
-        gear.backup_pairs.clone_from(&self.pair_state);
+        gear.backup_pairs.clear();
+        gear.backup_pairs.extend(self.pp_contacts().copied());
         gear.backup_walls.clone_from(&self.wall_slots);
         let t0 = self.time_s;
         let body_backup: Vec<_> = self.bodies.iter().map(|b| (b.state, b.previous)).collect();
@@ -192,7 +197,7 @@ impl World {
                         p.angular_velocity[i] = ro[i][1];
                     }
                 }
-                self.pair_state.copy_from_slice(&gear.backup_pairs);
+                self.set_pp_contacts(&gear.backup_pairs);
                 self.wall_slots.clone_from(&gear.backup_walls);
                 inc = self.evaluate_forces(dt);
                 self.counters.force_evaluations += 1;

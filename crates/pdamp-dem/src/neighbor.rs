@@ -81,19 +81,10 @@ impl NeighborList {
         a.sqrt() + b.sqrt() >= self.skin_m
     }
 
-    /// Rebuilds the list with a cell grid and remaps the per-pair `state` so that the history of
-    /// pairs present before and after is kept; new pairs start from `S::default()`.
-    pub fn rebuild<S: Copy + Default + Send + Sync>(
-        &mut self,
-        position: &[Vec3],
-        radius: &[f64],
-        state: &mut Vec<S>,
-    ) {
+    /// Rebuilds the list with a cell grid. (Contact history is not stored here: the world keeps
+    /// its contacts by partner indices, so they survive any rebuild.)
+    pub fn rebuild(&mut self, position: &[Vec3], radius: &[f64]) {
         let n = position.len();
-        let old_row_start = std::mem::take(&mut self.row_start);
-        let old_second = std::mem::take(&mut self.second);
-        let old_state = std::mem::take(state);
-
         let r_max = radius.iter().cloned().fold(0.0, f64::max);
         let reach = self.skin_m + self.extra_range_m;
         let cell = (2.0 * r_max + reach).max(1e-12);
@@ -144,28 +135,7 @@ impl NeighborList {
             }
         }
 
-        // Carry history: merge old and new rows (both sorted by partner).
         let m = self.second.len();
-        let mut new_state = vec![S::default(); m];
-        if old_row_start.len() == n + 1 {
-            for i in 0..n {
-                let (mut a, ae) = (old_row_start[i] as usize, old_row_start[i + 1] as usize);
-                let (mut b, be) = (self.row_start[i] as usize, self.row_start[i + 1] as usize);
-                while a < ae && b < be {
-                    match old_second[a].cmp(&self.second[b]) {
-                        std::cmp::Ordering::Less => a += 1,
-                        std::cmp::Ordering::Greater => b += 1,
-                        std::cmp::Ordering::Equal => {
-                            new_state[b] = old_state[a];
-                            a += 1;
-                            b += 1;
-                        }
-                    }
-                }
-            }
-        }
-        *state = new_state;
-
         // Transposed index (counting sort by second partner, stable in pair order).
         self.col_start.clear();
         self.col_start.resize(n + 1, 0);
@@ -303,7 +273,7 @@ mod tests {
     }
 
     #[test]
-    fn list_matches_brute_force_and_keeps_history() {
+    fn list_matches_brute_force() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let n = 2000;
         let pos: Vec<Vec3> = (0..n)
@@ -319,8 +289,7 @@ mod tests {
             .map(|_| 0.0005 + 0.0005 * rng.random::<f64>())
             .collect();
         let mut list = NeighborList::new(0.0002);
-        let mut state: Vec<u64> = Vec::new();
-        list.rebuild(&pos, &rad, &mut state);
+        list.rebuild(&pos, &rad);
         let mut brute = Vec::new();
         for i in 0..n {
             for j in i + 1..n {
@@ -337,16 +306,6 @@ mod tests {
             .zip(list.second.iter().cloned())
             .collect();
         assert_eq!(got, brute);
-        // Mark every pair with a key, move particles a little, rebuild: surviving pairs keep it.
-        for (p, s) in state.iter_mut().enumerate() {
-            *s = ((list.first[p] as u64) << 32) | list.second[p] as u64;
-        }
-        let moved: Vec<Vec3> = pos.iter().map(|x| x + Vec3::new(1e-5, 0.0, 0.0)).collect();
-        list.rebuild(&moved, &rad, &mut state);
-        for (p, s) in state.iter().enumerate().take(list.num_pairs()) {
-            let key = ((list.first[p] as u64) << 32) | list.second[p] as u64;
-            assert_eq!(*s, key);
-        }
         // Transposed index covers every pair once.
         let mut seen = vec![0; list.num_pairs()];
         for j in 0..n {

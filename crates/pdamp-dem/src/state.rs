@@ -5,7 +5,7 @@
 
 use crate::body::BodyState;
 use crate::energy::EnergyLedger;
-use crate::forces::{PairOutput, PairState, WallSlot};
+use crate::forces::{PpContact, WallSlot};
 use crate::integrate::GearState;
 use crate::math::Vec3;
 use crate::neighbor::NeighborList;
@@ -43,8 +43,7 @@ pub struct WorldState {
     ledger: EnergyLedger,
     counters: Counters,
     neighbors: NeighborList,
-    pair_state: Vec<PairState>,
-    pair_output: Vec<PairOutput>,
+    contacts: Vec<PpContact>,
     wall_slots: Vec<Vec<WallSlot>>,
     gear: Option<GearState>,
     initialized: bool,
@@ -88,8 +87,7 @@ impl World {
             ledger: self.ledger,
             counters: self.counters,
             neighbors: self.neighbors.clone(),
-            pair_state: self.pair_state.clone(),
-            pair_output: self.pair_output.clone(),
+            contacts: self.pp_contacts().copied().collect(),
             wall_slots: self.wall_slots.clone(),
             gear: self.gear.clone(),
             initialized: self.initialized,
@@ -136,8 +134,10 @@ impl World {
         }
         let np = s.neighbors.first.len();
         if s.neighbors.second.len() != np
-            || s.pair_state.len() != np
-            || s.pair_output.len() != np
+            || s.contacts.iter().any(|c| c.i >= c.j || c.j as usize >= n)
+            || s.contacts
+                .windows(2)
+                .any(|w| (w[0].i, w[0].j) >= (w[1].i, w[1].j))
             || s.neighbors
                 .first
                 .iter()
@@ -166,8 +166,7 @@ impl World {
         self.ledger = s.ledger;
         self.counters = s.counters;
         self.neighbors = s.neighbors;
-        self.pair_state = s.pair_state;
-        self.pair_output = s.pair_output;
+        self.set_pp_contacts(&s.contacts);
         self.wall_slots = s.wall_slots;
         self.gear = s.gear;
         self.initialized = s.initialized;

@@ -4,7 +4,7 @@
 use crate::body::RigidBody;
 use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
-use crate::forces::{PairOutput, PairState, WallSlot};
+use crate::forces::{PairOutput, PpChunk, WallSlot};
 use crate::integrate::{GearState, Integrator};
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
@@ -23,6 +23,22 @@ pub struct Counters {
     pub force_evaluations: u64,
     /// Neighbour-list builds.
     pub neighbor_builds: u64,
+}
+
+/// Wall-clock time spent in the phases of the time step, s (collected when
+/// [`World::profile`] is `Some`; for benchmarks).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct PhaseTimes {
+    /// Kicks and drift of the integrator.
+    pub integrate_s: f64,
+    /// Neighbour-list displacement check and rebuilds.
+    pub neighbors_s: f64,
+    /// Particle–particle contact laws.
+    pub pair_forces_s: f64,
+    /// Per-particle force sums, wall contacts, gravity.
+    pub particle_forces_s: f64,
+    /// Energy ledger update (kinetic, potential) and body loads.
+    pub energies_s: f64,
 }
 
 /// A DEM simulation.
@@ -48,9 +64,16 @@ pub struct World {
     pub ledger: EnergyLedger,
     /// Work counters.
     pub counters: Counters,
+    /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
+    pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    pub(crate) pair_state: Vec<PairState>,
-    pub(crate) pair_output: Vec<PairOutput>,
+    /// Force and torques of each contact at the last evaluation (scratch).
+    pub(crate) contact_output: Vec<PairOutput>,
+    /// For every neighbour pair: index of its contact in `contacts`, or `NO_CONTACT` (scratch).
+    pub(crate) pair_contact: Vec<u32>,
+    /// Active particle–particle contacts, by chunks of first partners, with the pair loop's
+    /// scratch.
+    pub(crate) pp_chunks: Vec<PpChunk>,
     pub(crate) wall_slots: Vec<Vec<WallSlot>>,
     pub(crate) scratch_force: Vec<Vec3>,
     pub(crate) scratch_torque: Vec<Vec3>,
@@ -74,9 +97,11 @@ impl World {
             integrator: Integrator::VelocityVerlet,
             ledger: EnergyLedger::default(),
             counters: Counters::default(),
+            profile: None,
             neighbors: NeighborList::new(0.0),
-            pair_state: Vec::new(),
-            pair_output: Vec::new(),
+            contact_output: Vec::new(),
+            pair_contact: Vec::new(),
+            pp_chunks: Vec::new(),
             wall_slots: Vec::new(),
             scratch_force: Vec::new(),
             scratch_torque: Vec::new(),
@@ -112,7 +137,7 @@ impl World {
 
     /// Number of touching particle–particle contacts.
     pub fn num_pp_contacts(&self) -> usize {
-        self.pair_state.iter().filter(|s| s.active).count()
+        self.pp_chunks.iter().map(|c| c.contacts.len()).sum()
     }
 
     /// Number of touching particle–wall contacts.
@@ -273,14 +298,35 @@ impl World {
         self.initialized = true;
     }
 
+    /// Starts timing a phase (only when profiling).
+    #[inline]
+    pub(crate) fn tick(&self) -> Option<std::time::Instant> {
+        self.profile.map(|_| std::time::Instant::now())
+    }
+
+    /// Adds the time since `t` to a phase (only when profiling).
+    #[inline]
+    pub(crate) fn tock(
+        &mut self,
+        t: Option<std::time::Instant>,
+        phase: fn(&mut PhaseTimes) -> &mut f64,
+    ) {
+        if let (Some(p), Some(t)) = (self.profile.as_mut(), t) {
+            *phase(p) += t.elapsed().as_secs_f64();
+        }
+    }
+
     /// Rebuilds the neighbour list when the displacement criterion asks for it.
     pub(crate) fn update_neighbors(&mut self) {
+        let t = self.tick();
+        self.update_neighbors_untimed();
+        self.tock(t, |p| &mut p.neighbors_s);
+    }
+
+    fn update_neighbors_untimed(&mut self) {
         if self.neighbors.needs_rebuild(&self.particles.position) {
-            self.neighbors.rebuild(
-                &self.particles.position,
-                &self.particles.radius,
-                &mut self.pair_state,
-            );
+            self.neighbors
+                .rebuild(&self.particles.position, &self.particles.radius);
             self.counters.neighbor_builds += 1;
         }
     }
@@ -300,8 +346,10 @@ impl World {
             Integrator::VelocityVerlet => self.step_velocity_verlet(),
             Integrator::Gear(params) => self.step_gear(&params),
         };
+        let t = self.tick();
         self.ledger.add(&inc);
         self.refresh_state_energies();
+        self.tock(t, |p| &mut p.energies_s);
         self.counters.steps += 1;
     }
 

@@ -21,11 +21,23 @@ pub(crate) struct NormalResponse {
     pub damping_n_s_m: f64,
 }
 
-/// $\beta = \ln e / \sqrt{\ln^2 e + \pi^2}$ (LIGGGHTS; ≤ 0).
+/// $\beta = \ln e / \sqrt{\ln^2 e + \pi^2}$ (LIGGGHTS; ≤ 0). The last value per thread is
+/// remembered, so the logarithm is not taken again for every contact of the same law.
 #[inline]
 pub(crate) fn liggghts_beta(restitution: f64) -> f64 {
-    let l = restitution.ln();
-    l / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+    thread_local! {
+        static LAST: std::cell::Cell<(u64, f64)> = const { std::cell::Cell::new((u64::MAX, 0.0)) };
+    }
+    LAST.with(|c| {
+        let (key, beta) = c.get();
+        if key == restitution.to_bits() {
+            return beta;
+        }
+        let l = restitution.ln();
+        let beta = l / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt();
+        c.set((restitution.to_bits(), beta));
+        beta
+    })
 }
 
 /// Linear dashpot coefficient $d_N = 2|\ln e|\sqrt{k_N \bar M/(\ln^2 e + \pi^2)}$ [P Eq. (4)].
