@@ -230,6 +230,93 @@ pub fn sweep_frf(hist: &TimeHistory, sweep: &Sweep, cycles: usize) -> Vec<FrfPoi
     out
 }
 
+/// One segment of a sweep split for the frequency-domain approach [D Sect. 3.3.2].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SweepSegment {
+    /// The segment's own sweep (same law and rate as the full sweep).
+    pub sweep: Sweep,
+    /// FRF points below this frequency (the segment's start-up transient) are dropped, Hz.
+    pub keep_from_hz: f64,
+    /// Upper end of the kept range, Hz.
+    pub keep_to_hz: f64,
+}
+
+/// Splits a sweep into `n` segments of equal width in the law's coordinate (frequency for
+/// linear, log-frequency for logarithmic sweeps) with the same sweep rate [D Sect. 3.3.2:
+/// "the frequency range is divided up into multiple overlapping segments and calculated
+/// simultaneously. The initial transient vibration parts of each simulation are cut off"].
+/// Segment i runs over $[u_i - o, u_{i+1} + o/2]$ (o = `overlap` × width, clipped to the
+/// sweep); its first o/2 are its start-up transient and are dropped, so neighbouring kept
+/// ranges overlap by o/2, where [`peak_hold`] combines them.
+pub fn segment_sweep(sweep: &Sweep, n: usize, overlap: f64) -> Vec<SweepSegment> {
+    let n = n.max(1);
+    let f_at = |u: f64| match sweep.law {
+        SweepLaw::Linear => sweep.start_hz + (sweep.end_hz - sweep.start_hz) * u,
+        SweepLaw::Logarithmic => sweep.start_hz * (sweep.end_hz / sweep.start_hz).powf(u),
+    };
+    let w = 1.0 / n as f64;
+    let o = overlap.clamp(0.0, 1.0) * w;
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i as f64 * w, (i + 1) as f64 * w);
+            let u0 = (a - o).max(0.0);
+            let u1 = (b + 0.5 * o).min(1.0);
+            let keep0 = if i == 0 { 0.0 } else { a - 0.5 * o };
+            let (k0, k1) = (f_at(keep0), f_at(u1));
+            SweepSegment {
+                sweep: Sweep {
+                    start_hz: f_at(u0),
+                    end_hz: f_at(u1),
+                    duration_s: sweep.duration_s * (u1 - u0),
+                    law: sweep.law,
+                },
+                keep_from_hz: k0.min(k1),
+                keep_to_hz: k0.max(k1),
+            }
+        })
+        .collect()
+}
+
+/// Peak hold over segment FRFs (as the analyser's peak-hold averaging, D Sect. 8.2.1): a point
+/// of one segment is kept unless another segment that covers its frequency has a larger
+/// magnitude there (linear interpolation of |H|); the result is sorted by frequency.
+pub fn peak_hold(segments: &[Vec<FrfPoint>]) -> Vec<FrfPoint> {
+    let mag_at = |seg: &[FrfPoint], f: f64| -> Option<f64> {
+        let (lo, hi) = (seg.first()?.frequency_hz, seg.last()?.frequency_hz);
+        if f < lo || f > hi {
+            return None;
+        }
+        let j = seg.partition_point(|p| p.frequency_hz < f);
+        if j == 0 {
+            return Some(seg[0].h_m_per_n.norm());
+        }
+        let (p0, p1) = (&seg[j - 1], &seg[j.min(seg.len() - 1)]);
+        let df = p1.frequency_hz - p0.frequency_hz;
+        let t = if df > 0.0 {
+            (f - p0.frequency_hz) / df
+        } else {
+            0.0
+        };
+        Some(p0.h_m_per_n.norm() + t * (p1.h_m_per_n.norm() - p0.h_m_per_n.norm()))
+    };
+    let mut out = Vec::new();
+    for (s, seg) in segments.iter().enumerate() {
+        for p in seg {
+            let m = p.h_m_per_n.norm();
+            let beaten = segments
+                .iter()
+                .enumerate()
+                .filter(|(t, _)| *t != s)
+                .any(|(_, other)| mag_at(other, p.frequency_hz).is_some_and(|mo| mo > m));
+            if !beaten {
+                out.push(*p);
+            }
+        }
+    }
+    out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    out
+}
+
 /// Time-domain damping ratio from the resonance peak of a sweep [D Eq. 3.47].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PeakDamping {

@@ -202,6 +202,8 @@ pub fn run_couple(
             sample_every,
             window_cycles,
             mode,
+            segments,
+            segment_overlap,
         } => {
             let f = ForceSpec {
                 force_amplitude_n: *force_amplitude_n,
@@ -222,18 +224,76 @@ pub fn run_couple(
                 time_step_s: *time_step_s,
                 sample_every: *sample_every,
             };
-            let hist = match &dem {
-                Some((p, d, o)) => run_dem_sweep(&structure, d, p, &spec, *o, progress, Some(&ck))?,
-                None => forced::run_sweep(&structure, &dampers, &spec)?,
-            };
-            sweep_outputs(
-                &structure,
-                &spec,
-                &hist,
-                *window_cycles,
-                mode.saturating_sub(1),
-                out,
-            )?
+            if *segments <= 1 {
+                let hist = match &dem {
+                    Some((p, d, o)) => {
+                        run_dem_sweep(&structure, d, p, &spec, *o, progress, Some(&ck))?
+                    }
+                    None => forced::run_sweep(&structure, &dampers, &spec)?,
+                };
+                let frf = forced::sweep_frf(&hist, &spec.sweep, *window_cycles);
+                sweep_outputs(
+                    &structure,
+                    &spec,
+                    &[(hist, sweep)],
+                    frf,
+                    mode.saturating_sub(1),
+                    out,
+                )?
+            } else {
+                // Frequency-domain approach [D Sect. 3.3.2]: overlapping segments from rest,
+                // start-up transients cut off, FRFs combined by peak hold.
+                let plan = forced::segment_sweep(&sweep, *segments, *segment_overlap);
+                let n = plan.len() as f64;
+                let mut runs = Vec::new();
+                let mut seg_frfs = Vec::new();
+                let mut seg_rows = Vec::new();
+                for (i, sg) in plan.iter().enumerate() {
+                    let sspec = SweepSpec {
+                        sweep: sg.sweep,
+                        ..spec.clone()
+                    };
+                    let hist = match &dem {
+                        Some((p, d, o)) => run_dem_sweep(
+                            &structure,
+                            d,
+                            p,
+                            &sspec,
+                            *o,
+                            &mut |f| progress((i as f64 + f) / n),
+                            None,
+                        )?,
+                        None => forced::run_sweep(&structure, &dampers, &sspec)?,
+                    };
+                    let frf: Vec<_> = forced::sweep_frf(&hist, &sg.sweep, *window_cycles)
+                        .into_iter()
+                        .filter(|p| {
+                            p.frequency_hz >= sg.keep_from_hz && p.frequency_hz <= sg.keep_to_hz
+                        })
+                        .collect();
+                    for p in &frf {
+                        seg_rows.push([
+                            (i + 1) as f64,
+                            p.frequency_hz,
+                            p.h_m_per_n.norm(),
+                            p.h_m_per_n.arg(),
+                        ]);
+                    }
+                    seg_frfs.push(frf);
+                    runs.push((hist, sg.sweep));
+                }
+                write_csv_atomic(
+                    out.join("frf_segments.csv"),
+                    &["segment", "frequency_hz", "magnitude_m_per_n", "phase_rad"],
+                    &seg_rows,
+                )
+                .map_err(io)?;
+                let frf = forced::peak_hold(&seg_frfs);
+                let mut v =
+                    sweep_outputs(&structure, &spec, &runs, frf, mode.saturating_sub(1), out)?;
+                v["segment_plan"] = json!(plan);
+                v
+            }
         }
         AnalysisSpec::SteadyState {
             start_hz,
@@ -495,9 +555,10 @@ fn free_outputs(
     }))
 }
 
-/// Modal parameters of an FRF for `summary.json`: global rational fraction polynomial fit
-/// ([`modal_fit::rfp_fit`]) with as many modes as the structure has inside the band (at least
-/// one), and the half-power bandwidth around each identified resonance.
+/// Modal parameters of an FRF for `summary.json`: for every structural mode inside the band,
+/// a rational fraction polynomial fit ([`modal_fit::rfp_fit`], one mode + residual terms) of the
+/// points between the midpoints to the neighbouring modes (local fits stay robust when one mode
+/// is strongly nonlinear), and the half-power bandwidth in the same band.
 fn extract_modal_parameters(
     structure: &ModalStructure,
     frequencies_hz: &[f64],
@@ -509,51 +570,107 @@ fn extract_modal_parameters(
     let (lo, hi) = frequencies_hz
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(a, b), &f| (a.min(f), b.max(f)));
-    let n = structure
+    let mut centers: Vec<f64> = structure
         .modes
         .iter()
-        .filter(|m| m.frequency_hz >= 0.9 * lo && m.frequency_hz <= 1.1 * hi)
-        .count()
-        .max(1);
-    let mag: Vec<f64> = h.iter().map(|c| c.norm()).collect();
-    match modal_fit::rfp_fit(frequencies_hz, h, n) {
-        Ok(fit) => {
-            let centers: Vec<f64> = fit.modes.iter().map(|m| m.frequency_hz).collect();
-            let hp = modal_fit::half_power_per_mode(frequencies_hz, &mag, &centers);
-            let modes: Vec<_> = fit
-                .modes
-                .iter()
-                .zip(&hp)
-                .map(|(m, h)| {
-                    json!({
-                        "frequency_hz": m.frequency_hz,
-                        "damping_ratio": m.damping_ratio,
-                        "modal_constant_re": m.modal_constant_re,
-                        "modal_constant_im": m.modal_constant_im,
-                        "half_power_frequency_hz": h.map(|r| r.resonance_frequency_hz),
-                        "half_power_damping_ratio": h.map(|r| r.damping_ratio),
-                    })
-                })
-                .collect();
-            json!({
-                "method": fit.method,
-                "model_modes": fit.model_modes,
-                "relative_error": fit.relative_error,
-                "modes": modes,
-            })
-        }
-        Err(e) => json!({ "error": e }),
+        .map(|m| m.frequency_hz)
+        .filter(|&f| f >= lo && f <= hi)
+        .collect();
+    if centers.is_empty() {
+        // no structural mode inside: the FRF's largest peak
+        let (i, _) = h
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.norm().total_cmp(&b.1.norm()))
+            .expect("non-empty");
+        centers.push(frequencies_hz[i]);
     }
+    let mag: Vec<f64> = h.iter().map(|c| c.norm()).collect();
+    let hp = modal_fit::half_power_per_mode(frequencies_hz, &mag, &centers);
+    let modes: Vec<_> = centers
+        .iter()
+        .enumerate()
+        .map(|(k, &fc)| {
+            let a = if k == 0 {
+                lo
+            } else {
+                0.5 * (centers[k - 1] + fc)
+            };
+            let b = if k + 1 == centers.len() {
+                hi
+            } else {
+                0.5 * (centers[k + 1] + fc)
+            };
+            let idx: Vec<usize> = (0..frequencies_hz.len())
+                .filter(|&i| frequencies_hz[i] >= a && frequencies_hz[i] <= b)
+                .collect();
+            let f: Vec<f64> = idx.iter().map(|&i| frequencies_hz[i]).collect();
+            let hh: Vec<_> = idx.iter().map(|&i| h[i]).collect();
+            let fit = modal_fit::rfp_fit(&f, &hh, 1);
+            let m = fit.as_ref().ok().and_then(|r| {
+                r.modes
+                    .iter()
+                    .min_by(|x, y| {
+                        (x.frequency_hz - fc)
+                            .abs()
+                            .total_cmp(&(y.frequency_hz - fc).abs())
+                    })
+                    .copied()
+            });
+            json!({
+                "structural_frequency_hz": fc,
+                "band_hz": [a, b],
+                "frequency_hz": m.map(|m| m.frequency_hz),
+                "damping_ratio": m.map(|m| m.damping_ratio),
+                "modal_constant_re": m.map(|m| m.modal_constant_re),
+                "modal_constant_im": m.map(|m| m.modal_constant_im),
+                "fit_relative_error": fit.as_ref().ok().map(|r| r.relative_error),
+                "fit_error": fit.err(),
+                "half_power_frequency_hz": hp[k].map(|r| r.resonance_frequency_hz),
+                "half_power_damping_ratio": hp[k].map(|r| r.damping_ratio),
+            })
+        })
+        .collect();
+    json!({
+        "method": "rational fraction polynomial per mode band (Sanathanan–Koerner reweighted) + half-power bandwidth",
+        "modes": modes,
+    })
 }
 
+/// Outputs of a sweep: `runs` are the (history, sweep) of the whole sweep or of its segments,
+/// `frf` the (peak-held) FRF.
 fn sweep_outputs(
     structure: &ModalStructure,
     spec: &SweepSpec,
-    hist: &TimeHistory,
-    window_cycles: usize,
+    runs: &[(TimeHistory, Sweep)],
+    frf: Vec<forced::FrfPoint>,
     mode: usize,
     out: &Path,
 ) -> Result<serde_json::Value, String> {
+    let k = mode.min(structure.modes.len() - 1);
+    let phi_ex = structure.point(&spec.excitation_point)?[k];
+    let phi_out = structure.point(&spec.output_point)?[k];
+    // Eq. 3.47 from the run with the largest peak (the segment through the resonance)
+    let mut pk: Option<forced::PeakDamping> = None;
+    let mut peak_run = 0;
+    for (i, (h, sw)) in runs.iter().enumerate() {
+        let p = forced::peak_damping(
+            h,
+            sw,
+            spec.force_amplitude_n,
+            phi_ex,
+            phi_out,
+            structure.modes[k].omega_rad_s(),
+            None,
+        );
+        if let Some(p) = p
+            && pk.is_none_or(|q| p.max_amplitude_m > q.max_amplitude_m)
+        {
+            pk = Some(p);
+            peak_run = i;
+        }
+    }
+    let hist = &runs.get(peak_run).ok_or("no sweep run")?.0;
     let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
         .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.force_n[i]])
         .collect();
@@ -563,7 +680,6 @@ fn sweep_outputs(
         &rows,
     )
     .map_err(io)?;
-    let frf = forced::sweep_frf(hist, &spec.sweep, window_cycles);
     let frows: Vec<[f64; 3]> = frf
         .iter()
         .map(|p| [p.frequency_hz, p.h_m_per_n.norm(), p.h_m_per_n.arg()])
@@ -597,18 +713,6 @@ fn sweep_outputs(
             .collect();
         forced::rfp_single_mode(&band)
     });
-    let k = mode.min(structure.modes.len() - 1);
-    let phi_ex = structure.point(&spec.excitation_point)?[k];
-    let phi_out = structure.point(&spec.output_point)?[k];
-    let pk = forced::peak_damping(
-        hist,
-        &spec.sweep,
-        spec.force_amplitude_n,
-        phi_ex,
-        phi_out,
-        structure.modes[k].omega_rad_s(),
-        None,
-    );
     let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("displacement (m)"));
     p.series.push(Series::new(
         "output point",
@@ -626,5 +730,7 @@ fn sweep_outputs(
         "modal_parameters": modal_parameters,
         "peak_damping_eq_3_47": pk,
         "frf_points": frf.len(),
+        "segments": runs.len(),
+        "response_csv_segment": peak_run + 1,
     }))
 }

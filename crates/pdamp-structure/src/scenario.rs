@@ -674,6 +674,10 @@ fn one() -> f64 {
     1.0
 }
 
+fn default_overlap() -> f64 {
+    0.3
+}
+
 /// One layer of a rolling damper: give `clearance_m` or `container_length_m` with
 /// `particles` and `particles_per_layer` (Eq. 5.1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -882,6 +886,14 @@ pub enum AnalysisSpec {
         /// Mode analysed by Eq. 3.47 (1-based).
         #[serde(default = "one_usize")]
         mode: usize,
+        /// Split the sweep into this many overlapping segments, each started from rest, FRFs
+        /// combined by peak hold (frequency-domain approach, D Sect. 3.3.2); 1 = one sweep.
+        #[serde(default = "one_usize")]
+        segments: usize,
+        /// Overlap of neighbouring segments as a fraction of the segment width (half of it is
+        /// the cut-off start-up transient).
+        #[serde(default = "default_overlap")]
+        segment_overlap: f64,
     },
     /// Steady-state FRF of approaches 2/3 by the iteration of D Fig. 3.7 / Eq. 3.44, one mode.
     SteadyState {
