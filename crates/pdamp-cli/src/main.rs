@@ -11,6 +11,7 @@ use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
 use std::path::PathBuf;
 
 mod cor;
+mod powder;
 mod structure;
 
 #[derive(Parser)]
@@ -109,6 +110,8 @@ enum Command {
     /// Particle dampers coupled to a structure (full DEM, effective fields or formulas): free
     /// decay (decay.csv, damping.csv), sweeps or steady-state FRFs (frf.csv), summary.json, plots.
     Couple(structure::CoupleArgs),
+    /// Powder-filled cavities, two-way coupled DEM–FEM (docs/powder.md): run, study, modes.
+    Powder(powder::PowderArgs),
     /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
     Bench {
         /// Number of particles.
@@ -318,6 +321,7 @@ fn run_cli() -> Result<()> {
         Command::Cor(args) => cor::run(args),
         Command::Structure(args) => structure::run_structure(args),
         Command::Couple(args) => structure::run_couple(args),
+        Command::Powder(args) => powder::run(args),
         Command::Bench {
             particles,
             steps,

@@ -603,3 +603,36 @@ pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, Strin
         .map(|(f, _)| f)
         .map_err(|e| e.to_string())
 }
+
+/// First bending frequency of the empty beam from piecewise Timoshenko theory (solid bottom,
+/// hollow cavity part, solid top) [Hz].
+pub fn timoshenko_reference(beam: &BeamSpec) -> f64 {
+    use crate::fe::beam_theory::{Segment, timoshenko_f1};
+    let inner = beam.width_m - 2.0 * beam.wall_thickness_m;
+    let segs = [
+        Segment {
+            length_m: beam.cavity_offset_m,
+            outer_m: beam.width_m,
+            inner_m: 0.0,
+        },
+        Segment {
+            length_m: beam.cavity_length_m,
+            outer_m: beam.width_m,
+            inner_m: inner,
+        },
+        Segment {
+            length_m: beam.length_m - beam.cavity_offset_m - beam.cavity_length_m,
+            outer_m: beam.width_m,
+            inner_m: 0.0,
+        },
+    ];
+    let m = beam.material;
+    timoshenko_f1(
+        &segs,
+        m.youngs_modulus_pa,
+        m.poisson_ratio,
+        m.density_kg_m3,
+        1320,
+        &[],
+    )
+}

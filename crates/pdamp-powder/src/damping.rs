@@ -62,7 +62,7 @@ mod tests {
 
     #[test]
     fn recovers_zeta_of_a_damped_oscillator() {
-        let (zeta, f) = (0.05, 700.0);
+        let (zeta, f): (f64, f64) = (0.05, 700.0);
         let w = 2.0 * std::f64::consts::PI * f;
         let wd = w * (1.0 - zeta * zeta).sqrt();
         let t: Vec<f64> = (0..30000).map(|i| i as f64 * 1e-6).collect();

@@ -16,9 +16,11 @@
 //!
 //! Details and measured results: `docs/powder.md`.
 
+pub mod analytic;
 pub mod cantilever;
 pub mod couple;
 pub mod damping;
 pub mod dem;
 pub mod fe;
 pub mod prep;
+pub mod study;

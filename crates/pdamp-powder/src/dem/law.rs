@@ -172,6 +172,9 @@ pub fn evaluate(
         };
     }
     if gap > 0.0 {
+        // an opening contact releases its tangential spring without work: count it as lost
+        let kt = law.tangential_ratio() * law.normal_stiffness_n_m;
+        out.dissipated_j = 0.5 * kt * dot(*gt, *gt);
         *gt = [0.0; 3];
         out.force = [f_adh * n[0], f_adh * n[1], f_adh * n[2]];
         return out;
@@ -183,10 +186,12 @@ pub fn evaluate(
     let fn_signed = (k * gap + d * gdot).min(0.0); // eq. 2
     let fn_abs = -fn_signed;
     out.elastic_j = 0.5 * k * gap * gap;
+    // dashpot power d ġ²; when the force is clipped to zero (fast separation) the spring
+    // energy ½ k g² drains without doing work: rate −k g ġ
     out.dissipated_j = if k * gap + d * gdot < 0.0 {
         d * gdot * gdot * dt
     } else {
-        0.0
+        -k * gap * gdot * dt
     };
     // tangential (eq. 5)
     let kt = law.tangential_ratio() * k;
@@ -258,16 +263,17 @@ mod tests {
             ..PowderLaw::PAPER
         };
         let mut gt = [0.0; 3];
-        // overlap 1e-5 m → |f_N| = 0.05642 N; large sliding velocity → |f_T| = μ|f_N|
+        // overlap 1e-5 m → |f_N| = 0.05642 N; slip 1e-4 m in one step → k_T g_T = 0.476 N
+        // exceeds μ|f_N| = 0.0226 N → sliding with |f_T| = μ|f_N|
         let r = evaluate(
             &law,
             [0.0, 0.0, 1.0],
             -1e-5,
-            [1.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
             5e-4,
             1e-6,
             &mut gt,
-            1e-6,
+            1e-5,
         );
         assert!(r.sliding);
         assert!((r.force[0] + 0.4 * 0.05642).abs() < 1e-12);

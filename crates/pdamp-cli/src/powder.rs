@@ -1,0 +1,120 @@
+//! `pdamp powder …`: two-way coupled DEM–FEM for powder-filled cavities (library:
+//! `pdamp-powder`, scenario keys and results in docs/powder.md).
+
+use std::path::PathBuf;
+
+use anyhow::{Result, anyhow};
+use clap::{Args, Subcommand, ValueEnum};
+use pdamp_powder::cantilever::{self, CantileverScenario};
+use pdamp_powder::study::{self, StudyParameter};
+
+/// Arguments of `pdamp powder`.
+#[derive(Args)]
+pub struct PowderArgs {
+    #[command(subcommand)]
+    action: PowderAction,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ParamArg {
+    PackingDensity,
+    StiffnessFactor,
+    Friction,
+    Restitution,
+    SurfaceEnergy,
+    D50,
+    Orientation,
+}
+
+#[derive(Subcommand)]
+enum PowderAction {
+    /// Prepares the powder and runs the coupled cantilever; writes DIR/tip.csv, envelope.csv,
+    /// energy.csv, summary.json (ζ1, ζ2, ζ̄5 of paper Table 1, iterations, wall time), tip.png.
+    Run {
+        /// Cantilever scenario (TOML, examples/powder_cantilever_*.toml).
+        scenario: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// One cantilever run per value of a parameter (paper Figs. 2–6, Table 1); writes
+    /// DIR/<param>_<value>/…, DIR/table.csv, DIR/decay.png, DIR/envelope.png. Resumable.
+    Study {
+        /// Base scenario.
+        scenario: PathBuf,
+        /// Varied parameter (orientation: 0 upright, 1 upside down, 2 horizontal).
+        #[arg(long, value_enum)]
+        parameter: ParamArg,
+        /// Comma-separated values (SI; stiffness-factor multiplies k_N).
+        #[arg(long, value_delimiter = ',', required = true)]
+        values: Vec<f64>,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Eigenfrequencies of the empty beam of a scenario against Timoshenko beam theory.
+    Modes {
+        /// Scenario (only [beam] is used).
+        scenario: PathBuf,
+        /// Number of modes.
+        #[arg(long, default_value_t = 4)]
+        count: usize,
+    },
+}
+
+fn load(path: &PathBuf) -> Result<CantileverScenario> {
+    let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    CantileverScenario::from_toml(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
+}
+
+/// Runs `pdamp powder …`.
+pub fn run(args: PowderArgs) -> Result<()> {
+    let bar = indicatif::ProgressBar::new(1000);
+    let mut progress = |stage: &str, f: f64| {
+        bar.set_message(stage.to_string());
+        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+    };
+    match args.action {
+        PowderAction::Run { scenario, out } => {
+            let sc = load(&scenario)?;
+            let r = cantilever::run(&sc, &mut progress).map_err(|e| anyhow!(e))?;
+            cantilever::write_outputs(&out, &sc, &r).map_err(|e| anyhow!(e))?;
+            bar.finish_and_clear();
+            println!("{}", serde_json::to_string_pretty(&r)?);
+            eprintln!("wrote {}", out.display());
+        }
+        PowderAction::Study {
+            scenario,
+            parameter,
+            values,
+            out,
+        } => {
+            let sc = load(&scenario)?;
+            let p = match parameter {
+                ParamArg::PackingDensity => StudyParameter::PackingDensity,
+                ParamArg::StiffnessFactor => StudyParameter::StiffnessFactor,
+                ParamArg::Friction => StudyParameter::Friction,
+                ParamArg::Restitution => StudyParameter::Restitution,
+                ParamArg::SurfaceEnergy => StudyParameter::SurfaceEnergy,
+                ParamArg::D50 => StudyParameter::D50,
+                ParamArg::Orientation => StudyParameter::Orientation,
+            };
+            let rows =
+                study::run_study(&sc, p, &values, &out, &mut progress).map_err(|e| anyhow!(e))?;
+            bar.finish_and_clear();
+            println!("{}", serde_json::to_string_pretty(&rows)?);
+            eprintln!("wrote {}", out.join("table.csv").display());
+        }
+        PowderAction::Modes { scenario, count } => {
+            let sc = load(&scenario)?;
+            let f = cantilever::empty_beam_modes(&sc.beam, count).map_err(|e| anyhow!(e))?;
+            let timo = cantilever::timoshenko_reference(&sc.beam);
+            bar.finish_and_clear();
+            println!(
+                "{}",
+                serde_json::json!({ "frequencies_hz": f, "timoshenko_f1_hz": timo, "dofs": 3 * sc.beam.mesh().nodes.len() })
+            );
+        }
+    }
+    Ok(())
+}
