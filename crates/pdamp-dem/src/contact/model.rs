@@ -12,6 +12,7 @@
 
 use super::{ContactForce, ContactHistory, ContactKinematics, PairProps};
 use super::{hertz, normal};
+use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
 fn default_min_impact_velocity() -> f64 {
@@ -462,6 +463,39 @@ impl ContactModel {
         k: &ContactKinematics,
         h: &mut ContactHistory,
     ) -> ContactForce {
+        if let (
+            NormalLaw::HertzMindlin {
+                restitution,
+                clip_attractive,
+            },
+            FrictionLaw::Mindlin {
+                friction_coefficient,
+            },
+            None,
+            None,
+        ) = (&self.normal, &self.friction, &self.rolling, &self.adhesion)
+        {
+            return hertz_mindlin_history(
+                *restitution,
+                *clip_attractive,
+                *friction_coefficient,
+                p,
+                k,
+                h,
+            );
+        }
+        self.evaluate_general(p, k, h)
+    }
+
+    /// [`ContactModel::evaluate`] without the one-pass shortcut for the LIGGGHTS law pair
+    /// (kept callable so that tests can check that both give the same numbers).
+    #[inline]
+    pub(crate) fn evaluate_general(
+        &self,
+        p: &PairProps,
+        k: &ContactKinematics,
+        h: &mut ContactHistory,
+    ) -> ContactForce {
         let mut f = ContactForce::default();
         let delta = k.overlap_m;
         if delta > 0.0 {
@@ -552,5 +586,70 @@ impl ContactModel {
                 1.5 * kn * hertz::hertz_max_overlap(kn, p.m_eff_kg, v).sqrt()
             }
         }
+    }
+}
+
+/// LIGGGHTS' `hertz` + `tangential history` in one pass (the same numbers as the general path of
+/// [`ContactModel::evaluate`] for [`NormalLaw::HertzMindlin`] with [`FrictionLaw::Mindlin`] and
+/// no rolling resistance or adhesion; see `docs` of those laws and the LIGGGHTS reference). This
+/// is the law of most benchmark and comparison runs, so it is kept free of dispatch and of
+/// repeated logarithms.
+#[inline]
+fn hertz_mindlin_history(
+    restitution: f64,
+    clip_attractive: bool,
+    mu: f64,
+    p: &PairProps,
+    k: &ContactKinematics,
+    h: &mut ContactHistory,
+) -> ContactForce {
+    let delta = k.overlap_m;
+    if delta <= 0.0 {
+        *h = ContactHistory::default();
+        return ContactForce::default();
+    }
+    if h.impact_velocity_m_s == 0.0 {
+        h.impact_velocity_m_s = k.overlap_rate_m_s.max(default_min_impact_velocity());
+    }
+    let damping = -2.0 * (5.0_f64 / 6.0).sqrt() * normal::liggghts_beta(restitution);
+    // Normal: a = √(R δ), S_n = 2 E a, k_n = 4/3 E a, γ_n = −2 √(5/6) β √(S_n m*).
+    let a = (p.r_eff_m * delta).sqrt();
+    let sn = 2.0 * p.e_eff_pa * a;
+    let kn = 4.0 / 3.0 * p.e_eff_pa * a;
+    let gamma_n = damping * (sn * p.m_eff_kg).sqrt();
+    let elastic = kn * delta;
+    let mut dissipative = gamma_n * k.overlap_rate_m_s;
+    if clip_attractive {
+        dissipative = dissipative.max(-elastic);
+    }
+    // Tangential: ξ += v_t Δt projected on the tangent plane; Coulomb cut-off at μ|F_n|.
+    let nrm = k.normal;
+    let vt = crate::math::tangential_part(&k.tangential_velocity_m_s, &nrm);
+    let kt = 8.0 * p.g_eff_pa * a;
+    let gamma_t = damping * (kt * p.m_eff_kg).sqrt();
+    let mut xi = h.spring_m + vt * k.dt_s;
+    xi -= nrm * xi.dot(&nrm);
+    let shear_len = xi.norm();
+    let ft_shear = kt * shear_len;
+    let ft_friction = mu * (elastic + dissipative).abs();
+    let ft = if ft_shear > ft_friction {
+        if shear_len != 0.0 {
+            let f = -kt * xi * (ft_friction / ft_shear);
+            xi = -f / kt;
+            f
+        } else {
+            Vec3::zeros()
+        }
+    } else {
+        -kt * xi - gamma_t * vt
+    };
+    h.spring_m = xi;
+    ContactForce {
+        normal_elastic_n: elastic,
+        normal_dissipative_n: dissipative,
+        tangential_n: ft,
+        rolling_torque_nm: Vec3::zeros(),
+        normal_energy_j: 0.4 * kn * delta * delta,
+        tangential_energy_j: 0.5 * kt * xi.norm_squared(),
     }
 }
