@@ -153,6 +153,9 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// Geometric candidate: (face, s, t, closest point, interior, face normal, gap, contact normal).
+type GeoHit = (u32, f64, f64, [f64; 3], bool, [f64; 3], f64, [f64; 3]);
+
 /// One particle–face contact of an evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 struct Hit {
@@ -479,7 +482,7 @@ impl Coupled {
                 let pos = powder.pos[i];
                 let r = powder.radius[i];
                 // gather geometric contacts
-                let mut geo: [(u32, f64, f64, [f64; 3], bool, [f64; 3], f64, [f64; 3]); 8] =
+                let mut geo: [GeoHit; 8] =
                     [(0, 0.0, 0.0, [0.0; 3], false, [0.0; 3], 0.0, [0.0; 3]); 8];
                 let mut ng = 0;
                 for &fi in list {

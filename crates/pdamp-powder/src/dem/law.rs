@@ -146,6 +146,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// point relative to the partner's [m/s]; `gt`: tangential spring $\mathbf g_T$ (history, updated
 /// in place; reset to zero when the contact opens); `dt`: time step [s].
 #[inline]
+#[allow(clippy::too_many_arguments)] // the contact kinematics, all scalars/vectors of one pair
 pub fn evaluate(
     law: &PowderLaw,
     n: [f64; 3],

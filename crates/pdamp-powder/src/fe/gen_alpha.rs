@@ -1,10 +1,9 @@
 //! Generalized-α time integration (Chung & Hulbert 1993, paper ref. [32]) of eq. 11 with Newton
 //! iterations and a sparse Cholesky solver.
 //!
-//! Balance at the generalized midpoint:
-//! $\mathbf M\mathbf a_{n+1-\alpha_m} + \mathbf C\mathbf v_{n+1-\alpha_f}
-//! + (1-\alpha_f)\mathbf F_{int}(\mathbf d_{n+1}) + \alpha_f\mathbf F_{int}(\mathbf d_n)
-//! = (1-\alpha_f)\mathbf F_{ext,n+1} + \alpha_f\mathbf F_{ext,n}$ with Newmark updates and
+//! Balance at the generalized midpoint (forces averaged, "TR-like"):
+//! $\mathbf M\mathbf a_{n+1-\alpha_m} + \mathbf C\mathbf v_{n+1-\alpha_f} + (1-\alpha_f)\mathbf F_{int}(\mathbf d_{n+1}) + \alpha_f\mathbf F_{int}(\mathbf d_n) = (1-\alpha_f)\mathbf F_{ext,n+1} + \alpha_f\mathbf F_{ext,n}$,
+//! with Newmark updates and
 //! $\alpha_m = \frac{2\rho_\infty-1}{\rho_\infty+1}$, $\alpha_f = \frac{\rho_\infty}{\rho_\infty+1}$,
 //! $\gamma = \tfrac12-\alpha_m+\alpha_f$, $\beta = \tfrac14(1-\alpha_m+\alpha_f)^2$.
 //! For ρ∞ = 0.8 this gives β = 0.30864, γ = 0.61111 as in paper Table A.3 (which lists

@@ -23,7 +23,7 @@ pub struct CsrMatrix {
 impl CsrMatrix {
     /// Builds the matrix from (row, col, value) triplets, summing duplicates.
     pub fn from_triplets(n: usize, mut t: Vec<(usize, usize, f64)>) -> Self {
-        t.sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+        t.sort_unstable_by_key(|a| (a.0, a.1));
         let mut m = CsrMatrix {
             n,
             row_ptr: vec![0; n + 1],
