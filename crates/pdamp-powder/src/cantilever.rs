@@ -477,7 +477,7 @@ pub fn run(
             res.tip_m.push(x);
             res.iterations.push(it as f64);
         }
-        if q % e_every == 0 {
+        if q % e_every == 0 || q == 1 {
             res.energy.push((t, c.energy()));
         }
         if q % 200 == 0 {
@@ -488,7 +488,7 @@ pub fn run(
     res.mean_iterations = c.total_iterations as f64 / c.steps.max(1) as f64;
     res.max_iterations = c.max_iterations_seen;
     res.damping = damping::table_one(&res.time_s, &res.tip_m, t_release);
-    let b0 = res.energy[0].1.balance_j;
+    let b0 = res.energy[1.min(res.energy.len() - 1)].1.balance_j; // after step 1: wall springs known
     let emax = res
         .energy
         .iter()
@@ -502,6 +502,7 @@ pub fn run(
     res.energy_closure = res
         .energy
         .iter()
+        .skip(1)
         .map(|(_, e)| (e.balance_j - b0).abs())
         .fold(0.0, f64::max)
         / emax;

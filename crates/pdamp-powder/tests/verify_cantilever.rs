@@ -45,9 +45,10 @@ fn reduced_cantilever_runs_and_damps() {
     assert!(r.mean_iterations < 5.0);
     let z1 = r.damping.zeta_1.expect("two minima after release");
     assert!(z1 > 0.0 && z1 < 0.5, "{z1}");
-    // dissipative run: the dissipation ledger is a per-step estimate (docs/powder.md); the
-    // elastic coupled closure is checked to 1e-3 in verify_coupling.rs
-    assert!(r.energy_closure < 0.5, "{}", r.energy_closure);
+    // dissipative run: stored + dissipated − load work stays constant (1.2e-3 of the largest
+    // stored energy measured; the elastic coupled closure is checked in verify_coupling.rs)
+    assert!(r.energy_closure < 5e-3, "{}", r.energy_closure);
+}", r.energy_closure);
 }
 
 #[test]
