@@ -48,7 +48,6 @@ fn reduced_cantilever_runs_and_damps() {
     // dissipative run: stored + dissipated − load work stays constant (1.2e-3 of the largest
     // stored energy measured; the elastic coupled closure is checked in verify_coupling.rs)
     assert!(r.energy_closure < 5e-3, "{}", r.energy_closure);
-}", r.energy_closure);
 }
 
 #[test]
