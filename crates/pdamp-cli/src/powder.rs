@@ -70,9 +70,18 @@ fn load(path: &PathBuf) -> Result<CantileverScenario> {
 /// Runs `pdamp powder …`.
 pub fn run(args: PowderArgs) -> Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
+    // without a terminal (background runs) print a line per stage and 5 % step on stderr
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let clock = std::time::Instant::now();
+    let mut last = (String::new(), -1i64);
     let mut progress = |stage: &str, f: f64| {
         bar.set_message(stage.to_string());
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+        let pct = (f * 20.0).floor() as i64 * 5;
+        if !tty && (stage != last.0 || pct != last.1) {
+            eprintln!("[{:8.1} s] {stage} {pct} %", clock.elapsed().as_secs_f64());
+            last = (stage.to_string(), pct);
+        }
     };
     match args.action {
         PowderAction::Run { scenario, out } => {
