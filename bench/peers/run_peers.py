@@ -9,6 +9,7 @@ energy balance P = (W_box - dE_kin - dE_pot) / T of each code, which must agree 
 
 Usage: python3 bench/peers/run_peers.py [--sizes 1000,8000,32000] [--threads 1,2]
                                         [--steps 5000] [--work target/peers]
+(PDAMP_BIN=path/to/pdamp skips the release build.)
 """
 import argparse
 import json
@@ -37,6 +38,8 @@ def ensure_liggghts():
 
 
 def pdamp_binary():
+    if os.environ.get("PDAMP_BIN"):
+        return os.environ["PDAMP_BIN"]
     sh(["cargo", "build", "--release", "-p", "pdamp-cli"], cwd=ROOT)
     return os.path.join(ROOT, "target", "release", "pdamp")
 

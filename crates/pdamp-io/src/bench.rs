@@ -106,6 +106,8 @@ pub struct PeerRun {
     pub neighbor_pairs: usize,
     /// Touching particle–particle contacts at the end.
     pub contacts_pp: usize,
+    /// Touching particle–wall contacts at the end.
+    pub contacts_pw: usize,
     /// Neighbour-list builds during the timed steps.
     pub neighbor_builds: u64,
     /// Where the time went.
@@ -149,6 +151,7 @@ pub fn run_peer(world: &mut World, steps: u64) -> PeerRun {
         dissipated_power_w: balance / duration.max(1e-300),
         neighbor_pairs: world.num_neighbor_pairs(),
         contacts_pp: world.num_pp_contacts(),
+        contacts_pw: world.num_pw_contacts(),
         neighbor_builds: world.counters.neighbor_builds - builds0,
         phases: world.profile.take().unwrap_or_default(),
     }
