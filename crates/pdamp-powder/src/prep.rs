@@ -149,20 +149,21 @@ pub fn prepare(
     ];
     let mut hist = vec![EMPTY_SLOTS; n];
     let mut steps = 0u64;
-    let step = |p: &mut Powder, planes: &[PlaneWall], hist: &mut Vec<_>| -> Vec<[f64; 3]> {
-        p.predict();
-        p.pair_forces();
-        let f = wall::plane_forces(p, planes, hist);
-        p.finish();
-        f
-    };
+    let mut on_wall = [[0.0; 3]; 6];
+    let step =
+        |p: &mut Powder, planes: &[PlaneWall], hist: &mut Vec<_>, on_wall: &mut [[f64; 3]; 6]| {
+            p.predict();
+            p.pair_forces();
+            wall::plane_forces(p, planes, hist, on_wall);
+            p.finish();
+        };
     let mtot: f64 = p.mass.iter().sum();
     // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
     let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
     let t_end = s.max_settling_time_s;
     while p.t < t_end {
         for _ in 0..200 {
-            step(&mut p, &planes, &mut hist);
+            step(&mut p, &planes, &mut hist, &mut on_wall);
             steps += 1;
         }
         let ke = p.kinetic_energy();
@@ -175,7 +176,7 @@ pub fn prepare(
     p.gravity = g0;
     let relax_steps = (s.relax_time_s / dt).ceil() as u64;
     for _ in 0..relax_steps {
-        step(&mut p, &planes, &mut hist);
+        step(&mut p, &planes, &mut hist, &mut on_wall);
         steps += 1;
     }
     let bed_top = p
@@ -198,7 +199,7 @@ pub fn prepare(
         planes[5].velocity = [0.0, 0.0, -dz / dt];
         for q in 0..nsteps {
             planes[5].point[2] = bed_top - dz * (q + 1) as f64;
-            step(&mut p, &planes, &mut hist);
+            step(&mut p, &planes, &mut hist, &mut on_wall);
             steps += 1;
             if q % 500 == 0 {
                 progress("compressing", q as f64 / nsteps as f64);
@@ -208,8 +209,8 @@ pub fn prepare(
     planes[5].point[2] = cavity.max[2];
     planes[5].velocity = [0.0; 3];
     for q in 0..relax_steps {
-        let f = step(&mut p, &planes, &mut hist);
-        plate_force = f[5][2];
+        step(&mut p, &planes, &mut hist, &mut on_wall);
+        plate_force = on_wall[5][2];
         steps += 1;
         if q % 500 == 0 {
             progress("relaxing", q as f64 / relax_steps as f64);

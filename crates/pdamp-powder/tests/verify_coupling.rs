@@ -101,7 +101,7 @@ fn bouncing_and_resting_particle_matches_rigid_plate() {
     for _ in 0..steps {
         p.predict();
         p.pair_forces();
-        wall::plane_forces(&mut p, &plane, &mut hist);
+        wall::plane_forces(&mut p, &plane, &mut hist, &mut [[0.0; 3]]);
         p.finish();
         f_rigid.push(p.wall_force[0][2]);
     }

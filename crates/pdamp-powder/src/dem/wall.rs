@@ -66,9 +66,20 @@ pub fn particle_wall(
 }
 
 /// Writes the forces of the rigid `planes` into `p.wall_force`/`p.wall_torque` (overwriting) and
-/// books the dissipation; returns the total force the particles exert on each plane [N].
-pub fn plane_forces(p: &mut Powder, planes: &[PlaneWall], hist: &mut [WallSlots]) -> Vec<[f64; 3]> {
-    let mut on_wall = vec![[0.0; 3]; planes.len()];
+/// books the dissipation; `on_wall[w]` receives the total force the particles exert on plane `w`
+/// [N] (no allocation per step).
+///
+/// # Panics
+/// If `on_wall` is shorter than `planes`.
+pub fn plane_forces(
+    p: &mut Powder,
+    planes: &[PlaneWall],
+    hist: &mut [WallSlots],
+    on_wall: &mut [[f64; 3]],
+) {
+    on_wall[..planes.len()]
+        .iter_mut()
+        .for_each(|f| *f = [0.0; 3]);
     let range = p
         .law
         .adhesion_range(p.radius.iter().fold(0.0f64, |m, &r| m.max(r)));
@@ -107,5 +118,4 @@ pub fn plane_forces(p: &mut Powder, planes: &[PlaneWall], hist: &mut [WallSlots]
         p.wall_torque[i] = t;
     }
     p.ledger.dissipated_pw_j += diss;
-    on_wall
 }
