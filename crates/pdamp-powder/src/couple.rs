@@ -49,46 +49,14 @@ impl Interface {
     }
 }
 
-/// Bilinear shape functions of a quad at (s, t).
-#[inline]
-fn quad_n(s: f64, t: f64) -> [f64; 4] {
-    [
-        (1.0 - s) * (1.0 - t) / 4.0,
-        (1.0 + s) * (1.0 - t) / 4.0,
-        (1.0 + s) * (1.0 + t) / 4.0,
-        (1.0 - s) * (1.0 + t) / 4.0,
-    ]
-}
-
 /// Closest point on a bilinear quad with corner positions `x` to `p`: returns (s, t, point,
 /// interior, unit normal of the quad at the point (right-hand rule of the node order)).
 pub fn closest_point(x: &[[f64; 3]; 4], p: [f64; 3]) -> (f64, f64, [f64; 3], bool, [f64; 3]) {
     let (mut s, mut t) = (0.0f64, 0.0f64);
     let mut interior = true;
     for _ in 0..8 {
-        let n = quad_n(s, t);
-        let ds = [
-            -(1.0 - t) / 4.0,
-            (1.0 - t) / 4.0,
-            (1.0 + t) / 4.0,
-            -(1.0 + t) / 4.0,
-        ];
-        let dt = [
-            -(1.0 - s) / 4.0,
-            -(1.0 + s) / 4.0,
-            (1.0 + s) / 4.0,
-            (1.0 - s) / 4.0,
-        ];
-        let mut c = [0.0; 3];
-        let mut a = [0.0; 3];
-        let mut b = [0.0; 3];
-        for k in 0..4 {
-            for q in 0..3 {
-                c[q] += n[k] * x[k][q];
-                a[q] += ds[k] * x[k][q];
-                b[q] += dt[k] * x[k][q];
-            }
-        }
+        let qp = crate::fe::quad::point(x, s, t);
+        let (c, a, b) = (qp.x, qp.dxds, qp.dxdt);
         let r = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
         let (aa, ab, bb) = (dot(a, a), dot(a, b), dot(b, b));
         let (ra, rb) = (dot(r, a), dot(r, b));
@@ -105,30 +73,9 @@ pub fn closest_point(x: &[[f64; 3]; 4], p: [f64; 3]) -> (f64, f64, [f64; 3], boo
             break;
         }
     }
-    let n = quad_n(s, t);
-    let ds = [
-        -(1.0 - t) / 4.0,
-        (1.0 - t) / 4.0,
-        (1.0 + t) / 4.0,
-        -(1.0 + t) / 4.0,
-    ];
-    let dt = [
-        -(1.0 - s) / 4.0,
-        -(1.0 + s) / 4.0,
-        (1.0 + s) / 4.0,
-        (1.0 - s) / 4.0,
-    ];
-    let mut c = [0.0; 3];
-    let mut a = [0.0; 3];
-    let mut b = [0.0; 3];
-    for k in 0..4 {
-        for q in 0..3 {
-            c[q] += n[k] * x[k][q];
-            a[q] += ds[k] * x[k][q];
-            b[q] += dt[k] * x[k][q];
-        }
-    }
-    let nn = cross(a, b);
+    let qp = crate::fe::quad::point(x, s, t);
+    let (c, a, b) = (qp.x, qp.dxds, qp.dxdt);
+    let nn = crate::fe::quad::cross(a, b);
     let l = dot(nn, nn).sqrt();
     (
         s,
@@ -142,15 +89,6 @@ pub fn closest_point(x: &[[f64; 3]; 4], p: [f64; 3]) -> (f64, f64, [f64; 3], boo
 #[inline]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Geometric candidate: (face, s, t, closest point, interior, face normal, gap, contact normal).
@@ -540,7 +478,7 @@ impl Coupled {
                     }
                     let (fi, s, t, _, _, _, gap, n) = geo[a];
                     let f = &faces[fi as usize];
-                    let nsh = quad_n(s, t);
+                    let nsh = crate::fe::quad::shape(s, t);
                     let mut vw = [0.0; 3];
                     for q in 0..4 {
                         for k in 0..3 {
@@ -574,7 +512,7 @@ impl Coupled {
         for res in &self.results {
             for h in &res.hits[..res.nhits as usize] {
                 let f = &self.interface.faces[h.face as usize];
-                let nsh = quad_n(h.s, h.t);
+                let nsh = crate::fe::quad::shape(h.s, h.t);
                 for q in 0..4 {
                     for k in 0..3 {
                         self.f_trial[3 * f.nodes[q] + k] -= nsh[q] * h.force[k];

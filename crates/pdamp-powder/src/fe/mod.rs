@@ -6,6 +6,7 @@ pub mod beam_theory;
 pub mod gen_alpha;
 pub mod mesh;
 pub mod modes;
+pub mod quad;
 pub mod sparse;
 pub mod structure;
 pub mod svk;

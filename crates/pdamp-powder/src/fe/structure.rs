@@ -249,37 +249,9 @@ pub fn face_weights(nodes: &[[f64; 3]], f: &Face) -> [f64; 4] {
     let g = 0.577_350_269_189_625_8;
     let mut w = [0.0; 4];
     for (s, t) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
-        let n = [
-            (1.0 - s) * (1.0 - t) / 4.0,
-            (1.0 + s) * (1.0 - t) / 4.0,
-            (1.0 + s) * (1.0 + t) / 4.0,
-            (1.0 - s) * (1.0 + t) / 4.0,
-        ];
-        let ds = [
-            -(1.0 - t) / 4.0,
-            (1.0 - t) / 4.0,
-            (1.0 + t) / 4.0,
-            -(1.0 + t) / 4.0,
-        ];
-        let dt = [
-            -(1.0 - s) / 4.0,
-            -(1.0 + s) / 4.0,
-            (1.0 + s) / 4.0,
-            (1.0 - s) / 4.0,
-        ];
-        let mut a = [0.0; 3];
-        let mut b = [0.0; 3];
-        for k in 0..4 {
-            for i in 0..3 {
-                a[i] += ds[k] * x[k][i];
-                b[i] += dt[k] * x[k][i];
-            }
-        }
-        let c = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ];
+        let qp = super::quad::point(&x, s, t);
+        let n = qp.n;
+        let c = super::quad::cross(qp.dxds, qp.dxdt);
         let j = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
         for k in 0..4 {
             w[k] += n[k] * j;
