@@ -1,7 +1,20 @@
 //! Coupling approach 1: full DEM [D Sect. 3.3, Fig. 3.6]. The container of a settled
-//! [`pdamp_design::Damper`] is moved every step with the damper point of the modal structure
-//! (1D along the damper's excitation direction, D Eq. 3.24–3.26), and the contact force of the
-//! particles on the container goes back into the modal equations as $f_{pd}$ [D Eq. 3.23].
+//! [`pdamp_design::Damper`] is moved every step with the damper node of the modal structure,
+//! and the contact loads of the particles on the container go back into the modal equations as
+//! $f_{pd}$ [D Eq. 3.23].
+//!
+//! Kinematics ([`DemKinematics`]):
+//! - 1D (default): the container translates along the damper's excitation direction $e$ with
+//!   the damper point, $x = \phi_{pd}^T q$ [D Eq. 3.24–3.26]; $Q = \phi_{pd}(F\cdot e)$.
+//! - rigid body: the three translations $u = \Phi_u q$ of the damper node (one structure point
+//!   per axis of the DEM frame, which is taken as the structure's global frame) and, where the
+//!   mode shapes provide rotational dof at the node, the three small rotations
+//!   $\theta = \Phi_\theta q$ [D Eq. 3.21–3.26 per dof]. A material point $y$ of the container
+//!   moves to $a + u + R(\theta)(y - a)$ about the attachment point $a$ ($R = \exp[\theta]_\times$,
+//!   angular velocity $\dot\theta$), so wall velocities are $v + \omega\times r$ in the contacts.
+//!   The contact force $F$ and the torque about the moving attachment point
+//!   $T_a = T_{ref} + (x_{ref} - a)\times F$ are projected back:
+//!   $Q = \Phi_u^T F + \Phi_\theta^T T_a$ (virtual work of the rigid container).
 //!
 //! Scheme: the modal coordinates are advanced by the same velocity-Verlet rule as the particles,
 //! interleaved with the DEM step, so structure + particles form one explicit symplectic system
@@ -12,15 +25,21 @@
 //! DEM step gives the contact force at $t_{n+1}$; kick $\dot q_{n+1}$ with it. The modal time
 //! step is the DEM step (stable while $\omega_{max}\Delta t < 2$). The container's
 //! own mass belongs to the structure model (a point mass at the damper point). The static
-//! weight of the bed along the direction is subtracted when `compensate_static_weight` is set,
-//! so displacements are measured from the loaded equilibrium (D Sect. 7.2.1 neglects the static
+//! weight of the bed (and in the rigid-body mode its moment about the attachment point in the
+//! settled configuration) is subtracted when `compensate_static_weight` is set, so
+//! displacements are measured from the loaded equilibrium (D Sect. 7.2.1 neglects the static
 //! deflection by the particles).
+//!
+//! Energy: [`DemEnergy`] accumulates the work the structure does on the bed,
+//! $W_{s\to b} = -\sum \tfrac12(Q_n + Q_{n+1})\cdot(q_{n+1} - q_n)$, next to the DEM ledger
+//! (wall work, bed energy change, dissipation), so the exchange can be checked to close.
 
 use crate::forced::SweepSpec;
 use crate::free::{FreeVibrationSpec, TimeHistory};
 use crate::integrate::{ModalIntegrator, generalized_force};
 use crate::modal::ModalStructure;
 use nalgebra::DVector;
+use pdamp_dem::math::Rotation;
 use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3, WorldState};
 use pdamp_design::Damper;
 use serde::{Deserialize, Serialize};
@@ -59,6 +78,10 @@ struct CoupledState {
     displacement: Vec<f64>,
     velocity: Vec<f64>,
     force: Vec<f64>,
+    #[serde(default)]
+    energy: DemEnergy,
+    #[serde(default)]
+    q_load: Option<DVector<f64>>,
 }
 
 /// Container motion over one step: the structure's state at `t1` extrapolated quadratically.
@@ -81,11 +104,181 @@ impl PrescribedMotion for Track {
     }
 }
 
+/// Rigid-body container motion over one step: translation $u$ of the attachment point and
+/// small rotation $\theta$ about it, both extrapolated quadratically from `t1`. The offset of
+/// the body reference point (lever `arm` = reference point − attachment point at rest) is
+/// $u + (R - I)\,arm$, its velocity $\dot u + \omega \times R\,arm$, with $R = \exp[\theta]_\times$
+/// and $\omega = \dot\theta$ (small rotations, D Eq. 3.24–3.26 per dof).
+#[derive(Debug, Clone, Copy)]
+struct RigidTrack {
+    t1: f64,
+    u1: Vec3,
+    v1: Vec3,
+    a1: Vec3,
+    th1: Vec3,
+    w1: Vec3,
+    al1: Vec3,
+    arm: Vec3,
+    rotate: bool,
+}
+
+impl PrescribedMotion for RigidTrack {
+    fn offset(&self, t_s: f64) -> BodyState {
+        let s = t_s - self.t1;
+        let mut b = BodyState::at_rest(self.u1 + self.v1 * s + self.a1 * (0.5 * s * s));
+        b.velocity_m_s = self.v1 + self.a1 * s;
+        if self.rotate {
+            let th = self.th1 + self.w1 * s + self.al1 * (0.5 * s * s);
+            let w = self.w1 + self.al1 * s;
+            let r = Rotation::from_scaled_axis(th);
+            let ra = r.transform_vector(&self.arm);
+            b.position_m += ra - self.arm;
+            b.velocity_m_s += w.cross(&ra);
+            b.orientation = r;
+            b.angular_velocity_rad_s = w;
+        }
+        b
+    }
+}
+
+/// Which rigid-body dof of the container follow the structure.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum DemKinematics {
+    /// 1D translation along the damper's excitation direction at the damper point.
+    #[default]
+    OneDimensional,
+    /// Rigid container: translations and optionally small rotations of the damper node.
+    Rigid(RigidKinematics),
+}
+
+/// Structure points of the rigid-body coupling: one point per axis of the DEM frame (x, y, z);
+/// `None` = that dof is not moved (e.g. a fixed dof of a planar model).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RigidKinematics {
+    /// Points of the translations u_x, u_y, u_z (m per modal coordinate).
+    pub translation_points: [Option<String>; 3],
+    /// Points of the rotations θ_x, θ_y, θ_z (rad per modal coordinate); `None`: translation only.
+    pub rotation_points: Option<[Option<String>; 3]>,
+    /// Attachment point a in the damper scenario's frame, m (rotation centre, torque
+    /// reference); `None`: the container's reference position.
+    pub attachment_point_m: Option<Vec3>,
+}
+
 /// Options of the DEM coupling.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct DemCoupling {
     /// Subtract the static bed weight along the direction from the contact force.
     pub compensate_static_weight: bool,
+    /// 1D or rigid-body kinematics.
+    pub kinematics: DemKinematics,
+}
+
+/// Energy exchange of a coupled DEM run since its start, J (see the module documentation).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct DemEnergy {
+    /// Work done by the structure on the bed through the container,
+    /// $-\sum\tfrac12(Q_n+Q_{n+1})\cdot\Delta q$ (with the static weight compensated, the
+    /// compensating load is included).
+    pub structure_work_on_bed_j: f64,
+    /// Work of the moving walls on the particles from the DEM ledger.
+    pub wall_work_j: f64,
+    /// Change of kinetic + potential + elastic contact energy of the bed.
+    pub bed_energy_change_j: f64,
+    /// Energy dissipated in the contacts.
+    pub dissipated_j: f64,
+    /// Change of the modal energy ½q̇ᵀq̇ + ½qᵀΩq of the structure.
+    pub structure_energy_change_j: f64,
+}
+
+/// Mode-shape rows of the rigid-body coupling, resolved against the structure.
+struct RigidRows {
+    tr: [Vec<f64>; 3],
+    rot: Option<[Vec<f64>; 3]>,
+    arm: Vec3,
+    attach: Vec3,
+    static_torque: Vec3,
+}
+
+impl RigidRows {
+    fn vec(rows: &[Vec<f64>; 3], x: &DVector<f64>) -> Vec3 {
+        Vec3::new(
+            crate::integrate::dot(&rows[0], x.as_slice()),
+            crate::integrate::dot(&rows[1], x.as_slice()),
+            crate::integrate::dot(&rows[2], x.as_slice()),
+        )
+    }
+    fn rot_vec(&self, x: &DVector<f64>) -> Vec3 {
+        self.rot.as_ref().map_or(Vec3::zeros(), |r| Self::vec(r, x))
+    }
+    /// $Q = \Phi_u^T F + \Phi_\theta^T T$.
+    fn project(&self, f: &Vec3, t: &Vec3) -> DVector<f64> {
+        let n = self.tr[0].len();
+        DVector::from_iterator(
+            n,
+            (0..n).map(|k| {
+                let mut q = self.tr[0][k] * f.x + self.tr[1][k] * f.y + self.tr[2][k] * f.z;
+                if let Some(r) = &self.rot {
+                    q += r[0][k] * t.x + r[1][k] * t.y + r[2][k] * t.z;
+                }
+                q
+            }),
+        )
+    }
+}
+
+/// Kinematics resolved for one run.
+enum Resolved {
+    OneD { pd: Vec<f64>, e: Vec3 },
+    Rigid(RigidRows),
+}
+
+fn resolve_kinematics(
+    structure: &ModalStructure,
+    damper: &Damper,
+    damper_point: &str,
+    k: &DemKinematics,
+) -> Result<Resolved, String> {
+    let n = structure.modes.len();
+    let rows = |pts: &[Option<String>; 3], what: &str| -> Result<[Vec<f64>; 3], String> {
+        let mut out = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        for (o, p) in out.iter_mut().zip(pts) {
+            if let Some(p) = p {
+                *o = structure
+                    .point(p)
+                    .map_err(|e| format!("{what}: {e}"))?
+                    .to_vec();
+            }
+        }
+        Ok(out)
+    };
+    match k {
+        DemKinematics::OneDimensional => Ok(Resolved::OneD {
+            pd: structure.point(damper_point)?.to_vec(),
+            e: damper.direction,
+        }),
+        DemKinematics::Rigid(r) => {
+            let tr = rows(&r.translation_points, "translation_points")?;
+            let rot = match &r.rotation_points {
+                Some(p) => Some(rows(p, "rotation_points")?),
+                None => None,
+            };
+            let w = &damper.settled;
+            let xref = w.bodies[damper.container].reference.position_m;
+            let attach = r.attachment_point_m.unwrap_or(xref);
+            // moment of the settled bed's weight about the attachment point
+            let mut static_torque = Vec3::zeros();
+            for (p, m) in w.particles.position.iter().zip(&w.particles.mass) {
+                static_torque += (p - attach).cross(&(w.gravity_m_s2 * *m));
+            }
+            Ok(Resolved::Rigid(RigidRows {
+                tr,
+                rot,
+                arm: xref - attach,
+                attach,
+                static_torque,
+            }))
+        }
+    }
 }
 
 /// Excitation of a coupled DEM run.
@@ -94,13 +287,19 @@ enum Load<'a> {
     Sweep(&'a SweepSpec, Vec<f64>),
 }
 
+/// Result of [`coupled_run`].
+struct CoupledResult {
+    history: TimeHistory,
+    energy: DemEnergy,
+}
+
 #[allow(clippy::too_many_arguments)] // private driver shared by the two public entry points
 fn coupled_run(
     structure: &ModalStructure,
     damper: &Damper,
     damper_point: &str,
     output_point: &str,
-    opts: DemCoupling,
+    opts: &DemCoupling,
     q0: DVector<f64>,
     v0: DVector<f64>,
     duration_s: f64,
@@ -108,45 +307,110 @@ fn coupled_run(
     load: Load,
     progress: &mut dyn FnMut(f64),
     ck: Option<&CouplingCheckpoint>,
-) -> Result<TimeHistory, String> {
+) -> Result<CoupledResult, String> {
     use pdamp_io::checkpoint as cp;
     structure.validate()?;
-    let pd = structure.point(damper_point)?.to_vec();
+    let kin = resolve_kinematics(structure, damper, damper_point, &opts.kinematics)?;
     let out = structure.point(output_point)?.to_vec();
     let dt = damper.time_step_s;
-    let e = damper.direction;
     let mut it = ModalIntegrator::new(structure, dt);
     it.q = q0;
     it.v = v0;
-    let x0 = it.displacement(&pd);
-    let vx0 = it.velocity(&pd);
     let mut w = damper.settled.clone();
-    // Move the settled bed with the container's initial displacement and velocity.
-    for (p, v) in w
-        .particles
-        .position
-        .iter_mut()
-        .zip(w.particles.velocity.iter_mut())
-    {
-        *p += e * x0;
-        *v += e * vx0;
-    }
     let c = damper.container;
     w.dt_s = dt;
-    w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
-        direction: e,
-        t1: 0.0,
-        x1: x0,
-        v1: vx0,
-        a1: 0.0,
-    }));
+    match &kin {
+        Resolved::OneD { pd, e } => {
+            let x0 = it.displacement(pd);
+            let vx0 = it.velocity(pd);
+            // Move the settled bed with the container's initial displacement and velocity.
+            for (p, v) in w
+                .particles
+                .position
+                .iter_mut()
+                .zip(w.particles.velocity.iter_mut())
+            {
+                *p += e * x0;
+                *v += e * vx0;
+            }
+            w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
+                direction: *e,
+                t1: 0.0,
+                x1: x0,
+                v1: vx0,
+                a1: 0.0,
+            }));
+        }
+        Resolved::Rigid(r) => {
+            let (u0, du0) = (RigidRows::vec(&r.tr, &it.q), RigidRows::vec(&r.tr, &it.v));
+            let (th0, dth0) = (r.rot_vec(&it.q), r.rot_vec(&it.v));
+            let rot = Rotation::from_scaled_axis(th0);
+            for (p, v) in w
+                .particles
+                .position
+                .iter_mut()
+                .zip(w.particles.velocity.iter_mut())
+            {
+                let rel = rot.transform_vector(&(*p - r.attach));
+                *p = r.attach + u0 + rel;
+                *v = rot.transform_vector(v) + du0 + dth0.cross(&rel);
+            }
+            for wv in w.particles.angular_velocity.iter_mut() {
+                *wv = rot.transform_vector(wv) + dth0;
+            }
+            w.bodies[c].motion = Motion::Prescribed(Arc::new(RigidTrack {
+                t1: 0.0,
+                u1: u0,
+                v1: du0,
+                a1: Vec3::zeros(),
+                th1: th0,
+                w1: dth0,
+                al1: Vec3::zeros(),
+                arm: r.arm,
+                rotate: r.rot.is_some(),
+            }));
+        }
+    }
     w.restart_clock();
-    let weight = if opts.compensate_static_weight {
-        damper.bed_mass_kg * w.gravity_m_s2.dot(&e)
-    } else {
-        0.0
+    let weight1d = match (&kin, opts.compensate_static_weight) {
+        (Resolved::OneD { e, .. }, true) => damper.bed_mass_kg * w.gravity_m_s2.dot(e),
+        _ => 0.0,
     };
-    let force = |w: &pdamp_dem::World| w.bodies[c].contact_force_n.dot(&e) - weight;
+    let weight = if opts.compensate_static_weight {
+        w.gravity_m_s2 * damper.bed_mass_kg
+    } else {
+        Vec3::zeros()
+    };
+    // Generalized loads of the particles on the container at the modal state q: the one
+    // entering the modal equations (static weight compensated if asked) and the raw one (for
+    // the work the structure does on the bed).
+    let bed_load = |w: &pdamp_dem::World, q: &DVector<f64>| -> (DVector<f64>, DVector<f64>) {
+        let b = &w.bodies[c];
+        match &kin {
+            Resolved::OneD { pd, e } => {
+                let f = b.contact_force_n.dot(e);
+                (
+                    generalized_force(pd, f - weight1d),
+                    generalized_force(pd, f),
+                )
+            }
+            Resolved::Rigid(r) => {
+                let f = b.contact_force_n;
+                let mut t = b.contact_torque_nm;
+                if r.rot.is_some() {
+                    // torque about the moving attachment point: T_a = T_ref + (x_ref − a) × F
+                    let lever = b.state.position_m - (r.attach + RigidRows::vec(&r.tr, q));
+                    t += lever.cross(&f);
+                }
+                let raw = r.project(&f, &t);
+                if opts.compensate_static_weight {
+                    (r.project(&(f - weight), &(t - r.static_torque)), raw)
+                } else {
+                    (raw.clone(), raw)
+                }
+            }
+        }
+    };
     let f_ex = |t: f64| match &load {
         Load::Free => DVector::zeros(structure.modes.len()),
         Load::Sweep(s, ex) => {
@@ -157,8 +421,10 @@ fn coupled_run(
         Load::Free => 0.0,
         Load::Sweep(s, _) => s.force_amplitude_n * s.sweep.phase_rad(t).cos(),
     };
-    let mut f_pd = force(&w);
-    it.make_consistent(&(f_ex(0.0) + generalized_force(&pd, f_pd)));
+    let (q_pd, mut q_raw) = bed_load(&w, &it.q);
+    it.make_consistent(&(f_ex(0.0) + q_pd));
+    let e_structure0 = it.energy_j();
+    let mut energy = DemEnergy::default();
     let mut hist = TimeHistory::default();
     let push = |it: &ModalIntegrator, h: &mut TimeHistory| {
         h.time_s.push(it.time_s);
@@ -178,6 +444,10 @@ fn coupled_run(
         hist.displacement_m = st.displacement;
         hist.velocity_m_s = st.velocity;
         hist.force_n = st.force;
+        energy = st.energy;
+        if let Some(ql) = st.q_load {
+            q_raw = ql;
+        }
         first = st.step + 1;
     }
     let _stoppable = ck.map(|_| cp::StoppableSection::enter());
@@ -187,19 +457,38 @@ fn coupled_run(
     let report = (n_steps / 200).max(1);
     for step in first..=n_steps {
         let t1 = step as f64 * dt;
+        let q_prev = it.q.clone();
         it.verlet_drift();
-        w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
-            direction: e,
-            t1,
-            x1: it.displacement(&pd),
-            v1: it.velocity(&pd) + 0.5 * dt * it.acceleration(&pd),
-            a1: it.acceleration(&pd),
-        }));
+        w.bodies[c].motion = match &kin {
+            Resolved::OneD { pd, e } => Motion::Prescribed(Arc::new(Track {
+                direction: *e,
+                t1,
+                x1: it.displacement(pd),
+                v1: it.velocity(pd) + 0.5 * dt * it.acceleration(pd),
+                a1: it.acceleration(pd),
+            })),
+            Resolved::Rigid(r) => {
+                let v1 = &it.v + &it.a * (0.5 * dt);
+                Motion::Prescribed(Arc::new(RigidTrack {
+                    t1,
+                    u1: RigidRows::vec(&r.tr, &it.q),
+                    v1: RigidRows::vec(&r.tr, &v1),
+                    a1: RigidRows::vec(&r.tr, &it.a),
+                    th1: r.rot_vec(&it.q),
+                    w1: r.rot_vec(&v1),
+                    al1: r.rot_vec(&it.a),
+                    arm: r.arm,
+                    rotate: r.rot.is_some(),
+                }))
+            }
+        };
         w.dt_s = t1 - w.time_s;
         w.step();
-        f_pd = force(&w);
-        it.verlet_kick(&(f_ex(t1) + generalized_force(&pd, f_pd)));
-        if !f_pd.is_finite() || !w.ledger.kinetic_j.is_finite() {
+        let (q_pd, q_new) = bed_load(&w, &it.q);
+        energy.structure_work_on_bed_j -= 0.5 * (&q_raw + &q_new).dot(&(&it.q - &q_prev));
+        q_raw = q_new;
+        it.verlet_kick(&(f_ex(t1) + &q_pd));
+        if !q_pd.iter().all(|x| x.is_finite()) || !w.ledger.kinetic_j.is_finite() {
             return Err(format!("DEM coupling became unstable at t = {t1:.6} s"));
         }
         if step % every == 0 {
@@ -222,6 +511,8 @@ fn coupled_run(
                     displacement: hist.displacement_m.clone(),
                     velocity: hist.velocity_m_s.clone(),
                     force: hist.force_n.clone(),
+                    energy,
+                    q_load: Some(q_raw.clone()),
                 };
                 cp::save(&c.path, h, &st)?;
                 if stop {
@@ -234,7 +525,16 @@ fn coupled_run(
             }
         }
     }
-    Ok(hist)
+    let l = &w.ledger;
+    energy.wall_work_j = l.wall_work_j;
+    energy.bed_energy_change_j = l.total_mechanical_j()
+        - (l.initial_kinetic_j + l.initial_potential_j + l.initial_elastic_j);
+    energy.dissipated_j = l.dissipated_j();
+    energy.structure_energy_change_j = it.energy_j() - e_structure0;
+    Ok(CoupledResult {
+        history: hist,
+        energy,
+    })
 }
 
 /// Free vibration with a full DEM damper at `damper_point` (approach 1).
@@ -246,10 +546,35 @@ pub fn run_dem_free(
     damper: &Damper,
     damper_point: &str,
     spec: &FreeVibrationSpec,
-    opts: DemCoupling,
+    opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
+    run_dem_free_with_energy(
+        structure,
+        damper,
+        damper_point,
+        spec,
+        opts,
+        progress,
+        checkpoint,
+    )
+    .map(|(h, _)| h)
+}
+
+/// [`run_dem_free`] that also returns the energy exchange [`DemEnergy`].
+///
+/// # Errors
+/// See [`run_dem_free`].
+pub fn run_dem_free_with_energy(
+    structure: &ModalStructure,
+    damper: &Damper,
+    damper_point: &str,
+    spec: &FreeVibrationSpec,
+    opts: &DemCoupling,
+    progress: &mut dyn FnMut(f64),
+    checkpoint: Option<&CouplingCheckpoint>,
+) -> Result<(TimeHistory, DemEnergy), String> {
     let init = structure.point(&spec.initial_point)?;
     let k = spec.mode;
     if k >= structure.modes.len() || init[k] == 0.0 {
@@ -264,7 +589,7 @@ pub fn run_dem_free(
     let mut v0 = DVector::zeros(n);
     q0[k] = spec.initial_displacement_m / init[k];
     v0[k] = spec.initial_velocity_m_s / init[k];
-    coupled_run(
+    let r = coupled_run(
         structure,
         damper,
         damper_point,
@@ -277,7 +602,8 @@ pub fn run_dem_free(
         Load::Free,
         progress,
         checkpoint,
-    )
+    )?;
+    Ok((r.history, r.energy))
 }
 
 /// Sine sweep with a full DEM damper at `damper_point` (approach 1, time-domain approach of
@@ -290,7 +616,7 @@ pub fn run_dem_sweep(
     damper: &Damper,
     damper_point: &str,
     spec: &SweepSpec,
-    opts: DemCoupling,
+    opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
@@ -311,4 +637,5 @@ pub fn run_dem_sweep(
         progress,
         checkpoint,
     )
+    .map(|r| r.history)
 }

@@ -103,11 +103,15 @@ pub fn run_couple(
         return Err("a DEM damper (approach 1) must be the only damper of a scenario".into());
     }
     let dem = match scn.dampers.first() {
-        Some(DamperSpec::Dem {
-            point,
-            scenario,
-            compensate_static_weight,
-        }) => {
+        Some(
+            spec @ DamperSpec::Dem {
+                point,
+                scenario,
+                compensate_static_weight,
+                ..
+            },
+        ) => {
+            let kinematics = spec.dem_kinematics(0)?;
             let p = if scenario.is_absolute() {
                 scenario.clone()
             } else {
@@ -126,6 +130,7 @@ pub fn run_couple(
                 d,
                 DemCoupling {
                     compensate_static_weight: *compensate_static_weight,
+                    kinematics,
                 },
             ))
         }
@@ -184,7 +189,7 @@ pub fn run_couple(
                 sample_every: *sample_every,
             };
             let hist = match &dem {
-                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, *o, progress, Some(&ck))?,
+                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, o, progress, Some(&ck))?,
                 None => free::run_free_vibration(&structure, &dampers, &spec)?,
             };
             free_outputs(&structure, &scn, &spec, &hist, out)?
@@ -227,7 +232,7 @@ pub fn run_couple(
             if *segments <= 1 {
                 let hist = match &dem {
                     Some((p, d, o)) => {
-                        run_dem_sweep(&structure, d, p, &spec, *o, progress, Some(&ck))?
+                        run_dem_sweep(&structure, d, p, &spec, o, progress, Some(&ck))?
                     }
                     None => forced::run_sweep(&structure, &dampers, &spec)?,
                 };
@@ -259,7 +264,7 @@ pub fn run_couple(
                             d,
                             p,
                             &sspec,
-                            *o,
+                            o,
                             &mut |f| progress((i as f64 + f) / n),
                             None,
                         )?,

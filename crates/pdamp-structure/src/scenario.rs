@@ -667,7 +667,37 @@ pub enum DamperSpec {
         /// Subtract the static bed weight.
         #[serde(default = "yes")]
         compensate_static_weight: bool,
+        /// Container dof that follow the structure: `"1d"` (along the damper's direction at
+        /// `point`), `"translation"` or `"translation+rotation"` (rigid body, D Eq. 3.21–3.26).
+        #[serde(default)]
+        dofs: DemDofs,
+        /// Rigid-body modes: structure points of u_x, u_y, u_z of the damper node in the
+        /// DEM frame (`""` = that dof is not moved); `point` must be one of them.
+        #[serde(default)]
+        translation_points: Option<Vec<String>>,
+        /// `"translation+rotation"`: points of θ_x, θ_y, θ_z (rad), `""` = not rotated.
+        #[serde(default)]
+        rotation_points: Option<Vec<String>>,
+        /// Attachment point (rotation centre, torque reference) in the damper scenario's
+        /// frame, m; default: the container's reference position.
+        #[serde(default)]
+        attachment_point_m: Option<[f64; 3]>,
     },
+}
+
+/// Container dof of a DEM damper (approach 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum DemDofs {
+    /// Translation along the damper's direction only.
+    #[default]
+    #[serde(rename = "1d")]
+    OneDimensional,
+    /// Three translations.
+    #[serde(rename = "translation")]
+    Translation,
+    /// Three translations and three small rotations.
+    #[serde(rename = "translation+rotation")]
+    TranslationRotation,
 }
 
 fn one() -> f64 {
@@ -710,6 +740,87 @@ impl DamperSpec {
             | DamperSpec::Vertical { point, .. }
             | DamperSpec::Constant { point, .. }
             | DamperSpec::Dem { point, .. } => point,
+        }
+    }
+
+    /// Kinematics of a DEM damper (`dampers[index]`), validated: the point lists have three
+    /// entries, `point` is one of the translation points, the keys fit `dofs`.
+    ///
+    /// # Errors
+    /// Messages name the offending key; not a DEM damper.
+    pub fn dem_kinematics(&self, index: usize) -> Result<crate::dem::DemKinematics, String> {
+        use crate::dem::{DemKinematics, RigidKinematics};
+        let DamperSpec::Dem {
+            point,
+            dofs,
+            translation_points,
+            rotation_points,
+            attachment_point_m,
+            ..
+        } = self
+        else {
+            return Err(format!("dampers[{index}]: not a DEM damper"));
+        };
+        let key = |k: &str| format!("dampers[{index}].{k}");
+        let three = |v: &Option<Vec<String>>, k: &str| -> Result<[Option<String>; 3], String> {
+            let v = v
+                .as_ref()
+                .ok_or_else(|| format!("{}: required for dofs = {dofs:?}", key(k)))?;
+            if v.len() != 3 {
+                return Err(format!(
+                    "{}: give three point names (x, y, z; \"\" = not moved), got {}",
+                    key(k),
+                    v.len()
+                ));
+            }
+            let o = |s: &String| (!s.trim().is_empty()).then(|| s.trim().to_string());
+            Ok([o(&v[0]), o(&v[1]), o(&v[2])])
+        };
+        match dofs {
+            DemDofs::OneDimensional => {
+                for (k, set) in [
+                    ("translation_points", translation_points.is_some()),
+                    ("rotation_points", rotation_points.is_some()),
+                    ("attachment_point_m", attachment_point_m.is_some()),
+                ] {
+                    if set {
+                        return Err(format!(
+                            "{}: only with dofs = \"translation\" or \"translation+rotation\"",
+                            key(k)
+                        ));
+                    }
+                }
+                Ok(DemKinematics::OneDimensional)
+            }
+            DemDofs::Translation | DemDofs::TranslationRotation => {
+                let tr = three(translation_points, "translation_points")?;
+                if !tr.iter().flatten().any(|p| p == point) {
+                    return Err(format!(
+                        "{}: '{point}' must be one of translation_points",
+                        key("point")
+                    ));
+                }
+                let rot = if *dofs == DemDofs::TranslationRotation {
+                    Some(three(rotation_points, "rotation_points")?)
+                } else if rotation_points.is_some() {
+                    return Err(format!(
+                        "{}: only with dofs = \"translation+rotation\"",
+                        key("rotation_points")
+                    ));
+                } else {
+                    None
+                };
+                if let Some(a) = attachment_point_m
+                    && !a.iter().all(|x| x.is_finite())
+                {
+                    return Err(format!("{}: must be finite", key("attachment_point_m")));
+                }
+                Ok(DemKinematics::Rigid(RigidKinematics {
+                    translation_points: tr,
+                    rotation_points: rot,
+                    attachment_point_m: attachment_point_m.map(pdamp_dem::Vec3::from),
+                }))
+            }
         }
     }
 

@@ -56,9 +56,7 @@ fn clamped_particle_is_an_added_mass() {
         &damper,
         "damper",
         &spec,
-        DemCoupling {
-            compensate_static_weight: false,
-        },
+        &DemCoupling::default(),
         &mut |_| {},
         None,
     )
