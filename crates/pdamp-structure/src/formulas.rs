@@ -7,6 +7,7 @@
 //! | [`HorizontalDamper`] | combined rolling/bouncing model D Eq. 6.12 (with 5.2, 5.10, 6.2, 6.8) | horizontal, any A; bouncing needs $A$ "sufficiently" above g |
 //! | [`VerticalDamper`] | vertical single/double collect-and-collide, solid-like, scattered, D Eq. 7.1–7.19 | vertical, bed as one block, inelastic wall impacts; 7.19 masses are DEM fits |
 //! | [`ConstantLossFactor`] | $\tilde E = 2\pi\bar\eta E_{kin}$ [D Eq. 3.15] with fixed η̄, m̄ | reference and efficiency studies (D Eq. 3.51) |
+//! | [`PowderFrictionDamper`] | powder-filled cavity, pure shear (paper eq. 17–20) or pure bending (eq. 21–26) sliding friction, $\tilde E = 4W(\varphi)$ | dense packing, every contact sliding, no impacts, no wall slip, $N_x, N_y \gg 1$, small φ (below) |
 //!
 //! All formulas give $\tilde E_{diss} = \pi\bar\eta\, m_{bed} V^2$ with $V = X\Omega$ (i.e.
 //! Ẽ = 2π η̄ E_kin, E_kin = ½ m_bed V², D Eq. 3.15; the text's Eq. 5.2/6.2 give the per-radian
@@ -441,6 +442,157 @@ impl EffectiveDamper for VerticalDamper {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Powder-filled cavities: first-order friction models of the paper (Praegla et al., Powder
+// Technology 2024, Sect. 4, eq. 17–26; "the paper" in docs/powder.md).
+// ---------------------------------------------------------------------------------------------
+
+/// Paper eq. 18–20 before the large-N approximation: frictional work of a box of length l
+/// filled with equal spheres of radius R under a shear deformation by the angle φ,
+/// $W = N_x(N_y-1)\,\mu\frac{F_{N,y}}{N_x}\Delta d$ with $\Delta d = 2R\tan\varphi$ and
+/// $N_y = l/(2R)$ (eq. 17), J.
+pub fn shear_work_discrete(l: f64, r: f64, mu: f64, f_ny: f64, phi: f64) -> f64 {
+    let n_y = l / (2.0 * r);
+    (n_y - 1.0) * mu * f_ny * 2.0 * r * phi.tan()
+}
+
+/// Paper eq. 20: $W = l\,\mu F_{N,y}\tan\varphi$, J (independent of R).
+pub fn shear_work(l: f64, mu: f64, f_ny: f64, phi: f64) -> f64 {
+    l * mu * f_ny * phi.tan()
+}
+
+/// Paper eq. 21–25 with the exact sums: $W = f\,2R\,\mu\frac{F_{N,x}}{N_y}\sum_i y_i$,
+/// $\sum_i y_i = (N_x-1)\,2R\,\frac{N_y}{2}\frac{N_y/2+1}{2}$, $f = 4\Delta y_{max}/(bl)$,
+/// $\Delta y_{max} = \frac b2\tan\varphi$, $N_x = b/(2R)$, $N_y = l/(2R)$, J.
+pub fn bending_work_discrete(l: f64, b: f64, r: f64, mu: f64, f_nx: f64, phi: f64) -> f64 {
+    let (n_x, n_y) = (b / (2.0 * r), l / (2.0 * r));
+    let f = 4.0 * (0.5 * b * phi.tan()) / (b * l);
+    let sum_y = (n_x - 1.0) * 2.0 * r * (n_y / 2.0) * (n_y / 2.0 + 1.0) / 2.0;
+    f * 2.0 * r * mu * f_nx / n_y * sum_y
+}
+
+/// Paper eq. 26: $W = \frac{f\,b\,l}{8}\mu F_{N,x}$ with $f = 2\tan\varphi/l$, i.e.
+/// $W = \tfrac14 b\,\mu F_{N,x}\tan\varphi$, J (independent of R).
+pub fn bending_work(l: f64, b: f64, mu: f64, f_nx: f64, phi: f64) -> f64 {
+    let f = 4.0 * (0.5 * b * phi.tan()) / (b * l);
+    f * b * l / 8.0 * mu * f_nx
+}
+
+/// Deformation mode of a powder-filled cavity (paper Fig. 7b/c).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrictionMechanism {
+    /// Pure shear by the angle φ (eq. 17–20), wall normal force $F_{N,y}$.
+    Shear,
+    /// Pure bending, end faces rotated by ±φ (eq. 21–26), wall normal force $F_{N,x}$.
+    Bending,
+}
+
+/// Approach-3 model of a powder-filled cavity (paper Sect. 4): all particles in sliding contact
+/// under constant wall normal forces (set by the compaction), so each contact dissipates
+/// μF_N·|slip|. Over one vibration cycle of deformation amplitude φ every slip path is run
+/// four times (0 → φ → 0 → −φ → 0), hence
+/// $\tilde E_{diss} = 4\,W(\varphi)$ with W from eq. 20 (shear) or eq. 26 (bending) and
+/// $\varphi = \kappa X$, κ the deformation angle per unit displacement of the damper point in
+/// the analysed mode (from the mode shapes, e.g. half the difference of the cross-section
+/// rotations at the cavity ends for bending). Ẽ ∝ X: a Coulomb (friction) damper,
+/// $\bar\eta \propto 1/X$, equivalent to a dry-friction force $F_{eq} = \tilde E/(4X)$.
+///
+/// Range of validity (the paper's assumptions): dense packing with every particle in contact
+/// and **every contact sliding** (no stick — at high packing densities contacts stick and the
+/// model overestimates, at low densities contacts open and F_N vanishes); friction only (no
+/// impacts); no slip at the walls; $N_x, N_y \gg 1$ (relative error of the R-free limits 2R/l
+/// for shear, ≤ 2R/b + 4R/l for bending); small angles (tan φ ≈ φ enters exactly, but the
+/// linear deformation fields of Fig. 7 are small-strain); the normal forces do not change with
+/// the vibration. The powder's mass belongs to the structure model (it moves with the walls);
+/// `effective_mass_kg` adds an extra m̄ at the damper point if wanted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PowderFrictionDamper {
+    /// Shear or bending.
+    pub mechanism: FrictionMechanism,
+    /// Cavity length l (along the beam axis, y in paper Fig. 7), m.
+    pub cavity_length_m: f64,
+    /// Cavity width b (across, x in paper Fig. 7; bending only), m.
+    pub cavity_width_m: f64,
+    /// Coefficient of friction μ.
+    pub friction: f64,
+    /// Wall normal force: $F_{N,y}$ (shear) or $F_{N,x}$ (bending), N.
+    pub wall_normal_force_n: f64,
+    /// κ = φ / X, rad/m.
+    pub angle_per_displacement_rad_m: f64,
+    /// Powder mass (for η̄ and the efficiency yardstick only), kg.
+    pub bed_mass_kg: f64,
+    /// Effective mass added at the damper point, kg.
+    pub effective_mass_kg: f64,
+}
+
+impl PowderFrictionDamper {
+    /// Frictional work W(φ) of one quarter cycle, J (eq. 20 or 26).
+    pub fn work_j(&self, phi: f64) -> f64 {
+        let phi = phi.abs();
+        match self.mechanism {
+            FrictionMechanism::Shear => shear_work(
+                self.cavity_length_m,
+                self.friction,
+                self.wall_normal_force_n,
+                phi,
+            ),
+            FrictionMechanism::Bending => bending_work(
+                self.cavity_length_m,
+                self.cavity_width_m,
+                self.friction,
+                self.wall_normal_force_n,
+                phi,
+            ),
+        }
+    }
+
+    /// Checks the parameters; messages name the scenario key.
+    ///
+    /// # Errors
+    /// Non-positive or non-finite values.
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |v: f64, k: &str| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("powder_friction: {k} must be > 0, got {v}"))
+            }
+        };
+        pos(self.cavity_length_m, "cavity_length_m")?;
+        if self.mechanism == FrictionMechanism::Bending {
+            pos(self.cavity_width_m, "cavity_width_m")?;
+        }
+        pos(self.bed_mass_kg, "bed_mass_kg")?;
+        for (v, k) in [
+            (self.friction, "friction"),
+            (self.wall_normal_force_n, "wall_normal_force_n"),
+            (self.effective_mass_kg, "effective_mass_kg"),
+        ] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(format!("powder_friction: {k} must be ≥ 0, got {v}"));
+            }
+        }
+        if !self.angle_per_displacement_rad_m.is_finite() {
+            return Err("powder_friction: angle_per_displacement_rad_m must be finite".into());
+        }
+        Ok(())
+    }
+}
+
+impl EffectiveDamper for PowderFrictionDamper {
+    fn evaluate(&self, amplitude_m: f64, _omega_rad_s: f64) -> EffectiveState {
+        EffectiveState {
+            effective_mass_kg: self.effective_mass_kg,
+            dissipated_energy_per_cycle_j: 4.0
+                * self.work_j(self.angle_per_displacement_rad_m * amplitude_m),
+        }
+    }
+    fn bed_mass_kg(&self) -> f64 {
+        self.bed_mass_kg
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -537,5 +689,67 @@ mod tests {
             assert!((e - eta).abs() < 1.5e-3, "{r}: {e}");
         }
         assert!(bouncing_impact_phase(0.9 * xo, h).is_none());
+    }
+
+    #[test]
+    fn powder_friction_hand_values_and_limits() {
+        // bending, l = 110 mm, b = 18 mm, μ = 0.4, F_N,x = 100 N, κ = 5 rad/m, X = 0.1 mm:
+        // φ = 5e-4, W = b μ F tanφ / 4 = 0.018·0.4·100·tan(5e-4)/4 = 9.0000008e-5 J, Ẽ = 4W
+        let mut d = PowderFrictionDamper {
+            mechanism: FrictionMechanism::Bending,
+            cavity_length_m: 0.11,
+            cavity_width_m: 0.018,
+            friction: 0.4,
+            wall_normal_force_n: 100.0,
+            angle_per_displacement_rad_m: 5.0,
+            bed_mass_kg: 0.165,
+            effective_mass_kg: 0.0,
+        };
+        d.validate().unwrap();
+        let e = d.evaluate(1e-4, 3000.0).dissipated_energy_per_cycle_j;
+        assert!((e / 3.600_000_3e-4 - 1.0).abs() < 1e-7, "{e}");
+        // shear: W = l μ F tanφ = 0.11·0.4·100·tan(5e-4) = 2.2000002e-3 J
+        d.mechanism = FrictionMechanism::Shear;
+        let e = d.evaluate(1e-4, 3000.0).dissipated_energy_per_cycle_j;
+        assert!((e / 8.800_000_7e-3 - 1.0).abs() < 1e-7, "{e}");
+        // limits: Ẽ ∝ X for small X (Coulomb damper, η̄ ∝ 1/X), Ẽ = 0 without friction or
+        // normal force, independent of frequency
+        let e1 = d.evaluate(1e-6, 100.0).dissipated_energy_per_cycle_j;
+        let e2 = d.evaluate(2e-6, 1000.0).dissipated_energy_per_cycle_j;
+        assert!((e2 / e1 - 2.0).abs() < 1e-9);
+        d.friction = 0.0;
+        assert_eq!(d.evaluate(1e-4, 100.0).dissipated_energy_per_cycle_j, 0.0);
+        d.friction = -1.0;
+        assert!(d.validate().unwrap_err().contains("friction"));
+    }
+
+    #[test]
+    fn friction_work_is_independent_of_particle_size() {
+        let (l, b, mu, f, phi) = (0.11, 0.018, 0.4, 10.0, 1e-3);
+        let ws = shear_work(l, mu, f, phi);
+        let wb = bending_work(l, b, mu, f, phi);
+        // halving R repeatedly: the exact sums approach the R-free limits, error ∝ R
+        let mut prev_s = f64::INFINITY;
+        let mut prev_b = f64::INFINITY;
+        for k in 0..6 {
+            let r = 0.5e-3 / 2f64.powi(k); // D50 = 1 mm … 31 µm
+            let es = (shear_work_discrete(l, r, mu, f, phi) / ws - 1.0).abs();
+            let eb = (bending_work_discrete(l, b, r, mu, f, phi) / wb - 1.0).abs();
+            // shear: exactly 2R/l; bending: O(R/b)
+            assert!((es - 2.0 * r / l).abs() < 1e-12, "{es}");
+            assert!(eb < 4.0 * r / b.min(l) + 2.0 * r / l);
+            assert!(es < prev_s && eb < prev_b);
+            prev_s = es;
+            prev_b = eb;
+        }
+        // the paper sizes D50 = 0.25, 0.5, 1 mm change the bending work by < 6 % in total
+        let w: Vec<f64> = [0.125e-3, 0.25e-3, 0.5e-3]
+            .iter()
+            .map(|&r| bending_work_discrete(l, b, r, mu, f, phi))
+            .collect();
+        assert!((w[2] / w[0] - 1.0).abs() < 0.06, "{w:?}");
+        // values: eq. 20 and 26
+        assert!((ws - l * mu * f * phi.tan()).abs() < 1e-18);
+        assert!((wb - 0.25 * b * phi.tan() * mu * f).abs() < 1e-18);
     }
 }

@@ -142,9 +142,14 @@ pub fn run_couple(
         interval_s: options.checkpoint_interval_s,
         resume: options.resume,
     };
+    let analysis_mode = match &scn.analysis {
+        AnalysisSpec::Free { mode, .. }
+        | AnalysisSpec::Sweep { mode, .. }
+        | AnalysisSpec::SteadyState { mode, .. } => mode.saturating_sub(1),
+    };
     let mut dampers = Vec::new();
     for d in &scn.dampers {
-        if let Some(m) = d.effective_model(base)? {
+        if let Some(m) = d.effective_model(base, &structure, analysis_mode)? {
             dampers.push(CoupledDamper {
                 point: d.point().to_string(),
                 model: m,

@@ -658,6 +658,36 @@ pub enum DamperSpec {
         /// m̄/m_bed.
         effective_mass_ratio: f64,
     },
+    /// Approach 3: powder-filled cavity, sliding-friction work under pure shear or bending
+    /// (paper Sect. 4, eq. 17–26; [`crate::formulas::PowderFrictionDamper`]).
+    PowderFriction {
+        /// Structure point (X is its amplitude).
+        point: String,
+        /// `shear` (eq. 20) or `bending` (eq. 26).
+        mechanism: crate::formulas::FrictionMechanism,
+        /// Cavity length l, m.
+        cavity_length_m: f64,
+        /// Cavity width b, m (bending).
+        #[serde(default)]
+        cavity_width_m: Option<f64>,
+        /// Coefficient of friction μ.
+        friction: f64,
+        /// Wall normal force F_N,y (shear) / F_N,x (bending), N.
+        wall_normal_force_n: f64,
+        /// κ = φ/X, rad/m; or give `angle_points`.
+        #[serde(default)]
+        angle_per_displacement_rad_m: Option<f64>,
+        /// Points giving φ from the analysed mode: bending `[θ_start, θ_end]`
+        /// (φ = (θ_end − θ_start)/2), shear `[u_start, θ_start, u_end, θ_end]`
+        /// (φ = (u_end − u_start)/l − (θ_start + θ_end)/2).
+        #[serde(default)]
+        angle_points: Option<Vec<String>>,
+        /// Powder mass, kg.
+        bed_mass_kg: f64,
+        /// m̄ added at the point, kg (the powder mass itself belongs to the structure).
+        #[serde(default)]
+        effective_mass_kg: f64,
+    },
     /// Approach 1: full DEM damper from a damper scenario (`[damper]` section).
     Dem {
         /// Structure point.
@@ -739,6 +769,7 @@ impl DamperSpec {
             | DamperSpec::Horizontal { point, .. }
             | DamperSpec::Vertical { point, .. }
             | DamperSpec::Constant { point, .. }
+            | DamperSpec::PowderFriction { point, .. }
             | DamperSpec::Dem { point, .. } => point,
         }
     }
@@ -824,13 +855,16 @@ impl DamperSpec {
         }
     }
 
-    /// The equivalent model of approaches 2/3 (`None` for DEM).
+    /// The equivalent model of approaches 2/3 (`None` for DEM); `structure` and the analysed
+    /// `mode` (0-based) resolve mode-dependent kinematics (`powder_friction` `angle_points`).
     ///
     /// # Errors
-    /// Invalid layer data, unreadable fields.csv.
+    /// Invalid layer data, unreadable fields.csv, invalid powder-friction keys.
     pub fn effective_model(
         &self,
         base_dir: &Path,
+        structure: &crate::modal::ModalStructure,
+        mode: usize,
     ) -> Result<Option<Box<dyn EffectiveDamper>>, String> {
         Ok(Some(match self {
             DamperSpec::Viscous {
@@ -918,6 +952,78 @@ impl DamperSpec {
                 effective_loss_factor: *effective_loss_factor,
                 effective_mass_ratio: *effective_mass_ratio,
             }),
+            DamperSpec::PowderFriction {
+                point,
+                mechanism,
+                cavity_length_m,
+                cavity_width_m,
+                friction,
+                wall_normal_force_n,
+                angle_per_displacement_rad_m,
+                angle_points,
+                bed_mass_kg,
+                effective_mass_kg,
+            } => {
+                use crate::formulas::{FrictionMechanism, PowderFrictionDamper};
+                let kappa = match (angle_per_displacement_rad_m, angle_points) {
+                    (Some(k), None) => *k,
+                    (None, Some(pts)) => {
+                        let val = |p: &str| -> Result<f64, String> {
+                            let v = structure
+                                .point(p)
+                                .map_err(|e| format!("powder_friction.angle_points: {e}"))?;
+                            v.get(mode).copied().ok_or_else(|| {
+                                format!("powder_friction: mode {} does not exist", mode + 1)
+                            })
+                        };
+                        let x = val(point)?;
+                        if x == 0.0 {
+                            return Err(format!(
+                                "powder_friction: point '{point}' is a node of mode {} (φ/X undefined)",
+                                mode + 1
+                            ));
+                        }
+                        match (mechanism, pts.len()) {
+                            (FrictionMechanism::Bending, 2) => {
+                                0.5 * (val(&pts[1])? - val(&pts[0])?) / x
+                            }
+                            (FrictionMechanism::Shear, 4) => {
+                                ((val(&pts[2])? - val(&pts[0])?) / cavity_length_m
+                                    - 0.5 * (val(&pts[1])? + val(&pts[3])?))
+                                    / x
+                            }
+                            _ => {
+                                return Err("powder_friction.angle_points: bending needs \
+                                            [θ_start, θ_end], shear [u_start, θ_start, u_end, \
+                                            θ_end]"
+                                    .into());
+                            }
+                        }
+                    }
+                    _ => {
+                        return Err("powder_friction: give exactly one of \
+                                    angle_per_displacement_rad_m and angle_points"
+                            .into());
+                    }
+                };
+                let d = PowderFrictionDamper {
+                    mechanism: *mechanism,
+                    cavity_length_m: *cavity_length_m,
+                    cavity_width_m: match (mechanism, cavity_width_m) {
+                        (FrictionMechanism::Bending, None) => {
+                            return Err("powder_friction: bending needs cavity_width_m".into());
+                        }
+                        (_, w) => w.unwrap_or(0.0),
+                    },
+                    friction: *friction,
+                    wall_normal_force_n: *wall_normal_force_n,
+                    angle_per_displacement_rad_m: kappa,
+                    bed_mass_kg: *bed_mass_kg,
+                    effective_mass_kg: *effective_mass_kg,
+                };
+                d.validate()?;
+                Box::new(d)
+            }
             DamperSpec::Dem { .. } => return Ok(None),
         }))
     }
