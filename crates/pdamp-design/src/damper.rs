@@ -3,6 +3,7 @@
 //! the transient cycles and evaluate the driving force and container velocity over whole cycles
 //! with the complex power method [D Eq. 3.12–3.17].
 
+use crate::convergence::{ConvergenceSpec, RunningEstimate, has_converged};
 use pdamp_dem::{HarmonicTranslation, Motion, Vec3, World};
 use pdamp_io::scenario::{STANDARD_GRAVITY_M_S2, Scenario};
 use pdamp_signal::Complex64;
@@ -25,7 +26,7 @@ pub struct Damper {
     pub container_mass_kg: f64,
     /// Mass of all particles m_bed, kg.
     pub bed_mass_kg: f64,
-    /// Cycles simulated per point.
+    /// Cycles simulated per point (the maximum with a convergence criterion).
     pub cycles: u32,
     /// Leading cycles dropped.
     pub transient_cycles: u32,
@@ -33,6 +34,8 @@ pub struct Damper {
     pub time_step_s: f64,
     /// Settling time used, s.
     pub settling_time_s: f64,
+    /// Early stop of a point on convergence (`None`: always `cycles` cycles).
+    pub convergence: Option<ConvergenceSpec>,
 }
 
 /// Result of one excitation point.
@@ -74,8 +77,13 @@ pub struct PointResult {
     pub share_tangential_pw: f64,
     /// Energy balance residual over the evaluated cycles relative to the wall work.
     pub energy_closure_relative: f64,
-    /// Evaluated cycles.
-    pub evaluated_cycles: u32,
+    /// Evaluated cycles (after the transient): `cycles − transient_cycles`, or fewer when the
+    /// point stopped early on convergence.
+    #[serde(alias = "evaluated_cycles")]
+    pub cycles_evaluated: u32,
+    /// Whether the convergence criterion was met (`None`: no criterion given, all cycles run).
+    #[serde(default)]
+    pub converged: Option<bool>,
     /// Time step used, s.
     pub time_step_s: f64,
     /// Accepted time steps.
@@ -151,6 +159,7 @@ impl Damper {
             time_step_s: scenario.simulation.time_step_s,
             settling_time_s,
             settled: world,
+            convergence: spec.convergence.clone(),
         })
     }
 
@@ -178,7 +187,14 @@ impl Damper {
             transient_cycles,
             time_step_s,
             settling_time_s: 0.0,
+            convergence: None,
         }
+    }
+
+    /// The same damper with an early stop on convergence (`cycles` becomes the maximum).
+    pub fn with_convergence(mut self, convergence: Option<ConvergenceSpec>) -> Self {
+        self.convergence = convergence;
+        self
     }
 
     /// Runs one excitation point (frequency f, displacement amplitude X) from the settled
@@ -209,6 +225,13 @@ impl Damper {
         let mut force = Vec::with_capacity(times.capacity());
         let mut velocity = Vec::with_capacity(times.capacity());
         let mut ledger0 = None;
+        // Early stop: per evaluated cycle the sums of the single-bin DFT of the driving force and
+        // the velocity (additive over whole cycles), and the running estimates.
+        let mut cycle_start_sample = 0usize;
+        let (mut f_sum, mut v_sum) = ((0.0, 0.0), (0.0, 0.0));
+        let mut history: Vec<RunningEstimate> = Vec::new();
+        let mut converged = self.convergence.as_ref().map(|_| false);
+        let mut n_eval = n_eval;
         let m_con = self.container_mass_kg;
         let container = self.container;
         let sample = |w: &World, times: &mut Vec<f64>, force: &mut Vec<f64>, vel: &mut Vec<f64>| {
@@ -225,6 +248,7 @@ impl Damper {
             let t_end = (cycle + 1) as f64 * period;
             if cycle == self.transient_cycles {
                 ledger0 = Some(w.ledger);
+                cycle_start_sample = times.len();
                 sample(&w, &mut times, &mut force, &mut velocity);
             }
             let evaluating = cycle >= self.transient_cycles;
@@ -269,6 +293,38 @@ impl Damper {
                      get a damping coefficient ∝ 1/min_impact_velocity_m_s that a fixed explicit step cannot follow",
                     cycle + 1
                 ));
+            }
+            if let Some(c) = &self.convergence
+                && evaluating
+            {
+                let k0 = cycle_start_sample;
+                let fc = harmonic_amplitude(&times[k0..], &force[k0..], frequency_hz);
+                let vc = harmonic_amplitude(&times[k0..], &velocity[k0..], frequency_hz);
+                cycle_start_sample = times.len() - 1;
+                f_sum = (f_sum.0 + fc.0, f_sum.1 + fc.1);
+                v_sum = (v_sum.0 + vc.0, v_sum.1 + vc.1);
+                let n = history.len() as f64 + 1.0;
+                let estimate = complex_power(
+                    Complex64::new(f_sum.0 / n, f_sum.1 / n),
+                    Complex64::new(v_sum.0 / n, v_sum.1 / n),
+                    frequency_hz,
+                    self.bed_mass_kg,
+                    self.container_mass_kg,
+                )
+                .map(|cp| RunningEstimate {
+                    effective_loss_factor: cp.effective_loss_factor,
+                    effective_mass_ratio: cp.effective_mass_ratio,
+                })
+                .unwrap_or(RunningEstimate {
+                    effective_loss_factor: f64::NAN,
+                    effective_mass_ratio: f64::NAN,
+                });
+                history.push(estimate);
+                if has_converged(&history, c) {
+                    converged = Some(true);
+                    n_eval = history.len() as u32;
+                    break;
+                }
             }
         }
         debug_assert!((times[0] - t_eval).abs() < 1e-9 * period.max(1.0));
@@ -315,7 +371,8 @@ impl Damper {
             share_tangential_pp: share(d_tp),
             share_tangential_pw: share(d_tw),
             energy_closure_relative: (dw - de - d) / dw.abs().max(1e-300),
-            evaluated_cycles: n_eval,
+            cycles_evaluated: n_eval,
+            converged,
             time_step_s: w.dt_s,
             steps: w.counters.steps,
             wall_time_s: start.elapsed().as_secs_f64(),

@@ -4,11 +4,107 @@
 
 use crate::damper::{Damper, PointResult};
 use pdamp_io::scenario::{AmplitudeAxis, FieldsSpec};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::{Condvar, Mutex};
+
+/// Particles per thread below which a second thread inside one simulation does not pay (the
+/// per-step synchronisation costs more than the split work saves).
+pub const MIN_PARTICLES_PER_THREAD: usize = 2000;
+
+/// How the points of a field share the threads.
+///
+/// Rule: points run in parallel, one thread each, as long as at least as many points are waiting
+/// as threads are idle. A point that starts when fewer points wait than threads are idle (the
+/// last points of a grid, a resumed run with a few points left, a grid smaller than the machine)
+/// gets an equal share of the idle threads, `idle / waiting`, for the DEM's own parallel loops,
+/// but only for large beds: at most one thread per [`MIN_PARTICLES_PER_THREAD`] particles. A
+/// point keeps its threads until it ends. Points start longest first (most time steps: lowest
+/// frequency), so the tail consists of the short ones. Results do not depend on the split (the
+/// DEM is deterministic for any thread count).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ThreadSplit {
+    /// Threads in all (default: the current rayon pool's, i.e. `pdamp --threads`).
+    pub threads: usize,
+    /// A simulation gets k threads only with at least k × this many particles.
+    pub min_particles_per_thread: usize,
+}
+
+impl Default for ThreadSplit {
+    fn default() -> Self {
+        Self {
+            threads: rayon::current_num_threads(),
+            min_particles_per_thread: MIN_PARTICLES_PER_THREAD,
+        }
+    }
+}
+
+impl ThreadSplit {
+    /// Threads for a point of a bed of `particles` that starts while `idle` threads are idle
+    /// and `waiting` points (this one included) are not started yet (≥ 1).
+    pub fn threads_for_point(&self, idle: usize, waiting: usize, particles: usize) -> usize {
+        let share = idle / waiting.max(1);
+        let by_size = particles / self.min_particles_per_thread.max(1);
+        share.min(by_size).max(1)
+    }
+}
+
+/// Runs `run(k, threads)` for every `k` of `order`, in that order of starting, with the threads
+/// shared as [`ThreadSplit`] says; `run` gets a rayon pool of `threads` threads installed.
+fn run_split<R: Send>(
+    order: &[usize],
+    split: ThreadSplit,
+    particles: usize,
+    run: impl Fn(usize) -> R + Sync,
+) -> Vec<(usize, R)> {
+    struct State {
+        idle: usize,
+        next: usize,
+    }
+    let threads = split.threads.max(1);
+    let state = Mutex::new(State {
+        idle: threads,
+        next: 0,
+    });
+    let freed = Condvar::new();
+    let results = Mutex::new(Vec::with_capacity(order.len()));
+    std::thread::scope(|s| {
+        for _ in 0..threads.min(order.len()) {
+            s.spawn(|| {
+                loop {
+                    let (k, t) = {
+                        let mut st = state.lock().unwrap_or_else(|e| e.into_inner());
+                        while st.next < order.len() && st.idle == 0 {
+                            st = freed.wait(st).unwrap_or_else(|e| e.into_inner());
+                        }
+                        if st.next >= order.len() {
+                            return;
+                        }
+                        let t = split.threads_for_point(st.idle, order.len() - st.next, particles);
+                        st.idle -= t.min(st.idle);
+                        st.next += 1;
+                        (order[st.next - 1], t)
+                    };
+                    let r = match rayon::ThreadPoolBuilder::new().num_threads(t).build() {
+                        Ok(pool) => pool.install(|| run(k)),
+                        Err(_) => run(k),
+                    };
+                    results
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push((k, r));
+                    state.lock().unwrap_or_else(|e| e.into_inner()).idle += t;
+                    freed.notify_all();
+                }
+            });
+        }
+    });
+    let mut results = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    results.sort_by_key(|(k, _)| *k);
+    results
+}
 
 /// Columns of `fields.csv`: the required columns first, then diagnostics.
-pub const FIELD_COLUMNS: [&str; 17] = [
+pub const FIELD_COLUMNS: [&str; 19] = [
     "frequency_hz",
     "amplitude_m",
     "acceleration_m_s2",
@@ -25,6 +121,8 @@ pub const FIELD_COLUMNS: [&str; 17] = [
     "share_tangential_pp",
     "share_tangential_pw",
     "energy_closure_relative",
+    "cycles_evaluated",
+    "converged",
     "wall_time_s",
 ];
 
@@ -98,6 +196,12 @@ pub fn field_row(r: &PointResult) -> Vec<f64> {
         r.share_tangential_pp,
         r.share_tangential_pw,
         r.energy_closure_relative,
+        r.cycles_evaluated as f64,
+        match r.converged {
+            Some(true) => 1.0,
+            Some(false) => 0.0,
+            None => f64::NAN,
+        },
         r.wall_time_s,
     ]
 }
@@ -150,7 +254,8 @@ fn failed_point(f: f64, x: f64) -> PointResult {
         share_tangential_pp: f64::NAN,
         share_tangential_pw: f64::NAN,
         energy_closure_relative: f64::NAN,
-        evaluated_cycles: 0,
+        cycles_evaluated: 0,
+        converged: None,
         time_step_s: f64::NAN,
         steps: 0,
         wall_time_s: f64::NAN,
@@ -159,10 +264,22 @@ fn failed_point(f: f64, x: f64) -> PointResult {
 
 /// Runs all grid points not yet stored in `out_dir/points/`, in parallel, then writes
 /// `out_dir/fields.csv`. `on_point(done, total)` is called after every finished point.
+/// Threads are shared as [`ThreadSplit::default`] says.
 pub fn run_fields(
     damper: &Damper,
     grid: &FieldGrid,
     out_dir: &Path,
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    run_fields_with(damper, grid, out_dir, ThreadSplit::default(), on_point)
+}
+
+/// [`run_fields`] with an explicit split of the threads between and inside the points.
+pub fn run_fields_with(
+    damper: &Damper,
+    grid: &FieldGrid,
+    out_dir: &Path,
+    split: ThreadSplit,
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, String> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
@@ -177,26 +294,24 @@ pub fn run_fields(
     let reused = results.iter().filter(|r| r.is_some()).count();
     let done = std::sync::atomic::AtomicUsize::new(reused);
     on_point(reused, total);
-    let pending: Vec<usize> = (0..total).filter(|&k| results[k].is_none()).collect();
-    // Expensive points (many steps: low frequency) first for better load balance.
-    let mut pending = pending;
-    pending.sort_by(|&a, &b| points[a].2.total_cmp(&points[b].2));
-    let fresh: Vec<(usize, Result<PointResult, String>)> = pending
-        .par_iter()
-        .with_max_len(1)
-        .map(|&k| {
-            let (i, j, f, x) = points[k];
-            let stored = damper.run_point(f, x, &mut ()).and_then(|r| {
-                let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
-                pdamp_io::atomic::write_atomic(point_path(out_dir, i, j), json.as_bytes())
-                    .map_err(|e| format!("output: {e}"))?;
-                Ok(r)
-            });
-            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            on_point(n, total);
-            (k, stored)
-        })
-        .collect();
+    let mut pending: Vec<usize> = (0..total).filter(|&k| results[k].is_none()).collect();
+    // Longest points first (most steps at most: lowest frequency) so that the short ones make
+    // the tail; a stable sort keeps the grid order among equals.
+    let max_steps = |f: f64| damper.cycles as f64 * (1.0 / (f * damper.time_step_s)).ceil();
+    pending.sort_by(|&a, &b| max_steps(points[b].2).total_cmp(&max_steps(points[a].2)));
+    let particles = damper.settled.particles.len();
+    let fresh = run_split(&pending, split, particles, |k| {
+        let (i, j, f, x) = points[k];
+        let stored = damper.run_point(f, x, &mut ()).and_then(|r| {
+            let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
+            pdamp_io::atomic::write_atomic(point_path(out_dir, i, j), json.as_bytes())
+                .map_err(|e| format!("output: {e}"))?;
+            Ok(r)
+        });
+        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        on_point(n, total);
+        stored
+    });
     let mut failed = Vec::new();
     let mut interrupted = 0;
     for (k, r) in fresh {

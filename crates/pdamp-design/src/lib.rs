@@ -2,6 +2,7 @@
 //! complex power method [D Sect. 3.2], effective fields over frequency × amplitude, motion modes,
 //! and reference solutions of idealised damper motions.
 
+pub mod convergence;
 pub mod damper;
 pub mod event_driven;
 pub mod fields;
@@ -10,4 +11,4 @@ pub mod plots;
 pub mod report;
 
 pub use damper::{Damper, PointObserver, PointResult};
-pub use fields::{FieldGrid, run_fields};
+pub use fields::{FieldGrid, ThreadSplit, run_fields, run_fields_with};

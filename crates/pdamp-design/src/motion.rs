@@ -49,6 +49,9 @@ pub struct MotionRecorder {
     pub omega_rad_s: f64,
     prev_phase: f64,
     prev_theta: f64,
+    /// Cycle whose VTK frames `vtk_frames` holds (with an early stop on convergence every
+    /// evaluated cycle is written, each over the previous one, as any may be the last).
+    vtk_cycle: u32,
     traj_every: u64,
 }
 
@@ -143,6 +146,7 @@ impl MotionRecorder {
             omega_rad_s: 2.0 * PI * frequency_hz,
             prev_phase: 0.0,
             prev_theta: 0.0,
+            vtk_cycle: u32::MAX,
             traj_every: ((steps_per_cycle / 200.0).floor() as u64).max(1),
         }
     }
@@ -212,9 +216,13 @@ impl PointObserver for MotionRecorder {
             }
         }
         if let Some((dir, frames)) = &self.vtk
-            && cycle + 1 == damper.cycles
+            && (cycle + 1 == damper.cycles || damper.convergence.is_some())
             && *frames > 0
         {
+            if self.vtk_cycle != cycle {
+                self.vtk_cycle = cycle;
+                self.vtk_frames.clear();
+            }
             let slot = (phase / (2.0 * PI) * *frames as f64).floor();
             let prev_slot = (prev / (2.0 * PI) * *frames as f64).floor();
             if slot != prev_slot || self.vtk_frames.is_empty() {

@@ -43,6 +43,11 @@ pub struct DamperRunSummary {
     pub effective_loss_factor: f64,
     /// Effective particle mass ratio m̄_bed/m_bed [D Eq. 3.17].
     pub effective_mass_ratio: f64,
+    /// Cycles evaluated (after the transient); fewer than `cycles − transient_cycles` when the
+    /// point stopped early on convergence.
+    pub cycles_evaluated: u32,
+    /// Whether `[damper] convergence` was met (`null`: no criterion given).
+    pub converged: Option<bool>,
     /// Everything else of the point (ledger cross-check, dissipation shares, timing).
     pub point: PointResult,
 }
@@ -132,6 +137,8 @@ pub fn run_damper_scenario(
         loss_factor: p.loss_factor,
         effective_loss_factor: p.effective_loss_factor,
         effective_mass_ratio: p.effective_mass_ratio,
+        cycles_evaluated: p.cycles_evaluated,
+        converged: p.converged,
         point: p,
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;

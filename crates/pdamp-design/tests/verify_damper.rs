@@ -141,6 +141,7 @@ fn complex_power_matches_ledger_on_shaken_box() {
         intensity: None,
         cycles: 11,
         transient_cycles: 3,
+        convergence: None,
         motion_output: Default::default(),
     });
     let damper = Damper::from_scenario(&sc, std::path::Path::new("."), |_| {}).expect("damper");
@@ -253,4 +254,160 @@ fn velocity_field_of_stuck_bed_follows_container() {
         assert!(cells > 0, "phase {k}: no samples");
     }
     assert!(!rec.trajectories.is_empty());
+}
+
+/// Early stop on convergence (`[damper] convergence`), on the two cases with a known steady
+/// answer: the collect-and-collide single particle (X/h = 1, periodic after the transient) and
+/// the stuck bed (η̄ ≈ 0: converges through the absolute floor). Each stops before the maximum
+/// number of cycles and its η̄, m̄/m and Ẽ are within the tolerance of the full-length run
+/// (relative_tolerance × max(|value|, absolute_floor) for η̄ and m̄/m, the same in Ẽ units for
+/// Ẽ = η̄ π m_bed V²). Without the table nothing changes (`converged` is `None`).
+#[test]
+fn convergence_stops_early_within_tolerance_of_the_full_run() {
+    use pdamp_design::convergence::ConvergenceSpec;
+    let spec = ConvergenceSpec {
+        relative_tolerance: 0.02,
+        min_evaluated_cycles: 4,
+        window_cycles: 2,
+        absolute_floor: 0.1,
+    };
+    let r = 1e-3;
+    let h = 4e-3;
+    let model = ContactModel {
+        normal: NormalLaw::Linear {
+            stiffness_n_m: 2e5,
+            restitution: 0.02,
+            clip_attractive: false,
+        },
+        friction: FrictionLaw::Frictionless,
+        rolling: None,
+        adhesion: None,
+    };
+    let mut w = World::new(vec![steel()], model, 5e-7);
+    w.gravity_m_s2 = Vec3::zeros();
+    w.add_body(box_body(Vec3::new(0.5 * h + r, 3.0 * r, 3.0 * r)));
+    w.add_particle(Vec3::new(-0.25 * h, 0.0, 0.0), r, 0);
+    let single = Damper::from_world(w, 0, Vec3::x(), 0.1, 20, 10);
+    let cases = [
+        ("single particle X/h = 1", single, 50.0, h),
+        ("stuck bed", stuck_bed_damper(8, 2), 200.0, 6.25e-5),
+    ];
+    for (name, damper, f, x) in cases {
+        let full = damper.run_point(f, x, &mut ()).expect("full run");
+        assert_eq!(full.converged, None);
+        assert_eq!(
+            full.cycles_evaluated,
+            damper.cycles - damper.transient_cycles
+        );
+        let early = damper
+            .clone()
+            .with_convergence(Some(spec.clone()))
+            .run_point(f, x, &mut ())
+            .expect("early run");
+        let v = x * 2.0 * std::f64::consts::PI * f;
+        let e_scale = std::f64::consts::PI * damper.bed_mass_kg * v * v;
+        eprintln!(
+            "{name}: full {} cycles η̄ = {:.5}, m̄/m = {:.5}, Ẽ = {:.5e} J, {:.2} s; \
+             early {} cycles ({:?}) η̄ = {:.5}, m̄/m = {:.5}, Ẽ = {:.5e} J, {:.2} s",
+            full.cycles_evaluated,
+            full.effective_loss_factor,
+            full.effective_mass_ratio,
+            full.dissipated_energy_per_cycle_j,
+            full.wall_time_s,
+            early.cycles_evaluated,
+            early.converged,
+            early.effective_loss_factor,
+            early.effective_mass_ratio,
+            early.dissipated_energy_per_cycle_j,
+            early.wall_time_s,
+        );
+        assert_eq!(early.converged, Some(true), "{name}");
+        assert!(
+            early.cycles_evaluated < full.cycles_evaluated,
+            "{name}: stopped after {} of {} cycles",
+            early.cycles_evaluated,
+            full.cycles_evaluated
+        );
+        let tol = |a: f64| spec.relative_tolerance * a.abs().max(spec.absolute_floor);
+        let d_eta = (early.effective_loss_factor - full.effective_loss_factor).abs();
+        let d_m = (early.effective_mass_ratio - full.effective_mass_ratio).abs();
+        let d_e = (early.dissipated_energy_per_cycle_j - full.dissipated_energy_per_cycle_j).abs();
+        assert!(
+            d_eta <= tol(full.effective_loss_factor),
+            "{name}: Δη̄ = {d_eta}"
+        );
+        assert!(
+            d_m <= tol(full.effective_mass_ratio),
+            "{name}: Δm̄/m = {d_m}"
+        );
+        assert!(
+            d_e <= e_scale * tol(full.dissipated_energy_per_cycle_j / e_scale),
+            "{name}: ΔẼ = {d_e} J"
+        );
+    }
+}
+
+/// The split of the threads between and inside the points does not change any result: a grid
+/// run with one thread per point equals one where the last points get two threads each inside
+/// the simulation (`min_particles_per_thread = 1` so the 8-particle bed qualifies), bit for bit.
+#[test]
+fn fields_thread_split_does_not_change_results() {
+    use pdamp_design::fields::{FieldGrid, ThreadSplit, run_fields_with};
+    use pdamp_io::scenario::AmplitudeAxis;
+    let damper = stuck_bed_damper(3, 1);
+    let grid = FieldGrid {
+        frequencies_hz: vec![200.0, 400.0],
+        amplitude_axis: AmplitudeAxis::Intensity,
+        amplitude_values: vec![1.0, 5.0, 20.0],
+        frequency_log: true,
+        amplitude_log: true,
+    };
+    assert_eq!(
+        ThreadSplit {
+            threads: 4,
+            min_particles_per_thread: 1
+        }
+        .threads_for_point(4, 2, 8),
+        2
+    );
+    let base = std::env::temp_dir().join(format!("pdamp_split_test_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    let mut runs = Vec::new();
+    for (name, split) in [
+        (
+            "serial",
+            ThreadSplit {
+                threads: 1,
+                min_particles_per_thread: 1,
+            },
+        ),
+        (
+            "points",
+            ThreadSplit {
+                threads: 2,
+                min_particles_per_thread: 1_000_000,
+            },
+        ),
+        (
+            "inside",
+            ThreadSplit {
+                threads: 4,
+                min_particles_per_thread: 1,
+            },
+        ),
+    ] {
+        let out =
+            run_fields_with(&damper, &grid, &base.join(name), split, |_, _| {}).expect("fields");
+        assert!(out.failed.is_empty());
+        runs.push(out.points);
+    }
+    for run in &runs[1..] {
+        for (a, b) in runs[0].iter().zip(run) {
+            let (mut a, mut b) = (a.clone(), b.clone());
+            a.wall_time_s = 0.0;
+            b.wall_time_s = 0.0;
+            assert_eq!(a, b);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&base);
 }

@@ -190,6 +190,10 @@ pub struct DamperSpec {
     /// Leading cycles dropped as transient before the evaluation.
     #[serde(default = "default_transient_cycles")]
     pub transient_cycles: u32,
+    /// Optional early stop of a point once its effective quantities have converged; `cycles`
+    /// is then the maximum. Without it every point runs exactly `cycles` cycles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub convergence: Option<ConvergenceSpec>,
     /// Motion-mode output of `pdamp run` (velocity fields, trajectories, VTK frames).
     #[serde(default)]
     pub motion_output: MotionOutputSpec,
@@ -197,6 +201,41 @@ pub struct DamperSpec {
 
 fn default_cycles() -> u32 {
     20
+}
+
+/// Early stop of an excitation point [`DamperSpec::convergence`]: after the transient cycles,
+/// the running estimates of η̄ and m̄_bed/m_bed over all evaluated cycles (complex power over the
+/// whole cycles so far [D Eq. 3.12–3.17]) are taken at the end of every cycle. The point stops
+/// once at least `min_evaluated_cycles` cycles are evaluated and the latest estimate differs from
+/// each of the estimates of the last `window_cycles` cycles by at most
+/// `relative_tolerance × max(|latest|, absolute_floor)`, for η̄ and for m̄_bed/m_bed.
+/// η̄ = Ẽ/(π m_bed V²) is Ẽ in units of the bed's power scale, so the η̄ test is the test of the
+/// dissipated energy per cycle Ẽ, with the floor `absolute_floor × π m_bed V²`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvergenceSpec {
+    /// Relative tolerance between successive running estimates (0 < tol < 1), e.g. 0.02.
+    pub relative_tolerance: f64,
+    /// Evaluated cycles (after `transient_cycles`) before a stop is considered (≥ window + 1).
+    #[serde(default = "default_min_evaluated_cycles")]
+    pub min_evaluated_cycles: u32,
+    /// Number of preceding cycle-end estimates the latest one must agree with (≥ 1).
+    #[serde(default = "default_window_cycles")]
+    pub window_cycles: u32,
+    /// Floor of the scale of η̄ and m̄_bed/m_bed (both in units of the bed mass): values below
+    /// it are compared absolutely, to `relative_tolerance × absolute_floor` (≥ 0).
+    #[serde(default = "default_absolute_floor")]
+    pub absolute_floor: f64,
+}
+
+fn default_min_evaluated_cycles() -> u32 {
+    4
+}
+fn default_window_cycles() -> u32 {
+    2
+}
+fn default_absolute_floor() -> f64 {
+    0.1
 }
 fn default_transient_cycles() -> u32 {
     5
@@ -1005,6 +1044,49 @@ impl Scenario {
                     d.transient_cycles,
                     d.transient_cycles + 15
                 ));
+            }
+            if let Some(c) = &d.convergence {
+                if !(c.relative_tolerance.is_finite()
+                    && c.relative_tolerance > 0.0
+                    && c.relative_tolerance < 1.0)
+                {
+                    return Err(format!(
+                        "damper.convergence.relative_tolerance must be in (0, 1), got {}; e.g. 0.02",
+                        c.relative_tolerance
+                    ));
+                }
+                if c.window_cycles == 0 {
+                    return Err(
+                        "damper.convergence.window_cycles must be >= 1, got 0; e.g. 2".into(),
+                    );
+                }
+                if c.min_evaluated_cycles <= c.window_cycles {
+                    return Err(format!(
+                        "damper.convergence.min_evaluated_cycles ({}) must exceed \
+                         damper.convergence.window_cycles ({}): the first estimate compared needs \
+                         window_cycles earlier ones; e.g. min_evaluated_cycles = {}",
+                        c.min_evaluated_cycles,
+                        c.window_cycles,
+                        c.window_cycles + 2
+                    ));
+                }
+                if d.transient_cycles + c.min_evaluated_cycles > d.cycles {
+                    return Err(format!(
+                        "damper.convergence.min_evaluated_cycles ({}) plus damper.transient_cycles \
+                         ({}) exceeds damper.cycles ({}), the maximum; raise cycles to at least {}",
+                        c.min_evaluated_cycles,
+                        d.transient_cycles,
+                        d.cycles,
+                        d.transient_cycles + c.min_evaluated_cycles
+                    ));
+                }
+                if !(c.absolute_floor.is_finite() && c.absolute_floor >= 0.0) {
+                    return Err(format!(
+                        "damper.convergence.absolute_floor must be >= 0 (in units of the bed mass), \
+                         got {}; e.g. 0.1",
+                        c.absolute_floor
+                    ));
+                }
             }
         }
         if let Some(f) = &self.fields {

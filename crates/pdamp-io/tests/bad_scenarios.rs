@@ -328,6 +328,46 @@ const CASES: &[Case] = &[
         line_of: Some("cycles = 3"),
     },
     Case {
+        what: "convergence tolerance zero",
+        from: "transient_cycles = 3\n",
+        to: "transient_cycles = 3\nconvergence = { relative_tolerance = 0.0 }\n",
+        expect: &[
+            "damper.convergence.relative_tolerance",
+            "must be in (0, 1)",
+            "e.g. 0.02",
+        ],
+        line_of: Some("convergence = {"),
+    },
+    Case {
+        what: "convergence with an unknown key",
+        from: "transient_cycles = 3\n",
+        to: "transient_cycles = 3\nconvergence = { relative_tolerance = 0.02, window = 2 }\n",
+        expect: &["unknown field `window`", "window_cycles"],
+        line_of: Some("convergence = {"),
+    },
+    Case {
+        what: "convergence window not shorter than the minimum",
+        from: "transient_cycles = 3\n",
+        to: "transient_cycles = 3\nconvergence = { relative_tolerance = 0.02, min_evaluated_cycles = 3, window_cycles = 3 }\n",
+        expect: &[
+            "damper.convergence.min_evaluated_cycles (3) must exceed",
+            "window_cycles (3)",
+            "min_evaluated_cycles = 5",
+        ],
+        line_of: Some("convergence = {"),
+    },
+    Case {
+        what: "convergence minimum beyond the maximum cycles",
+        from: "transient_cycles = 3\n",
+        to: "transient_cycles = 3\nconvergence = { relative_tolerance = 0.02, min_evaluated_cycles = 6 }\n",
+        expect: &[
+            "damper.convergence.min_evaluated_cycles (6)",
+            "exceeds damper.cycles (8)",
+            "at least 9",
+        ],
+        line_of: Some("convergence = {"),
+    },
+    Case {
         what: "fields grid without a damper",
         from: "[damper]\ncontainer_body = \"box\"\ncontainer_mass_kg = 0.05\ndirection = [1.0, 0.0, 0.0]\nfrequency_hz = 30.0\namplitude_m = 0.001\ncycles = 8\ntransient_cycles = 3\n",
         to: "[fields]\nfrequencies_hz = [20.0, 40.0]\nintensities = [1.0, 2.0]\n",
