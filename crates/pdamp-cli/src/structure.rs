@@ -1,4 +1,4 @@
-//! `pdamp structure modes|optimize-layers|coated-wall` and `pdamp couple`: the structural level [D Sect. 3.3] (library:
+//! `pdamp structure modes|optimize-layers|damper-positions|coated-wall` and `pdamp couple`: the structural level [D Sect. 3.3] (library:
 //! `pdamp-structure`, inputs in docs/structure.md).
 
 use std::path::PathBuf;
@@ -30,6 +30,16 @@ enum StructureAction {
     /// DIR/study.csv (best first) and DIR/summary.json.
     OptimizeLayers {
         /// Study file (TOML: scenario = "…free analysis…", [study]).
+        study: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Damper-position study (D Sect. 8.2.3, Fig. 8.27): one equivalent damper (approach 2/3)
+    /// moved along a beam, Fig. 3.7 resonance equilibrium per mode and position; writes
+    /// DIR/positions.csv, DIR/positions.png/svg and DIR/summary.json.
+    DamperPositions {
+        /// Study file (TOML: scenario = "…steady_state analysis…", [study] positions).
         study: PathBuf,
         /// Output directory.
         #[arg(long)]
@@ -93,6 +103,13 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
                 .map_err(|e| anyhow!(e))?;
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("study.csv").display());
+            Ok(())
+        }
+        StructureAction::DamperPositions { study, out } => {
+            let s = pdamp_structure::position_study::run_position_study_file(&study, &out)
+                .map_err(|e| anyhow!(e))?;
+            println!("{}", serde_json::to_string_pretty(&s)?);
+            eprintln!("wrote {}", out.join("positions.csv").display());
             Ok(())
         }
         StructureAction::CoatedWall {

@@ -31,6 +31,7 @@ pub mod integrate;
 pub mod matrix_market;
 pub mod modal;
 pub mod modal_fit;
+pub mod position_study;
 pub mod report;
 pub mod scenario;
 pub mod sparse;
