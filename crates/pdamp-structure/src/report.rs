@@ -258,21 +258,54 @@ pub fn run_couple(
                 let mut runs = Vec::new();
                 let mut seg_frfs = Vec::new();
                 let mut seg_rows = Vec::new();
+                // DEM segments are checkpointed: the finished segments' histories in
+                // checkpoint.bin (kind "couple-dem-segments", rewritten atomically after every
+                // segment), the running segment in checkpoint_segment_<i>.bin (the coupled-run
+                // checkpoint, own digest per segment); --resume skips the finished ones and
+                // continues the running one, ending bit for bit as an uninterrupted run.
+                let mut done: Vec<SegmentHistory> = match (&dem, options.resume) {
+                    (Some(_), true) => {
+                        pdamp_io::checkpoint::load(&ck.path, SEGMENTS_KIND, &ck.inputs_digest)?
+                            .unwrap_or_default()
+                    }
+                    _ => Vec::new(),
+                };
                 for (i, sg) in plan.iter().enumerate() {
                     let sspec = SweepSpec {
                         sweep: sg.sweep,
                         ..spec.clone()
                     };
                     let hist = match &dem {
-                        Some((p, d, o)) => run_dem_sweep(
-                            &structure,
-                            d,
-                            p,
-                            &sspec,
-                            o,
-                            &mut |f| progress((i as f64 + f) / n),
-                            None,
-                        )?,
+                        Some(_) if i < done.len() => done[i].clone().into_history(),
+                        Some((p, d, o)) => {
+                            let cki = CouplingCheckpoint {
+                                path: out.join(format!("checkpoint_segment_{i}.bin")),
+                                inputs_digest: pdamp_io::checkpoint::digest(
+                                    format!("{} segment {i}", ck.inputs_digest).as_bytes(),
+                                ),
+                                ..ck.clone()
+                            };
+                            let h = run_dem_sweep(
+                                &structure,
+                                d,
+                                p,
+                                &sspec,
+                                o,
+                                &mut |f| progress((i as f64 + f) / n),
+                                Some(&cki),
+                            )?;
+                            done.push(SegmentHistory::from_history(&h));
+                            pdamp_io::checkpoint::save(
+                                &ck.path,
+                                &pdamp_io::checkpoint::CheckpointHeader::new(
+                                    SEGMENTS_KIND,
+                                    &ck.inputs_digest,
+                                ),
+                                &done,
+                            )?;
+                            let _ = std::fs::remove_file(&cki.path);
+                            h
+                        }
                         None => forced::run_sweep(&structure, &dampers, &sspec)?,
                     };
                     let frf: Vec<_> = forced::sweep_frf(&hist, &sg.sweep, *window_cycles)
@@ -440,6 +473,38 @@ pub fn run_couple(
     )
     .map_err(io)?;
     Ok(summary)
+}
+
+/// Checkpoint kind of the finished segments of a segmented DEM sweep.
+const SEGMENTS_KIND: &str = "couple-dem-segments";
+
+/// The response of one finished sweep segment (checkpointed).
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+struct SegmentHistory {
+    time_s: Vec<f64>,
+    displacement_m: Vec<f64>,
+    velocity_m_s: Vec<f64>,
+    force_n: Vec<f64>,
+}
+
+impl SegmentHistory {
+    fn from_history(h: &TimeHistory) -> Self {
+        Self {
+            time_s: h.time_s.clone(),
+            displacement_m: h.displacement_m.clone(),
+            velocity_m_s: h.velocity_m_s.clone(),
+            force_n: h.force_n.clone(),
+        }
+    }
+    fn into_history(self) -> TimeHistory {
+        TimeHistory {
+            time_s: self.time_s,
+            displacement_m: self.displacement_m,
+            velocity_m_s: self.velocity_m_s,
+            force_n: self.force_n,
+            updates: Vec::new(),
+        }
+    }
 }
 
 fn free_outputs(
