@@ -152,7 +152,7 @@ impl World {
         let mut gear = self.gear.take().unwrap();
         self.update_neighbors();
         gear.backup_pairs.clear();
-        gear.backup_pairs.extend(self.pp_contacts().copied());
+        self.collect_pp_contacts(&mut gear.backup_pairs);
         gear.backup_walls.clone_from(&self.wall_slots);
         let t0 = self.time_s;
         let body_backup: Vec<_> = self.bodies.iter().map(|b| (b.state, b.previous)).collect();

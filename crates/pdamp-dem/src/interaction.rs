@@ -22,6 +22,25 @@ pub struct InteractionTable {
     models: Vec<ContactModel>,
     model_of: Vec<u16>,
     elastic: Vec<PairElastic>,
+    /// Constants of the one-pass Hertz–Mindlin kernel for pairs whose model is LIGGGHTS'
+    /// `hertz` + `tangential history` without rolling resistance or adhesion.
+    hm_fast: Vec<Option<HmConstants>>,
+}
+
+/// Constants of a pair with the one-pass Hertz–Mindlin law (see
+/// [`ContactModel::hertz_mindlin_constants`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HmConstants {
+    /// Effective Young's modulus $\bar E$, Pa.
+    pub e_eff_pa: f64,
+    /// Effective shear modulus $\bar G$, Pa.
+    pub g_eff_pa: f64,
+    /// $-2\sqrt{5/6}\,\beta(e)$ of LIGGGHTS' damping coefficients.
+    pub damping: f64,
+    /// Coulomb friction coefficient.
+    pub mu: f64,
+    /// Clip the normal force at zero (no attraction).
+    pub clip_attractive: bool,
 }
 
 impl InteractionTable {
@@ -40,12 +59,39 @@ impl InteractionTable {
         }
         let mut m = default_model;
         m.prepare();
-        Self {
+        let mut t = Self {
             n,
             models: vec![m],
             model_of: vec![0; n * n],
             elastic,
-        }
+            hm_fast: Vec::new(),
+        };
+        t.update_fast();
+        t
+    }
+
+    fn update_fast(&mut self) {
+        self.hm_fast = (0..self.n * self.n)
+            .map(|k| {
+                let m = &self.models[self.model_of[k] as usize];
+                let el = &self.elastic[k];
+                m.hertz_mindlin_constants()
+                    .map(|(damping, mu, clip_attractive)| HmConstants {
+                        e_eff_pa: el.e_eff_pa,
+                        g_eff_pa: el.g_eff_pa,
+                        damping,
+                        mu,
+                        clip_attractive,
+                    })
+            })
+            .collect();
+    }
+
+    /// Constants of the one-pass Hertz–Mindlin kernel for the pair (`a`, `b`), if its model
+    /// is that law.
+    #[inline]
+    pub(crate) fn hm_fast(&self, a: u16, b: u16) -> Option<&HmConstants> {
+        self.hm_fast[a as usize * self.n + b as usize].as_ref()
     }
 
     /// Number of materials.
@@ -61,6 +107,7 @@ impl InteractionTable {
         let (a, b) = (a as usize, b as usize);
         self.model_of[a * self.n + b] = k;
         self.model_of[b * self.n + a] = k;
+        self.update_fast();
     }
 
     /// Contact model and elastic constants of the pair (`a`, `b`).

@@ -67,10 +67,25 @@ pub struct World {
     /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    /// Force and torques of each contact at the last evaluation (scratch).
-    pub(crate) contact_output: Vec<PairOutput>,
-    /// For every neighbour pair: index of its contact in `contacts`, or `NO_CONTACT` (scratch).
+    /// For every neighbour pair: what the second partner gathers (force and torque) at the last
+    /// evaluation; valid where `pair_contact` holds a contact.
+    pub(crate) pair_out: Vec<PairOutput>,
+    /// Force and torque on every particle from the pairs where it is the first partner (scratch).
+    pub(crate) row_force: Vec<Vec3>,
+    pub(crate) row_torque: Vec<Vec3>,
+    /// For every neighbour pair: slot of its contact in the slab of the first partner's chunk,
+    /// or `NO_CONTACT`.
     pub(crate) pair_contact: Vec<u32>,
+    /// Particles that may touch a wall before the candidates are rebuilt (see
+    /// `refresh_wall_candidates`); the others skip the wall search.
+    pub(crate) wall_candidate: Vec<bool>,
+    /// Body poses and neighbour-list build count when the candidates were computed.
+    pub(crate) wall_ref: Vec<(Vec3, crate::math::Rotation, usize)>,
+    pub(crate) wall_ref_builds: u64,
+    /// Use the wall candidates (switched off only by tests comparing both paths).
+    pub(crate) wall_skip: bool,
+    /// Scratch of the contact remap at neighbour-list rebuilds.
+    pub(crate) remap_scratch: Vec<crate::forces::PpContact>,
     /// Active particle–particle contacts, by chunks of first partners, with the pair loop's
     /// scratch.
     pub(crate) pp_chunks: Vec<PpChunk>,
@@ -99,8 +114,15 @@ impl World {
             counters: Counters::default(),
             profile: None,
             neighbors: NeighborList::new(0.0),
-            contact_output: Vec::new(),
+            pair_out: Vec::new(),
+            row_force: Vec::new(),
+            row_torque: Vec::new(),
             pair_contact: Vec::new(),
+            remap_scratch: Vec::new(),
+            wall_candidate: Vec::new(),
+            wall_ref: Vec::new(),
+            wall_ref_builds: 0,
+            wall_skip: true,
             pp_chunks: Vec::new(),
             wall_slots: Vec::new(),
             scratch_force: Vec::new(),
@@ -137,7 +159,7 @@ impl World {
 
     /// Number of touching particle–particle contacts.
     pub fn num_pp_contacts(&self) -> usize {
-        self.pp_chunks.iter().map(|c| c.contacts.len()).sum()
+        self.pp_chunks.iter().map(|c| c.len()).sum()
     }
 
     /// Number of touching particle–wall contacts.
@@ -283,6 +305,7 @@ impl World {
             })
             .fold(0.0, f64::max);
         self.wall_slots.resize(n, Vec::new());
+        self.wall_ref.clear();
         self.neighbors.builds = 0;
         self.update_neighbors();
         for b in self.bodies.iter_mut() {
@@ -325,8 +348,15 @@ impl World {
 
     fn update_neighbors_untimed(&mut self) {
         if self.neighbors.needs_rebuild(&self.particles.position) {
+            // Contacts are attached to the pairs of the list: take them off, rebuild, put them
+            // back onto the new pairs (in (i, j) order, which also compacts the slabs).
+            let mut contacts = std::mem::take(&mut self.remap_scratch);
+            contacts.clear();
+            self.collect_pp_contacts(&mut contacts);
             self.neighbors
                 .rebuild(&self.particles.position, &self.particles.radius);
+            self.set_pp_contacts(&contacts);
+            self.remap_scratch = contacts;
             self.counters.neighbor_builds += 1;
         }
     }

@@ -15,7 +15,7 @@ use super::{hertz, normal};
 use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
-fn default_min_impact_velocity() -> f64 {
+pub(crate) fn default_min_impact_velocity() -> f64 {
     1e-3
 }
 
@@ -585,6 +585,32 @@ impl ContactModel {
                 let kn = hertz::hertz_stiffness(p.e_eff_pa, p.r_eff_m);
                 1.5 * kn * hertz::hertz_max_overlap(kn, p.m_eff_kg, v).sqrt()
             }
+        }
+    }
+}
+
+impl ContactModel {
+    /// For LIGGGHTS' `hertz` + `tangential history` without rolling resistance or adhesion:
+    /// the damping factor $-2\sqrt{5/6}\,\beta(e)$, the friction coefficient and whether the
+    /// normal force is clipped at zero; `None` for every other model.
+    pub(crate) fn hertz_mindlin_constants(&self) -> Option<(f64, f64, bool)> {
+        match (&self.normal, &self.friction, &self.rolling, &self.adhesion) {
+            (
+                NormalLaw::HertzMindlin {
+                    restitution,
+                    clip_attractive,
+                },
+                FrictionLaw::Mindlin {
+                    friction_coefficient,
+                },
+                None,
+                None,
+            ) => Some((
+                -2.0 * (5.0_f64 / 6.0).sqrt() * normal::liggghts_beta(*restitution),
+                *friction_coefficient,
+                *clip_attractive,
+            )),
+            _ => None,
         }
     }
 }
