@@ -230,6 +230,7 @@ impl Damper {
         let mut cycle_start_sample = 0usize;
         let (mut f_sum, mut v_sum) = ((0.0, 0.0), (0.0, 0.0));
         let mut history: Vec<RunningEstimate> = Vec::new();
+        let mut per_cycle: Vec<RunningEstimate> = Vec::new();
         let mut converged = self.convergence.as_ref().map(|_| false);
         let mut n_eval = n_eval;
         let m_con = self.container_mass_kg;
@@ -304,23 +305,29 @@ impl Damper {
                 f_sum = (f_sum.0 + fc.0, f_sum.1 + fc.1);
                 v_sum = (v_sum.0 + vc.0, v_sum.1 + vc.1);
                 let n = history.len() as f64 + 1.0;
-                let estimate = complex_power(
-                    Complex64::new(f_sum.0 / n, f_sum.1 / n),
-                    Complex64::new(v_sum.0 / n, v_sum.1 / n),
-                    frequency_hz,
-                    self.bed_mass_kg,
-                    self.container_mass_kg,
-                )
-                .map(|cp| RunningEstimate {
-                    effective_loss_factor: cp.effective_loss_factor,
-                    effective_mass_ratio: cp.effective_mass_ratio,
-                })
-                .unwrap_or(RunningEstimate {
-                    effective_loss_factor: f64::NAN,
-                    effective_mass_ratio: f64::NAN,
-                });
-                history.push(estimate);
-                if has_converged(&history, c) {
+                let estimate = |f: (f64, f64), v: (f64, f64)| {
+                    complex_power(
+                        Complex64::new(f.0, f.1),
+                        Complex64::new(v.0, v.1),
+                        frequency_hz,
+                        self.bed_mass_kg,
+                        self.container_mass_kg,
+                    )
+                    .map(|cp| RunningEstimate {
+                        effective_loss_factor: cp.effective_loss_factor,
+                        effective_mass_ratio: cp.effective_mass_ratio,
+                    })
+                    .unwrap_or(RunningEstimate {
+                        effective_loss_factor: f64::NAN,
+                        effective_mass_ratio: f64::NAN,
+                    })
+                };
+                history.push(estimate(
+                    (f_sum.0 / n, f_sum.1 / n),
+                    (v_sum.0 / n, v_sum.1 / n),
+                ));
+                per_cycle.push(estimate(fc, vc));
+                if has_converged(&history, &per_cycle, c) {
                     converged = Some(true);
                     n_eval = history.len() as u32;
                     break;

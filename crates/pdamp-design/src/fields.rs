@@ -13,14 +13,16 @@ pub const MIN_PARTICLES_PER_THREAD: usize = 2000;
 
 /// How the points of a field share the threads.
 ///
-/// Rule: points run in parallel, one thread each, as long as at least as many points are waiting
-/// as threads are idle. A point that starts when fewer points wait than threads are idle (the
-/// last points of a grid, a resumed run with a few points left, a grid smaller than the machine)
-/// gets an equal share of the idle threads, `idle / waiting`, for the DEM's own parallel loops,
-/// but only for large beds: at most one thread per [`MIN_PARTICLES_PER_THREAD`] particles. A
-/// point keeps its threads until it ends. Points start longest first (most time steps: lowest
-/// frequency), so the tail consists of the short ones. Results do not depend on the split (the
-/// DEM is deterministic for any thread count).
+/// Rule: a point starts whenever a thread is idle and gets `ceil(idle / waiting)` threads
+/// (`waiting`: points not started yet, itself included), but at most one per
+/// [`MIN_PARTICLES_PER_THREAD`] particles of the bed. So points run in parallel, one thread
+/// each, as long as at least as many points wait as threads are idle; when fewer points wait
+/// than threads are idle (a grid smaller than the machine, a resumed run with a few points
+/// left, the last points of a grid started together) large beds share the idle threads evenly
+/// and use them inside the simulation (the DEM's own parallel loops). A point keeps its threads
+/// until it ends; threads freed while the last points run stay idle. Points start longest first
+/// (most time steps at most: lowest frequency), so the tail consists of the short ones. Results
+/// do not depend on the split (the DEM is deterministic for any thread count).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ThreadSplit {
     /// Threads in all (default: the current rayon pool's, i.e. `pdamp --threads`).
@@ -42,7 +44,7 @@ impl ThreadSplit {
     /// Threads for a point of a bed of `particles` that starts while `idle` threads are idle
     /// and `waiting` points (this one included) are not started yet (≥ 1).
     pub fn threads_for_point(&self, idle: usize, waiting: usize, particles: usize) -> usize {
-        let share = idle / waiting.max(1);
+        let share = idle.div_ceil(waiting.max(1));
         let by_size = particles / self.min_particles_per_thread.max(1);
         share.min(by_size).max(1)
     }
@@ -348,4 +350,32 @@ pub fn run_fields_with(
 pub fn write_fields_csv(path: &Path, points: &[PointResult]) -> Result<(), String> {
     pdamp_io::csv::write_csv_atomic(path, &FIELD_COLUMNS, points.iter().map(field_row))
         .map_err(|e| format!("output: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thread_split_rule() {
+        let split = ThreadSplit {
+            threads: 16,
+            min_particles_per_thread: 2000,
+        };
+        // 9 large-bed points on 16 threads started together: shares 2,2,2,2,2,2,2,1,1.
+        let (mut idle, mut got) = (16, Vec::new());
+        for waiting in (1..=9).rev() {
+            let t = split.threads_for_point(idle, waiting, 100_000);
+            idle -= t;
+            got.push(t);
+        }
+        assert_eq!(got, [2, 2, 2, 2, 2, 2, 2, 1, 1]);
+        // Enough points: one thread each.
+        assert_eq!(split.threads_for_point(16, 40, 100_000), 1);
+        assert_eq!(split.threads_for_point(1, 3, 100_000), 1);
+        // The last point of a grid alone on the machine takes all threads, a small bed not.
+        assert_eq!(split.threads_for_point(16, 1, 100_000), 16);
+        assert_eq!(split.threads_for_point(16, 1, 4500), 2);
+        assert_eq!(split.threads_for_point(16, 1, 300), 1);
+    }
 }
