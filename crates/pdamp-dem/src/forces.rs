@@ -430,6 +430,7 @@ impl World {
             wall_ref,
             wall_ref_builds,
             wall_skip,
+            scratch_xr: xr,
             ..
         } = self;
         let p = &*p;
@@ -470,6 +471,17 @@ impl World {
         row_force.resize(n, Vec3::zeros());
         row_torque.resize(n, Vec3::zeros());
         let reach = nl.extra_range_m;
+        // Positions and radii packed together: one load per partner in the pair loop.
+        xr.resize(n, [0.0; 4]);
+        xr.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+            for (k, v) in out.iter_mut().enumerate() {
+                let i = c * CHUNK + k;
+                let x = p.position[i];
+                *v = [x.x, x.y, x.z, p.radius[i]];
+            }
+        });
+        let xr = &*xr;
+        let uniform = interactions.hm_uniform();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
             let mut pcs: Vec<(&mut [u32], &mut [PairOutput])> = Vec::with_capacity(nchunks);
@@ -495,15 +507,23 @@ impl World {
                     let (mut dn, mut dtan, mut el) = (0.0, 0.0, 0.0);
                     let q0 = nl.row_start[lo] as usize;
                     for i in lo..hi {
-                        let xi = p.position[i];
-                        let ri = p.radius[i] + reach;
+                        let [xi0, xi1, xi2, ri0] = xr[i];
+                        let ri = ri0 + reach;
+                        let mat_i = p.material[i];
                         let (mut fi, mut ti) = (Vec3::zeros(), Vec3::zeros());
-                        for q in nl.row_start[i] as usize..nl.row_start[i + 1] as usize {
-                            let j = nl.second[q] as usize;
-                            let slot = pc[q - q0];
-                            let d = xi - p.position[j];
+                        let row = nl.row_start[i] as usize..nl.row_start[i + 1] as usize;
+                        let (a, b) = (row.start - q0, row.end - q0);
+                        let pairs = nl.second[row.clone()]
+                            .iter()
+                            .zip(pc[a..b].iter_mut())
+                            .zip(po[a..b].iter_mut());
+                        for ((&j, slot_ref), out_ref) in pairs {
+                            let j = j as usize;
+                            let slot = *slot_ref;
+                            let [xj0, xj1, xj2, rj] = xr[j];
+                            let d = Vec3::new(xi0 - xj0, xi1 - xj1, xi2 - xj2);
                             let dist2 = d.norm_squared();
-                            let cut = ri + p.radius[j];
+                            let cut = ri + rj;
                             if dist2 >= cut * cut && slot == NO_CONTACT {
                                 continue;
                             }
@@ -511,7 +531,8 @@ impl World {
                             if reach <= 0.0
                                 && dist2 < cut * cut
                                 && dist > 0.0
-                                && let Some(hm) = interactions.hm_fast(p.material[i], p.material[j])
+                                && let Some(hm) =
+                                    uniform.or_else(|| interactions.hm_fast(mat_i, p.material[j]))
                             {
                                 let s = if slot == NO_CONTACT {
                                     let s = chunk.alloc(PpContact {
@@ -519,7 +540,7 @@ impl World {
                                         j: j as u32,
                                         state: PairState::default(),
                                     });
-                                    pc[q - q0] = s;
+                                    *slot_ref = s;
                                     s
                                 } else {
                                     slot
@@ -531,7 +552,7 @@ impl World {
                                 el += e;
                                 fi += out.force;
                                 ti += out.torque_first;
-                                po[q - q0] = PairOutput {
+                                *out_ref = PairOutput {
                                     force: out.force,
                                     torque_second: out.torque_second,
                                 };
@@ -557,15 +578,15 @@ impl World {
                             dtan += y;
                             el += e;
                             if touching {
-                                pc[q - q0] = s;
+                                *slot_ref = s;
                                 fi += out.force;
                                 ti += out.torque_first;
-                                po[q - q0] = PairOutput {
+                                *out_ref = PairOutput {
                                     force: out.force,
                                     torque_second: out.torque_second,
                                 };
                             } else {
-                                pc[q - q0] = NO_CONTACT;
+                                *slot_ref = NO_CONTACT;
                                 chunk.free.push(s);
                             }
                         }

@@ -25,6 +25,8 @@ pub struct InteractionTable {
     /// Constants of the one-pass Hertz–Mindlin kernel for pairs whose model is LIGGGHTS'
     /// `hertz` + `tangential history` without rolling resistance or adhesion.
     hm_fast: Vec<Option<HmConstants>>,
+    /// The constants shared by every pair, if all pairs use the one-pass law with the same ones.
+    hm_uniform: Option<HmConstants>,
 }
 
 /// Constants of a pair with the one-pass Hertz–Mindlin law (see
@@ -65,6 +67,7 @@ impl InteractionTable {
             model_of: vec![0; n * n],
             elastic,
             hm_fast: Vec::new(),
+            hm_uniform: None,
         };
         t.update_fast();
         t
@@ -85,6 +88,16 @@ impl InteractionTable {
                     })
             })
             .collect();
+        self.hm_uniform = match self.hm_fast.first() {
+            Some(Some(c)) if self.hm_fast.iter().all(|x| x.as_ref() == Some(c)) => Some(*c),
+            _ => None,
+        };
+    }
+
+    /// The one-pass Hertz–Mindlin constants if every pair of materials uses them.
+    #[inline]
+    pub(crate) fn hm_uniform(&self) -> Option<&HmConstants> {
+        self.hm_uniform.as_ref()
     }
 
     /// Constants of the one-pass Hertz–Mindlin kernel for the pair (`a`, `b`), if its model

@@ -91,6 +91,8 @@ pub struct World {
     pub(crate) pp_chunks: Vec<PpChunk>,
     pub(crate) wall_slots: Vec<Vec<WallSlot>>,
     pub(crate) scratch_force: Vec<Vec3>,
+    /// Positions and radii packed per particle for the pair loop (scratch).
+    pub(crate) scratch_xr: Vec<[f64; 4]>,
     pub(crate) scratch_torque: Vec<Vec3>,
     pub(crate) gear: Option<GearState>,
     pub(crate) initialized: bool,
@@ -126,6 +128,7 @@ impl World {
             pp_chunks: Vec::new(),
             wall_slots: Vec::new(),
             scratch_force: Vec::new(),
+            scratch_xr: Vec::new(),
             scratch_torque: Vec::new(),
             gear: None,
             initialized: false,
