@@ -852,6 +852,7 @@ fn wall_contacts_of(
                 let point = bs.point_to_world(&c.point);
                 // Inherit history: same feature first, then the closest normal on the same wall.
                 let mut state = PairState::default();
+                let mut prev_point = point;
                 let mut best: Option<(usize, f64)> = None;
                 for (k, s) in slots.iter().enumerate() {
                     if s.body as usize == bi && s.wall as usize == wi && s.state.active {
@@ -867,6 +868,7 @@ fn wall_contacts_of(
                 }
                 if let Some((k, _)) = best {
                     state = slots[k].state;
+                    prev_point = slots[k].point;
                     slots[k].state.active = false; // consumed
                 }
                 fresh.push(WallSlot {
@@ -909,7 +911,16 @@ fn wall_contacts_of(
                         * (s.state.rolling_torque_prev + f.rolling_torque_nm)
                             .dot(&bs.angular_velocity_rad_s)
                         * dt;
-                let (dn, dtan) = account(&mut s.state, &f, fn_vec, ft, &v_rel, &w_rel, dt, true);
+                // The previous force acted at the previous contact point: on a rotating wall
+                // its half of the trapezoid uses the wall velocity there (exactly zero change
+                // for walls that only translate).
+                let dv_wall = bs.point_velocity(&prev_point) - v_wall;
+                let (fn_prev, ft_prev) = (s.state.normal_force_prev, s.state.tangential_force_prev);
+                inc.wall_work_j += 0.5 * (fn_prev + ft_prev).dot(&dv_wall) * dt;
+                let (mut dn, mut dtan) =
+                    account(&mut s.state, &f, fn_vec, ft, &v_rel, &w_rel, dt, true);
+                dn += 0.5 * fn_prev.dot(&dv_wall) * dt;
+                dtan += 0.5 * ft_prev.dot(&dv_wall) * dt;
                 inc.dissipated_normal_pw_j += dn;
                 inc.dissipated_tangential_pw_j += dtan;
                 inc.elastic_j += f.normal_energy_j + f.tangential_energy_j;
