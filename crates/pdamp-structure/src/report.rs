@@ -93,7 +93,6 @@ pub fn run_couple(
     let mut inputs = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let structure = structure_spec.build(base)?.modal;
-    std::fs::create_dir_all(out).map_err(io)?;
     let dem_count = scn
         .dampers
         .iter()
@@ -156,6 +155,8 @@ pub fn run_couple(
             });
         }
     }
+    // Only now, with the dampers validated: bad input leaves no output directory behind.
+    std::fs::create_dir_all(out).map_err(io)?;
     let approach = if dem.is_some() {
         "1 (full DEM)"
     } else if scn
