@@ -51,14 +51,15 @@ pub struct WallSlot {
     pub state: PairState,
 }
 
-/// Output of one pair evaluation that the second partner gathers: the force on the first partner
-/// (the second gets the opposite) and the torque on the second partner.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct PairOutput {
+/// What the second partner of a contact gathers from one pair evaluation.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct SecondOutput {
     /// Force on the first partner (the second gets the opposite), N.
-    pub force: Vec3,
+    force: Vec3,
     /// Torque on the second partner, N·m.
-    pub torque_second: Vec3,
+    torque: Vec3,
+    /// Second partner.
+    second: u32,
 }
 
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
@@ -222,6 +223,23 @@ impl World {
     }
 }
 
+/// How many pairs ahead the pair loop prefetches partner data.
+const PREFETCH_AHEAD: usize = 6;
+
+/// Hints the processor to load the cache line of `x` (no effect on other targets).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is only a hint; it never faults, whatever the address.
+    #[allow(unused_unsafe)]
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// Marks a neighbour pair without an active contact in `pair_contact`.
 pub(crate) const NO_CONTACT: u32 = u32::MAX;
 
@@ -296,29 +314,28 @@ fn evaluate_pair(
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn hm_pair_fast(
-    p: &crate::particles::ParticleSet,
     c: &crate::interaction::HmConstants,
-    i: usize,
-    j: usize,
+    (ri, rj): (f64, f64),
+    ki: &Kin,
+    kj: &Kin,
     d: Vec3,
     dist: f64,
     st: &mut PairState,
     dt: f64,
 ) -> (PairEval, f64, f64, f64) {
-    let (ri, rj) = (p.radius[i], p.radius[j]);
     let delta = ri + rj - dist;
     let n = d * (1.0 / dist);
     let rb_i = ri - 0.5 * delta;
     let rb_j = rj - 0.5 * delta;
-    let dv = p.velocity[i] - p.velocity[j];
+    let dv = Vec3::from(ki.v) - Vec3::from(kj.v);
     // v_rel = Δv + ω_i × (−r_b,i n) − ω_j × (r_b,j n) = Δv − (r_b,i ω_i + r_b,j ω_j) × n
-    let v_rel = dv - (p.angular_velocity[i] * rb_i + p.angular_velocity[j] * rb_j).cross(&n);
+    let v_rel = dv - (Vec3::from(ki.w) * rb_i + Vec3::from(kj.w) * rb_j).cross(&n);
     let rate = -n.dot(&dv);
     let h = &mut st.history;
     if h.impact_velocity_m_s == 0.0 {
         h.impact_velocity_m_s = rate.max(crate::contact::default_min_impact_velocity());
     }
-    let (mi, mj) = (p.mass[i], p.mass[j]);
+    let (mi, mj) = (ki.m, kj.m);
     let r_eff = ri * rj / (ri + rj);
     let m_eff = mi * mj / (mi + mj);
     let a = (r_eff * delta).sqrt();
@@ -372,6 +389,31 @@ fn hm_pair_fast(
     )
 }
 
+/// Velocity, mass and angular velocity of one particle, packed into one cache line for the
+/// contact laws of the pair loop (scratch, refreshed every evaluation).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(crate) struct Kin {
+    v: [f64; 3],
+    m: f64,
+    w: [f64; 3],
+    _pad: f64,
+}
+
+impl Kin {
+    /// The packed state of particle `i`.
+    #[inline]
+    fn of(p: &crate::particles::ParticleSet, i: usize) -> Self {
+        let (u, w) = (p.velocity[i], p.angular_velocity[i]);
+        Kin {
+            v: [u.x, u.y, u.z],
+            m: p.mass[i],
+            w: [w.x, w.y, w.z],
+            _pad: 0.0,
+        }
+    }
+}
+
 /// Forces and torques of one pair evaluation.
 #[derive(Debug, Clone, Copy)]
 struct PairEval {
@@ -419,6 +461,10 @@ impl World {
             interactions,
             neighbors,
             pair_out,
+            out_count,
+            second_start,
+            second_list,
+            scratch_fill: fill,
             row_force,
             row_torque,
             pair_contact,
@@ -431,6 +477,7 @@ impl World {
             wall_ref_builds,
             wall_skip,
             scratch_xr: xr,
+            scratch_kin: kin,
             ..
         } = self;
         let p = &*p;
@@ -443,8 +490,9 @@ impl World {
         //    squared-distance test on positions and radii; a contact keeps its slot in the
         //    chunk's slab (history updated in place); a contact that ended closes its work
         //    integral and frees its slot. The first partner's force and torque are summed here;
-        //    the second partner gathers them from `pair_out` (fixed order: thread-count
-        //    independent).
+        //    the second partner's share goes to the chunk's output list (`pair_out`, written
+        //    sequentially), which a counting sort by second partner then indexes for the gather
+        //    (fixed order, the first partner ascending: thread-count independent).
         let nchunks = n.div_ceil(PP_CHUNK);
         let m = nl.num_pairs();
         if pp_chunks.len() != nchunks || pair_contact.len() != m {
@@ -467,25 +515,34 @@ impl World {
                 pp_chunks[k.i as usize / PP_CHUNK].orphans.push(k);
             }
         }
-        pair_out.resize(m, PairOutput::default());
+        // Every chunk writes the outputs of its contacts densely from the start of its pair range.
+        pair_out.resize(m, SecondOutput::default());
+        out_count.resize(nchunks, 0);
         row_force.resize(n, Vec3::zeros());
         row_torque.resize(n, Vec3::zeros());
         let reach = nl.extra_range_m;
         // Positions and radii packed together: one load per partner in the pair loop.
+        // Velocities, masses and spins packed likewise: one cache line per contact partner.
         xr.resize(n, [0.0; 4]);
-        xr.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
-            for (k, v) in out.iter_mut().enumerate() {
-                let i = c * CHUNK + k;
-                let x = p.position[i];
-                *v = [x.x, x.y, x.z, p.radius[i]];
-            }
-        });
+        kin.resize(n, Kin::default());
+        xr.par_chunks_mut(CHUNK)
+            .zip(kin.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (out, kout))| {
+                for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
+                    let i = c * CHUNK + k;
+                    let x = p.position[i];
+                    *v = [x.x, x.y, x.z, p.radius[i]];
+                    *kv = Kin::of(p, i);
+                }
+            });
         let xr = &*xr;
+        let kin = &*kin;
         let uniform = interactions.hm_uniform();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
-            let mut pcs: Vec<(&mut [u32], &mut [PairOutput])> = Vec::with_capacity(nchunks);
-            let (mut rest_c, mut rest_o): (&mut [u32], &mut [PairOutput]) =
+            let mut pcs: Vec<(&mut [u32], &mut [SecondOutput])> = Vec::with_capacity(nchunks);
+            let (mut rest_c, mut rest_o): (&mut [u32], &mut [SecondOutput]) =
                 (pair_contact, pair_out);
             for c in 0..nchunks {
                 let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
@@ -501,11 +558,14 @@ impl World {
                 .zip(pcs.into_par_iter())
                 .zip(row_force.par_chunks_mut(PP_CHUNK))
                 .zip(row_torque.par_chunks_mut(PP_CHUNK))
+                .zip(out_count.par_iter_mut())
                 .enumerate()
-                .for_each(|(c, (((chunk, (pc, po)), rf), rt))| {
+                .for_each(|(c, ((((chunk, (pc, po)), rf), rt), count))| {
+                    let mut outs = 0usize;
                     let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
                     let (mut dn, mut dtan, mut el) = (0.0, 0.0, 0.0);
                     let q0 = nl.row_start[lo] as usize;
+                    let second_c = &nl.second[q0..nl.row_start[hi] as usize];
                     for i in lo..hi {
                         let [xi0, xi1, xi2, ri0] = xr[i];
                         let ri = ri0 + reach;
@@ -513,13 +573,22 @@ impl World {
                         let (mut fi, mut ti) = (Vec3::zeros(), Vec3::zeros());
                         let row = nl.row_start[i] as usize..nl.row_start[i + 1] as usize;
                         let (a, b) = (row.start - q0, row.end - q0);
-                        let pairs = nl.second[row.clone()]
-                            .iter()
-                            .zip(pc[a..b].iter_mut())
-                            .zip(po[a..b].iter_mut());
-                        for ((&j, slot_ref), out_ref) in pairs {
-                            let j = j as usize;
-                            let slot = *slot_ref;
+                        for qq in a..b {
+                            // Look ahead: fetch the partner of a later pair (and its velocities
+                            // and contact state if it is in contact) while this one computes.
+                            if let Some(&jn) = second_c.get(qq + PREFETCH_AHEAD) {
+                                prefetch(&xr[jn as usize]);
+                                let sn = pc[qq + PREFETCH_AHEAD];
+                                if sn != NO_CONTACT {
+                                    prefetch(&kin[jn as usize]);
+                                    if let Some(k) = chunk.slab.get(sn as usize) {
+                                        prefetch(k);
+                                    }
+                                }
+                            }
+                            let j = second_c[qq] as usize;
+                            let slot = pc[qq];
+                            let slot_ref = &mut pc[qq];
                             let [xj0, xj1, xj2, rj] = xr[j];
                             let d = Vec3::new(xi0 - xj0, xi1 - xj1, xi2 - xj2);
                             let dist2 = d.norm_squared();
@@ -546,16 +615,19 @@ impl World {
                                     slot
                                 };
                                 let st = &mut chunk.slab[s as usize].state;
-                                let (out, x, y, e) = hm_pair_fast(p, hm, i, j, d, dist, st, dt);
+                                let (out, x, y, e) =
+                                    hm_pair_fast(hm, (ri0, rj), &kin[i], &kin[j], d, dist, st, dt);
                                 dn += x;
                                 dtan += y;
                                 el += e;
                                 fi += out.force;
                                 ti += out.torque_first;
-                                *out_ref = PairOutput {
+                                po[outs] = SecondOutput {
                                     force: out.force,
-                                    torque_second: out.torque_second,
+                                    torque: out.torque_second,
+                                    second: j as u32,
                                 };
+                                outs += 1;
                                 continue;
                             }
                             let touching = interacts(p, interactions, reach, i, j, dist);
@@ -581,10 +653,12 @@ impl World {
                                 *slot_ref = s;
                                 fi += out.force;
                                 ti += out.torque_first;
-                                *out_ref = PairOutput {
+                                po[outs] = SecondOutput {
                                     force: out.force,
-                                    torque_second: out.torque_second,
+                                    torque: out.torque_second,
+                                    second: j as u32,
                                 };
+                                outs += 1;
                             } else {
                                 *slot_ref = NO_CONTACT;
                                 chunk.free.push(s);
@@ -604,7 +678,34 @@ impl World {
                         dtan += y;
                     }
                     chunk.sums = (dn, dtan, el);
+                    *count = outs as u32;
                 });
+        }
+        // Counting sort of the outputs by second partner. For one particle its entries follow
+        // the chunks and, within a chunk, the pair loop: the first partner ascending (the order
+        // of the transposed neighbour index), whatever the thread count.
+        second_start.clear();
+        second_start.resize(n + 1, 0);
+        for (c, &cnt) in out_count.iter().enumerate() {
+            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
+            for o in &pair_out[base..base + cnt as usize] {
+                second_start[o.second as usize + 1] += 1;
+            }
+        }
+        for k in 0..n {
+            second_start[k + 1] += second_start[k];
+        }
+        let total = second_start[n] as usize;
+        second_list.resize(total, 0);
+        fill.clear();
+        fill.extend_from_slice(&second_start[..n]);
+        for (c, &cnt) in out_count.iter().enumerate() {
+            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
+            for (k, o) in pair_out[base..base + cnt as usize].iter().enumerate() {
+                let f = &mut fill[o.second as usize];
+                second_list[*f as usize] = (base + k) as u32;
+                *f += 1;
+            }
         }
         let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
 
@@ -627,8 +728,9 @@ impl World {
         );
         let wall_candidate = &*wall_candidate;
         let bodies_ref = &*bodies;
-        let outs = &*pair_out;
-        let pair_contact = &*pair_contact;
+        let pair_out = &*pair_out;
+        let second_start = &*second_start;
+        let second_list = &*second_list;
         let rows_f = &*row_force;
         let rows_t = &*row_torque;
         let g = *gravity_m_s2;
@@ -661,14 +763,11 @@ impl World {
                         let mut t = rows_t[i];
                         inc.external_work_j += p.external_force[i].dot(&p.velocity[i]) * dt;
                         // Contacts where `i` is the second partner, in neighbour-list order.
-                        for &q in
-                            &nl.col_pairs[nl.col_start[i] as usize..nl.col_start[i + 1] as usize]
-                        {
-                            if pair_contact[q as usize] != NO_CONTACT {
-                                let o = &outs[q as usize];
-                                f -= o.force;
-                                t += o.torque_second;
-                            }
+                        let range = second_start[i] as usize..second_start[i + 1] as usize;
+                        for &g in &second_list[range] {
+                            let o = &pair_out[g as usize];
+                            f -= o.force;
+                            t += o.torque;
                         }
                         if !wall_candidate[i] && slot_list.is_empty() {
                             *f_out = f;
@@ -1021,7 +1120,10 @@ mod tests {
                 let d = p.position[0] - p.position[1];
                 let dist = d.norm();
                 assert!(dist < 1.8e-3);
-                let (a, dn_a, dt_a, e_a) = hm_pair_fast(&p, &hm, 0, 1, d, dist, &mut s_fast, dt);
+                let (k0, k1) = (Kin::of(&p, 0), Kin::of(&p, 1));
+                let radii = (p.radius[0], p.radius[1]);
+                let (a, dn_a, dt_a, e_a) =
+                    hm_pair_fast(&hm, radii, &k0, &k1, d, dist, &mut s_fast, dt);
                 let (b, dn_b, dt_b, e_b) =
                     evaluate_pair(&p, &table, 0, 1, d, dist, true, &mut s_gen, dt);
                 for (x, y) in [

@@ -4,7 +4,7 @@
 use crate::body::RigidBody;
 use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
-use crate::forces::{PairOutput, PpChunk, WallSlot};
+use crate::forces::{PpChunk, WallSlot};
 use crate::integrate::{GearState, Integrator};
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
@@ -67,9 +67,15 @@ pub struct World {
     /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    /// For every neighbour pair: what the second partner gathers (force and torque) at the last
-    /// evaluation; valid where `pair_contact` holds a contact.
-    pub(crate) pair_out: Vec<PairOutput>,
+    /// Outputs of the contacts for their second partners: chunk `c` writes `out_count[c]`
+    /// entries from the start of its pair range (`row_start` of its first particle).
+    pub(crate) pair_out: Vec<crate::forces::SecondOutput>,
+    pub(crate) out_count: Vec<u32>,
+    /// Counting sort of `pair_out` by second partner: entries of particle `j` are
+    /// `second_list[second_start[j]..second_start[j + 1]]`.
+    pub(crate) second_start: Vec<u32>,
+    pub(crate) second_list: Vec<u32>,
+    pub(crate) scratch_fill: Vec<u32>,
     /// Force and torque on every particle from the pairs where it is the first partner (scratch).
     pub(crate) row_force: Vec<Vec3>,
     pub(crate) row_torque: Vec<Vec3>,
@@ -93,6 +99,8 @@ pub struct World {
     pub(crate) scratch_force: Vec<Vec3>,
     /// Positions and radii packed per particle for the pair loop (scratch).
     pub(crate) scratch_xr: Vec<[f64; 4]>,
+    /// Velocities, masses and spins packed per particle for the pair loop (scratch).
+    pub(crate) scratch_kin: Vec<crate::forces::Kin>,
     pub(crate) scratch_torque: Vec<Vec3>,
     pub(crate) gear: Option<GearState>,
     pub(crate) initialized: bool,
@@ -117,6 +125,10 @@ impl World {
             profile: None,
             neighbors: NeighborList::new(0.0),
             pair_out: Vec::new(),
+            out_count: Vec::new(),
+            second_start: Vec::new(),
+            second_list: Vec::new(),
+            scratch_fill: Vec::new(),
             row_force: Vec::new(),
             row_torque: Vec::new(),
             pair_contact: Vec::new(),
@@ -129,6 +141,7 @@ impl World {
             wall_slots: Vec::new(),
             scratch_force: Vec::new(),
             scratch_xr: Vec::new(),
+            scratch_kin: Vec::new(),
             scratch_torque: Vec::new(),
             gear: None,
             initialized: false,
