@@ -81,7 +81,7 @@ struct CheckpointArgs {
 
 impl CheckpointArgs {
     fn options(self) -> Result<cantilever::RunOptions> {
-        if !(self.checkpoint_interval_s >= 0.0) {
+        if self.checkpoint_interval_s.is_nan() || self.checkpoint_interval_s < 0.0 {
             return Err(anyhow!("--checkpoint-interval-s must be ≥ 0"));
         }
         Ok(cantilever::RunOptions {
@@ -139,8 +139,8 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 ParamArg::D50 => StudyParameter::D50,
                 ParamArg::Orientation => StudyParameter::Orientation,
             };
-            let rows =
-                study::run_study(&sc, p, &values, &out, options, &mut progress).map_err(|e| anyhow!(e))?;
+            let rows = study::run_study(&sc, p, &values, &out, options, &mut progress)
+                .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
             println!("{}", serde_json::to_string_pretty(&rows)?);
             eprintln!("wrote {}", out.join("table.csv").display());

@@ -363,7 +363,9 @@ impl Coupled {
             || !cand_ok
             || st.cand_pos.is_empty() != st.cand_start.is_empty()
             || !(st.cand_pos.is_empty() || st.cand_pos.len() == n)
-            || [&st.f_ps, &st.dk, &st.f_trial].iter().any(|v| v.len() != ndof)
+            || [&st.f_ps, &st.dk, &st.f_trial]
+                .iter()
+                .any(|v| v.len() != ndof)
             || st.xcur.len() != nn
             || st.vcur.len() != nn
         {

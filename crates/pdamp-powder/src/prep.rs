@@ -221,7 +221,10 @@ impl Preparation {
 
     /// Wall-clock time spent in this preparation so far, over all runs [s].
     pub fn wall_time_s(&self) -> f64 {
-        self.wall_time_s + self.segment_start.map_or(0.0, |t| t.elapsed().as_secs_f64())
+        self.wall_time_s
+            + self
+                .segment_start
+                .map_or(0.0, |t| t.elapsed().as_secs_f64())
     }
 
     /// A copy for a checkpoint (its wall time includes the running segment).
