@@ -1,7 +1,8 @@
 //! Kill-and-resume: `pdamp run` killed with SIGKILL at random moments (settling and main run)
 //! and resumed with `--resume` ends with outputs identical to an uninterrupted run; SIGINT
 //! writes a checkpoint and exits with status 130. Same thread count throughout (results are
-//! also independent of it, see `determinism_across_thread_counts`).
+//! also independent of it, see `determinism_across_thread_counts`). The same for `pdamp
+//! couple` (full-DEM dampers) and `pdamp powder run`/`study` (the DEM–FEM runs, `powder_*`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
