@@ -847,3 +847,55 @@ pub fn timoshenko_reference(beam: &BeamSpec) -> f64 {
         &[],
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoint_inspection_and_damage() {
+        let dir = std::env::temp_dir().join(format!("pdamp-powder-inspect-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(ck::CHECKPOINT_FILE);
+        let cavity = Aabb {
+            min: [0.0; 3],
+            max: [0.006, 0.006, 0.012],
+        };
+        let s = PrepSettings::default();
+        let mut pr = Preparation::new(
+            cavity,
+            &LogNormal::paper(2e-3),
+            PowderLaw::PAPER.coarse_grained(2.0),
+            8000.0,
+            5e-6,
+            &s,
+        );
+        let mut k = 0;
+        let _ = pr.run(&mut |_, _| {}, &mut |_| {
+            k += 1;
+            if k == 50 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        let header = CheckpointHeader::new(CHECKPOINT_KIND, "digest");
+        ck::save(&path, &header, &Phase::Preparing(Box::new(pr.snapshot()))).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let (phase, t) = inspect_checkpoint(&bytes).unwrap();
+        assert_eq!(phase, "preparing");
+        assert!((t - 50.0 * 5e-6).abs() < 1e-15, "{t}");
+        // another scenario, another kind, damage and truncation are refused with a message
+        let e = ck::load::<Phase>(&path, CHECKPOINT_KIND, "other")
+            .err()
+            .unwrap();
+        assert!(e.contains("different scenario"), "{e}");
+        let e = ck::load::<Phase>(&path, "run", "digest").err().unwrap();
+        assert!(e.contains("not 'run'"), "{e}");
+        let mut bad = bytes.clone();
+        bad[bytes.len() / 2] ^= 1;
+        assert!(inspect_checkpoint(&bad).unwrap_err().contains("damaged"));
+        assert!(inspect_checkpoint(&bytes[..bytes.len() - 100]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
