@@ -36,6 +36,8 @@ enum PowderAction {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        ck: CheckpointArgs,
     },
     /// One cantilever run per value of a parameter (paper Figs. 2–6, Table 1); writes
     /// DIR/<param>_<value>/…, DIR/table.csv, DIR/decay.png, DIR/envelope.png. Resumable.
@@ -51,6 +53,8 @@ enum PowderAction {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        ck: CheckpointArgs,
     },
     /// Eigenfrequencies of the empty beam of a scenario against Timoshenko beam theory.
     Modes {
@@ -60,6 +64,31 @@ enum PowderAction {
         #[arg(long, default_value_t = 4)]
         count: usize,
     },
+}
+
+/// Checkpointing of `powder run` and of every run of `powder study`.
+#[derive(Args, Clone, Copy)]
+struct CheckpointArgs {
+    /// Continue from DIR/checkpoint.bin (of a study: inside the interrupted run), written every
+    /// --checkpoint-interval-s, after the preparation and on Ctrl-C; the results equal those of
+    /// an uninterrupted run.
+    #[arg(long)]
+    resume: bool,
+    /// Wall-clock seconds between checkpoints (0 = only on Ctrl-C/SIGTERM).
+    #[arg(long, default_value_t = 60.0)]
+    checkpoint_interval_s: f64,
+}
+
+impl CheckpointArgs {
+    fn options(self) -> Result<cantilever::RunOptions> {
+        if self.checkpoint_interval_s.is_nan() || self.checkpoint_interval_s < 0.0 {
+            return Err(anyhow!("--checkpoint-interval-s must be ≥ 0"));
+        }
+        Ok(cantilever::RunOptions {
+            checkpoint_interval_s: self.checkpoint_interval_s,
+            resume: self.resume,
+        })
+    }
 }
 
 fn load(path: &PathBuf) -> Result<CantileverScenario> {
@@ -84,10 +113,10 @@ pub fn run(args: PowderArgs) -> Result<()> {
         }
     };
     match args.action {
-        PowderAction::Run { scenario, out } => {
+        PowderAction::Run { scenario, out, ck } => {
             let sc = load(&scenario)?;
-            let r = cantilever::run(&sc, &mut progress).map_err(|e| anyhow!(e))?;
-            cantilever::write_outputs(&out, &sc, &r).map_err(|e| anyhow!(e))?;
+            let r = cantilever::run_in_dir(&sc, &out, ck.options()?, &mut progress)
+                .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
             println!("{}", serde_json::to_string_pretty(&r)?);
             eprintln!("wrote {}", out.display());
@@ -97,8 +126,10 @@ pub fn run(args: PowderArgs) -> Result<()> {
             parameter,
             values,
             out,
+            ck,
         } => {
             let sc = load(&scenario)?;
+            let options = ck.options()?;
             let p = match parameter {
                 ParamArg::PackingDensity => StudyParameter::PackingDensity,
                 ParamArg::StiffnessFactor => StudyParameter::StiffnessFactor,
@@ -108,8 +139,8 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 ParamArg::D50 => StudyParameter::D50,
                 ParamArg::Orientation => StudyParameter::Orientation,
             };
-            let rows =
-                study::run_study(&sc, p, &values, &out, &mut progress).map_err(|e| anyhow!(e))?;
+            let rows = study::run_study(&sc, p, &values, &out, options, &mut progress)
+                .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
             println!("{}", serde_json::to_string_pretty(&rows)?);
             eprintln!("wrote {}", out.join("table.csv").display());

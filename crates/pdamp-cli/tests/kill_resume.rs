@@ -1,7 +1,8 @@
 //! Kill-and-resume: `pdamp run` killed with SIGKILL at random moments (settling and main run)
 //! and resumed with `--resume` ends with outputs identical to an uninterrupted run; SIGINT
 //! writes a checkpoint and exits with status 130. Same thread count throughout (results are
-//! also independent of it, see `determinism_across_thread_counts`).
+//! also independent of it, see `determinism_across_thread_counts`). The same for `pdamp
+//! couple` (full-DEM dampers) and `pdamp powder run`/`study` (the DEM–FEM runs, `powder_*`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -504,4 +505,248 @@ fn couple_dem_segmented_sweep_sigkill_then_resume_gives_identical_outputs() {
     };
     assert_eq!(summary(&reference), summary(&out), "summary.json differs");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---- `pdamp powder run` / `study` (DEM–FEM) ----
+
+/// The reduced cantilever `examples/powder_cantilever_small.toml` shortened to 4 ms (load ramp
+/// and hold 2.5 ms, then 1.5 ms of free decay): ≈ 540 particles, preparation (settling,
+/// compression, relaxation) ≈ 3 s, 400 coupled steps ≈ 4 s on an idle machine.
+fn powder_scenario(path: &Path, seed: u64) -> PathBuf {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/powder_cantilever_small.toml");
+    let text = std::fs::read_to_string(src)
+        .unwrap()
+        .replace("duration_s = 0.008", "duration_s = 0.004")
+        .replace("seed = 1\n", &format!("seed = {seed}\n"));
+    assert!(text.contains("duration_s = 0.004") && text.contains(&format!("seed = {seed}\n")));
+    std::fs::write(path, text).unwrap();
+    path.to_path_buf()
+}
+
+fn powder(threads: &str, args: &[&str], scn: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut c = pdamp();
+    c.args(["--threads", threads, "powder"])
+        .args(args)
+        .arg(scn)
+        .args(["--out"])
+        .arg(out)
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    c
+}
+
+/// The uninterrupted reference run (2 threads), shared by the powder tests: (scratch dir,
+/// scenario, output dir, wall time of the run in s).
+fn powder_reference() -> &'static (PathBuf, PathBuf, PathBuf, f64) {
+    static REF: std::sync::OnceLock<(PathBuf, PathBuf, PathBuf, f64)> = std::sync::OnceLock::new();
+    REF.get_or_init(|| {
+        let dir = scratch("powder");
+        let scn = powder_scenario(&dir.join("cantilever.toml"), 1);
+        let out = dir.join("reference");
+        let t0 = Instant::now();
+        let o = powder("2", &["run"], &scn, &out, &[]).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (dir, scn, out, t0.elapsed().as_secs_f64())
+    })
+}
+
+/// Removes the shared scratch dir once all three powder tests are done.
+fn powder_test_done() {
+    static DONE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    if DONE.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1 == 3 {
+        let _ = std::fs::remove_dir_all(&powder_reference().0);
+    }
+}
+
+/// All outputs of a powder run (tip.csv, envelope.csv, energy.csv, summary.json without its
+/// wall times, tip.png/svg) are identical byte for byte.
+fn assert_same_powder(a: &Path, b: &Path) {
+    let (fa, fb) = (outputs(a), outputs(b));
+    let names = |f: &[(String, Vec<u8>)]| f.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&fa), names(&fb), "same files");
+    for f in [
+        "tip.csv",
+        "envelope.csv",
+        "energy.csv",
+        "summary.json",
+        "tip.png",
+    ] {
+        assert!(names(&fa).iter().any(|n| n == f), "{f} missing");
+    }
+    for ((n, x), (_, y)) in fa.iter().zip(&fb) {
+        assert!(
+            x == y,
+            "{n} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+/// Sends SIGINT to `child` as soon as a line of its stderr contains `pattern`; returns the exit
+/// code and the whole stderr.
+fn sigint_on_line(mut child: std::process::Child, pattern: &str) -> (Option<i32>, String) {
+    use std::io::BufRead;
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        let mut all = String::new();
+        for line in std::io::BufReader::new(stderr).lines() {
+            let line = line.unwrap_or_default();
+            let _ = tx.send(line.clone());
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
+    });
+    for line in rx.iter() {
+        if line.contains(pattern) {
+            let k = Command::new("kill")
+                .args(["-INT", &child.id().to_string()])
+                .status()
+                .unwrap();
+            assert!(k.success());
+            break;
+        }
+    }
+    let status = child.wait().unwrap();
+    (status.code(), reader.join().unwrap())
+}
+
+/// `pdamp powder run` killed with SIGKILL at random moments (preparation and coupled run),
+/// each time after it wrote a checkpoint of its own, and resumed: the outputs equal those of
+/// the uninterrupted run byte for byte.
+#[test]
+fn powder_sigkill_at_random_moments_then_resume_gives_identical_outputs() {
+    let (dir, scn, reference, full) = powder_reference();
+    let full = *full;
+    let out = dir.join("killed");
+    let ckpt = out.join("checkpoint.bin");
+    let mut rng = 0x5eed_0fd3_f3a1_u64 ^ std::process::id() as u64;
+    let (mut kills, mut resumed_from_checkpoint) = (0, 0);
+    let mut stages = Vec::new();
+    for attempt in 0..8 {
+        let args: &[&str] = if attempt == 0 {
+            &["--checkpoint-interval-s", "0.05"]
+        } else {
+            &["--checkpoint-interval-s", "0.05", "--resume"]
+        };
+        let before = checkpoint_stamp(&ckpt);
+        let mut child = powder("2", &["run"], scn, &out, args).spawn().unwrap();
+        // as for `pdamp run`: a random moment, then (after the first attempt) not before this
+        // process has written a checkpoint of its own
+        let wait = Duration::from_secs_f64(full * (0.03 + 0.2 * next(&mut rng)));
+        if !kill_after_checkpoint(&mut child, &ckpt, before, wait, attempt == 0) {
+            break;
+        }
+        kills += 1;
+        if ckpt.exists() {
+            resumed_from_checkpoint += 1;
+        }
+        let mut err = String::new();
+        let _ = std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err);
+        let stage = err.lines().last().unwrap_or("(start)").to_string();
+        stages.push(stage);
+    }
+    let o = powder("2", &["run"], scn, &out, &["--resume"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    eprintln!(
+        "powder: {kills} SIGKILLs ({resumed_from_checkpoint} after a checkpoint existed), last progress lines {stages:?}; full run {full:.2} s"
+    );
+    assert!(kills >= 3, "the run was killed several times ({kills})");
+    assert!(resumed_from_checkpoint >= 2);
+    assert_same_powder(reference, &out);
+    // resuming a finished run changes nothing
+    let o = powder("2", &["run"], scn, &out, &["--resume"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert_same_powder(reference, &out);
+    powder_test_done();
+}
+
+/// SIGINT during the preparation and during the coupled run writes a checkpoint and exits
+/// with status 130; a checkpoint of another scenario is refused; resuming after the coupled-run
+/// checkpoint does not redo the preparation and ends as the uninterrupted run.
+#[test]
+fn powder_sigint_then_resume_gives_identical_outputs_and_refuses_other_scenarios() {
+    let (dir, scn, reference, _) = powder_reference();
+    let out = dir.join("interrupted");
+    let ckpt = out.join("checkpoint.bin");
+    let run = |extra: &[&str]| powder("2", &["run"], scn, &out, extra);
+    let (code, err) = sigint_on_line(
+        run(&["--checkpoint-interval-s", "0"]).spawn().unwrap(),
+        "settling",
+    );
+    assert_eq!(code, Some(130), "{err}");
+    assert!(err.contains("continue with --resume"), "{err}");
+    assert!(ckpt.exists());
+    // another scenario (seed 2) in the same directory: refused, checkpoint kept
+    let other = powder_scenario(&dir.join("other.toml"), 2);
+    let o = powder("2", &["run"], &other, &out, &["--resume"])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("different scenario"), "{e}");
+    assert!(!out.join("summary.json").exists());
+    // continue the preparation, stop again in the coupled run
+    let (code, err) = sigint_on_line(
+        run(&["--resume", "--checkpoint-interval-s", "0"])
+            .spawn()
+            .unwrap(),
+        "coupled run",
+    );
+    assert_eq!(code, Some(130), "{err}");
+    let o = run(&["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        !err.contains("settling") && !err.contains("compressing"),
+        "the preparation is not redone: {err}"
+    );
+    assert_same_powder(reference, &out);
+    powder_test_done();
+}
+
+/// `pdamp powder study --resume` continues inside the interrupted run (not from its start).
+/// The study runs on 1 thread throughout and is compared with the 2-thread reference: results
+/// do not depend on the thread count either.
+#[test]
+fn powder_study_resumes_inside_the_interrupted_run_on_one_thread() {
+    let (dir, scn, reference, _) = powder_reference();
+    let out = dir.join("study");
+    let study = |extra: &[&str]| {
+        powder(
+            "1",
+            &[
+                "study",
+                "--parameter",
+                "packing-density",
+                "--values",
+                "0.58",
+            ],
+            scn,
+            &out,
+            extra,
+        )
+    };
+    let (code, err) = sigint_on_line(study(&[]).spawn().unwrap(), "coupled run");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(err.contains("continue with --resume"), "{err}");
+    let o = study(&["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        !err.contains("settling"),
+        "resumed inside the run, after its preparation: {err}"
+    );
+    // packing density 0.58 is the base scenario's: the run equals the reference
+    assert_same_powder(reference, &out.join("packing_density_0.58"));
+    assert!(out.join("table.csv").exists());
+    powder_test_done();
 }

@@ -4,20 +4,27 @@
 //! resultant 264 N) ramped over 5 ms, held 1 ms and released; the tip displacement (top centre
 //! point, x) decays freely. Scenario files: `examples/powder_cantilever_*.toml`, keys in
 //! `docs/powder.md`.
+//!
+//! [`run_in_dir`] checkpoints a run (preparation and coupled run) into `DIR/checkpoint.bin`
+//! and continues it with `resume`; the outputs then equal those of an uninterrupted run byte
+//! for byte (wall times aside), see docs/reliability.md.
 
-use std::path::Path;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
+pub use pdamp_io::run::RunOptions;
 use serde::{Deserialize, Serialize};
 
-use crate::couple::{Coupled, CoupledEnergy, CouplingSettings, Interface};
+use crate::couple::{Coupled, CoupledEnergy, CoupledState, CouplingSettings, Interface};
 use crate::damping::{self, TableOneRatios};
 use crate::dem::{LogNormal, PowderLaw};
 use crate::fe::{
     self, Aabb, BoxMeshDivisions, Dynamics, GenAlpha, HexMesh, LoadRamp, MassKind, Rayleigh,
     Structure, SurfaceLoad, SvkMaterial,
 };
-use crate::prep::{self, PrepReport, PrepSettings};
+use crate::prep::{PrepReport, PrepSettings, Preparation};
 
 fn d_len() -> f64 {
     0.132
@@ -345,7 +352,7 @@ pub fn cavity_interface(s: &Structure, cavity: &Aabb) -> Interface {
 }
 
 /// Time series and results of a run.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CantileverResult {
     /// Sample times [s].
     #[serde(skip)]
@@ -389,29 +396,181 @@ pub struct CantileverResult {
     pub energy_closure: f64,
 }
 
-/// Runs the scenario (preparation + coupled run). `progress(stage, fraction)`.
+/// Kind tag of `pdamp powder run` checkpoints.
+pub const CHECKPOINT_KIND: &str = "powder-run";
+
+/// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
+pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, String> {
+    let text = toml::to_string(sc).map_err(|e| format!("scenario: {e}"))?;
+    Ok(ck::digest(text.as_bytes()))
+}
+
+/// What a checkpoint holds: the preparation in progress, or the coupled run in progress
+/// (which starts with the prepared powder), or nothing once the outputs are written.
+#[derive(Serialize, Deserialize)]
+enum Phase {
+    Preparing(Box<Preparation>),
+    Running(Box<RunState>),
+    Finished,
+}
+
+/// The coupled run after step `step`: the complete dynamic state and the results so far.
+#[derive(Serialize, Deserialize)]
+struct RunState {
+    step: u64,
+    coupled: CoupledState,
+    prep: Option<PrepReport>,
+    time_s: Vec<f64>,
+    tip_m: Vec<f64>,
+    iterations: Vec<f64>,
+    energy: Vec<(f64, CoupledEnergy)>,
+    max_tip_before_release_m: f64,
+    wall_time_s: f64,
+}
+
+/// Where and how often a run checkpoints.
+struct Checkpointing {
+    path: PathBuf,
+    header: CheckpointHeader,
+    interval_s: f64,
+}
+
+impl Checkpointing {
+    fn save(&self, phase: &Phase) -> Result<(), String> {
+        ck::save(&self.path, &self.header, phase)
+    }
+    fn interrupted(&self, time_s: f64) -> String {
+        ck::Interrupted {
+            time_s,
+            path: self.path.clone(),
+        }
+        .to_string()
+    }
+}
+
+/// Decodes a `pdamp powder run` checkpoint of any scenario and returns its phase and
+/// simulated time [s] (for inspection and fuzzing; never panics).
+pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), String> {
+    Ok(match ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)? {
+        Phase::Preparing(p) => ("preparing", p.time_s()),
+        Phase::Running(r) => ("running", r.coupled.dynamics.t),
+        Phase::Finished => ("finished", f64::NAN),
+    })
+}
+
+/// Runs the scenario (preparation + coupled run) without files. `progress(stage, fraction)`.
 pub fn run(
     sc: &CantileverScenario,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<CantileverResult, String> {
     sc.validate()?;
+    run_core(sc, None, None, progress)
+}
+
+/// Runs the scenario and writes its outputs ([`write_outputs`]) into `dir`, checkpointing
+/// into `DIR/checkpoint.bin` every `options.checkpoint_interval_s` of wall-clock time, once
+/// the preparation is finished (unless the interval is 0) and on a stop request
+/// ([`pdamp_io::checkpoint::request_stop`], the CLI's Ctrl-C/SIGTERM), which ends the run with
+/// an error starting with [`pdamp_io::checkpoint::INTERRUPTED`]. With `options.resume` the run
+/// continues from the checkpoint (a checkpoint of another scenario is refused) and the
+/// outputs equal those of an uninterrupted run byte for byte, wall times aside; resuming a
+/// finished run returns its summary.
+pub fn run_in_dir(
+    sc: &CantileverScenario,
+    dir: &Path,
+    options: RunOptions,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<CantileverResult, String> {
+    sc.validate()?;
+    let digest = scenario_digest(sc)?;
+    let c = Checkpointing {
+        path: dir.join(ck::CHECKPOINT_FILE),
+        header: CheckpointHeader::new(CHECKPOINT_KIND, &digest),
+        interval_s: options.checkpoint_interval_s,
+    };
+    let resumed: Option<Phase> = if options.resume {
+        ck::load(&c.path, CHECKPOINT_KIND, &digest)?
+    } else {
+        None
+    };
+    if let Some(Phase::Finished) = resumed {
+        let path = dir.join("summary.json");
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let js: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        return serde_json::from_value(js["result"].clone())
+            .map_err(|e| format!("{}: {e}", path.display()));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let r = run_core(sc, Some(&c), resumed, progress)?;
+    write_outputs(dir, sc, &r)?;
+    c.save(&Phase::Finished)?;
+    Ok(r)
+}
+
+fn run_core(
+    sc: &CantileverScenario,
+    ckp: Option<&Checkpointing>,
+    resumed: Option<Phase>,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<CantileverResult, String> {
     let (mut s, tip) = build_structure(&sc.beam, &sc.load, sc.run.gravity_m_s2);
     let dt = sc.run.time_step_s;
     let cavity = sc.beam.cavity();
-    let (powder, prep_rep) = match &sc.powder {
-        Some(p) => {
-            let (pw, rep) = prep::prepare(
-                cavity,
-                &p.psd(),
-                p.scaled_law(),
-                p.density_kg_m3,
-                dt,
-                &p.prep,
-                progress,
-            );
-            (pw, Some(rep))
+    let _stoppable = ckp.map(|_| ck::StoppableSection::enter());
+    let mut timer = CheckpointTimer::new(ckp.map_or(0.0, |c| c.interval_s));
+    let (mut preparing, mut running) = (None, None);
+    match resumed {
+        Some(Phase::Preparing(p)) => {
+            p.check_consistency()?;
+            preparing = Some(*p);
         }
-        None => (
+        Some(Phase::Running(r)) => running = Some(*r),
+        Some(Phase::Finished) | None => {}
+    }
+    // preparation (fresh, continued, or done before the checkpoint)
+    let prepared = match (&running, &sc.powder) {
+        (Some(_), _) => None,
+        (None, Some(p)) => {
+            let mut pr = preparing.take().unwrap_or_else(|| {
+                Preparation::new(
+                    cavity,
+                    &p.psd(),
+                    p.scaled_law(),
+                    p.density_kg_m3,
+                    dt,
+                    &p.prep,
+                )
+            });
+            let mut err = None;
+            let flow = pr.run(progress, &mut |pr| {
+                let Some(c) = ckp else {
+                    return ControlFlow::Continue(());
+                };
+                let stop = ck::stop_requested();
+                if stop || timer.due() {
+                    if let Err(e) = c.save(&Phase::Preparing(Box::new(pr.snapshot()))) {
+                        err = Some(e);
+                        return ControlFlow::Break(());
+                    }
+                    if stop {
+                        return ControlFlow::Break(());
+                    }
+                }
+                ControlFlow::Continue(())
+            });
+            if let Some(e) = err {
+                return Err(e);
+            }
+            if flow.is_break() {
+                let c = ckp.ok_or("preparation stopped")?;
+                return Err(c.interrupted(pr.time_s()));
+            }
+            let (pw, rep) = pr.finish();
+            Some((pw, Some(rep)))
+        }
+        (None, None) => Some((
             crate::dem::Powder::new(
                 PowderLaw::PAPER,
                 Vec::new(),
@@ -421,10 +580,8 @@ pub fn run(
                 dt,
             ),
             None,
-        ),
+        )),
     };
-    let mut powder = powder;
-    powder.gravity = sc.run.gravity_m_s2;
     let n = s.n_dof();
     let dynamics = Dynamics::new(
         &mut s,
@@ -437,20 +594,16 @@ pub fn run(
     .map_err(|e| e.to_string())?;
     let interface = cavity_interface(&s, &cavity);
     let structure_mass = s.total_mass();
-    let powder_mass: f64 = powder.mass.iter().sum();
     let elements = s.mesh.elements.len();
-    let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling);
     let nsteps = (sc.run.duration_s / dt).round() as u64;
-    let every = ((sc.run.output_interval_s / dt).round() as u64).max(1);
-    let e_every = (nsteps / 2000).max(1);
-    let mut res = CantileverResult {
+    let result = |c: &Coupled, prep: Option<PrepReport>| CantileverResult {
         time_s: vec![0.0],
         tip_m: vec![0.0],
         iterations: vec![0.0],
         energy: vec![(0.0, c.energy())],
         damping: TableOneRatios::default(),
         max_tip_before_release_m: 0.0,
-        prep: prep_rep,
+        prep,
         particles: c.powder.len(),
         structure_dofs: c.structure.n_dof(),
         elements,
@@ -460,12 +613,59 @@ pub fn run(
         max_iterations: 0,
         wall_time_s: 0.0,
         structure_mass_kg: structure_mass,
-        powder_mass_kg: powder_mass,
+        powder_mass_kg: c.powder.mass.iter().sum(),
         energy_closure: 0.0,
     };
+    let (mut c, mut res, first) = match (running, prepared) {
+        (Some(st), _) => {
+            let c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)?;
+            let res = CantileverResult {
+                time_s: st.time_s,
+                tip_m: st.tip_m,
+                iterations: st.iterations,
+                energy: st.energy,
+                max_tip_before_release_m: st.max_tip_before_release_m,
+                wall_time_s: st.wall_time_s,
+                ..result(&c, st.prep)
+            };
+            (c, res, st.step + 1)
+        }
+        (None, Some((mut powder, prep))) => {
+            powder.gravity = sc.run.gravity_m_s2;
+            let c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling);
+            let res = result(&c, prep);
+            (c, res, 1)
+        }
+        (None, None) => return Err("internal: neither a prepared powder nor a checkpoint".into()),
+    };
+    let wall_before = res.wall_time_s;
     let clock = Instant::now();
+    let wall = |clock: &Instant| wall_before + clock.elapsed().as_secs_f64();
+    let state = |c: &Coupled, res: &CantileverResult, step: u64, wall_time_s: f64| {
+        Phase::Running(Box::new(RunState {
+            step,
+            coupled: c.save_state(),
+            prep: res.prep.clone(),
+            time_s: res.time_s.clone(),
+            tip_m: res.tip_m.clone(),
+            iterations: res.iterations.clone(),
+            energy: res.energy.clone(),
+            max_tip_before_release_m: res.max_tip_before_release_m,
+            wall_time_s,
+        }))
+    };
+    // the prepared powder is checkpointed at once (preparation can take long)
+    if let Some(cp) = ckp
+        && first == 1
+        && sc.powder.is_some()
+        && cp.interval_s > 0.0
+    {
+        cp.save(&state(&c, &res, 0, wall(&clock)))?;
+    }
+    let every = ((sc.run.output_interval_s / dt).round() as u64).max(1);
+    let e_every = (nsteps / 2000).max(1);
     let t_release = sc.load.rise_s + sc.load.hold_s;
-    for q in 1..=nsteps {
+    for q in first..=nsteps {
         let it = c.step().map_err(|e| e.to_string())?;
         let t = c.dynamics.t;
         let x = c.dynamics.d[3 * tip];
@@ -483,8 +683,17 @@ pub fn run(
         if q % 200 == 0 {
             progress("coupled run", q as f64 / nsteps as f64);
         }
+        if let Some(cp) = ckp {
+            let stop = ck::stop_requested();
+            if stop || timer.due() {
+                cp.save(&state(&c, &res, q, wall(&clock)))?;
+                if stop {
+                    return Err(cp.interrupted(t));
+                }
+            }
+        }
     }
-    res.wall_time_s = clock.elapsed().as_secs_f64();
+    res.wall_time_s = wall(&clock);
     res.mean_iterations = c.total_iterations as f64 / c.steps.max(1) as f64;
     res.max_iterations = c.max_iterations_seen;
     res.damping = damping::table_one(&res.time_s, &res.tip_m, t_release);
@@ -509,7 +718,7 @@ pub fn run(
     Ok(res)
 }
 
-/// Writes tip.csv, envelope.csv, energy.csv, summary.json and tip/envelope plots into `dir`.
+/// Writes tip.csv, envelope.csv, energy.csv, the tip plot and (last) summary.json into `dir`.
 pub fn write_outputs(
     dir: &Path,
     sc: &CantileverScenario,
@@ -570,14 +779,6 @@ pub fn write_outputs(
         erows,
     )
     .map_err(|e| e.to_string())?;
-    let summary = serde_json::json!({ "result": r, "scenario": sc });
-    pdamp_io::atomic::write_atomic(
-        dir.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
-    )
-    .map_err(|e| e.to_string())?;
     let ms: Vec<f64> = r.time_s.iter().map(|t| t * 1e3).collect();
     let mm: Vec<f64> = r.tip_m.iter().map(|x| x * 1e3).collect();
     let mut plot = pdamp_plot::LinePlot::new(
@@ -586,6 +787,15 @@ pub fn write_outputs(
     );
     plot.series.push(pdamp_plot::Series::new("", ms, mm));
     pdamp_plot::line_plot(dir.join("tip"), &plot).map_err(|e| e.to_string())?;
+    // last: a run directory with summary.json is complete (the study skips it)
+    let summary = serde_json::json!({ "result": r, "scenario": sc });
+    pdamp_io::atomic::write_atomic(
+        dir.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .map_err(|e| e.to_string())?
+            .as_bytes(),
+    )
+    .map_err(|e| e.to_string())?;
     Ok(())
 }
 
@@ -636,4 +846,56 @@ pub fn timoshenko_reference(beam: &BeamSpec) -> f64 {
         1320,
         &[],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoint_inspection_and_damage() {
+        let dir = std::env::temp_dir().join(format!("pdamp-powder-inspect-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(ck::CHECKPOINT_FILE);
+        let cavity = Aabb {
+            min: [0.0; 3],
+            max: [0.006, 0.006, 0.012],
+        };
+        let s = PrepSettings::default();
+        let mut pr = Preparation::new(
+            cavity,
+            &LogNormal::paper(2e-3),
+            PowderLaw::PAPER.coarse_grained(2.0),
+            8000.0,
+            5e-6,
+            &s,
+        );
+        let mut k = 0;
+        let _ = pr.run(&mut |_, _| {}, &mut |_| {
+            k += 1;
+            if k == 50 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        let header = CheckpointHeader::new(CHECKPOINT_KIND, "digest");
+        ck::save(&path, &header, &Phase::Preparing(Box::new(pr.snapshot()))).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let (phase, t) = inspect_checkpoint(&bytes).unwrap();
+        assert_eq!(phase, "preparing");
+        assert!((t - 50.0 * 5e-6).abs() < 1e-15, "{t}");
+        // another scenario, another kind, damage and truncation are refused with a message
+        let e = ck::load::<Phase>(&path, CHECKPOINT_KIND, "other")
+            .err()
+            .unwrap();
+        assert!(e.contains("different scenario"), "{e}");
+        let e = ck::load::<Phase>(&path, "run", "digest").err().unwrap();
+        assert!(e.contains("not 'run'"), "{e}");
+        let mut bad = bytes.clone();
+        bad[bytes.len() / 2] ^= 1;
+        assert!(inspect_checkpoint(&bad).unwrap_err().contains("damaged"));
+        assert!(inspect_checkpoint(&bytes[..bytes.len() - 100]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

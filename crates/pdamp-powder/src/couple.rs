@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use crate::dem::Powder;
 use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
-use crate::fe::{Dynamics, DynamicsError, Face, Structure};
+use crate::fe::{Dynamics, DynamicsError, DynamicsState, Face, Structure};
 
 /// The interface $\Gamma^{ps}$: boundary faces of the structure in contact with the powder.
 #[derive(Debug, Clone)]
@@ -175,7 +175,7 @@ pub enum CoupleError {
 }
 
 /// Energies of the coupled system [J].
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoupledEnergy {
     /// Structure kinetic energy.
     pub structure_kinetic_j: f64,
@@ -193,6 +193,35 @@ pub struct CoupledEnergy {
     pub load_work_j: f64,
     /// Stored + dissipated − load work (constant for an exact scheme).
     pub balance_j: f64,
+}
+
+/// The dynamic state of a [`Coupled`] system between steps, for checkpoints: the structure's
+/// time integration, the particles (with their pair list and spring history), the
+/// particle–wall spring history, the interface force and work, the contact candidates and the
+/// fixed-point work vectors, and the iteration counters. The mesh, the interface and the
+/// factorization are rebuilt from the scenario.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+pub struct CoupledState {
+    /// Structure.
+    pub dynamics: DynamicsState,
+    /// Particles.
+    pub powder: Powder,
+    counters: [u64; 4],
+    f_ps: Vec<f64>,
+    elastic_pw_j: f64,
+    interface_work_j: f64,
+    hist: Vec<WallSlots>,
+    cand_start: Vec<usize>,
+    cand: Vec<u32>,
+    cand_pos: Vec<[f64; 3]>,
+    cand_disp: f64,
+    dk: Vec<f64>,
+    f_trial: Vec<f64>,
+    r_prev: Vec<f64>,
+    r_cur: Vec<f64>,
+    omega: f64,
+    xcur: Vec<[f64; 3]>,
+    vcur: Vec<[f64; 3]>,
 }
 
 /// The coupled particle–structure system.
@@ -278,6 +307,92 @@ impl Coupled {
             vcur: vec![[0.0; 3]; nn],
             powder,
         }
+    }
+
+    /// The state for a checkpoint (see [`CoupledState`]).
+    pub fn save_state(&self) -> CoupledState {
+        CoupledState {
+            dynamics: self.dynamics.save_state(),
+            powder: self.powder.clone(),
+            counters: [
+                self.last_iterations as u64,
+                self.total_iterations,
+                self.max_iterations_seen as u64,
+                self.steps,
+            ],
+            f_ps: self.f_ps.clone(),
+            elastic_pw_j: self.elastic_pw_j,
+            interface_work_j: self.interface_work_j,
+            hist: self.hist.clone(),
+            cand_start: self.cand_start.clone(),
+            cand: self.cand.clone(),
+            cand_pos: self.cand_pos.clone(),
+            cand_disp: self.cand_disp,
+            dk: self.dk.clone(),
+            f_trial: self.f_trial.clone(),
+            r_prev: self.r_prev.clone(),
+            r_cur: self.r_cur.clone(),
+            omega: self.omega,
+            xcur: self.xcur.clone(),
+            vcur: self.vcur.clone(),
+        }
+    }
+
+    /// The system of [`Coupled::new`] continued from `st` (saved by [`Coupled::save_state`]
+    /// for the same structure, interface and settings): the following steps are bit for bit
+    /// those of the saved run. `dynamics` is a fresh [`Dynamics`] of `structure`.
+    pub fn from_state(
+        structure: Structure,
+        mut dynamics: Dynamics,
+        interface: Interface,
+        settings: CouplingSettings,
+        st: CoupledState,
+    ) -> Result<Self, String> {
+        st.powder.check_consistency()?;
+        dynamics.restore_state(st.dynamics)?;
+        let (n, ndof) = (st.powder.len(), structure.n_dof());
+        let nn = structure.mesh.nodes.len();
+        let nf = interface.faces.len();
+        let cand_ok = (st.cand_start.is_empty() && st.cand.is_empty())
+            || (st.cand_start.len() == n + 1
+                && st.cand_start[0] == 0
+                && st.cand_start[n] == st.cand.len()
+                && st.cand_start.windows(2).all(|w| w[0] <= w[1])
+                && st.cand.iter().all(|&f| (f as usize) < nf));
+        if st.hist.len() != n
+            || !cand_ok
+            || st.cand_pos.is_empty() != st.cand_start.is_empty()
+            || !(st.cand_pos.is_empty() || st.cand_pos.len() == n)
+            || [&st.f_ps, &st.dk, &st.f_trial]
+                .iter()
+                .any(|v| v.len() != ndof)
+            || st.xcur.len() != nn
+            || st.vcur.len() != nn
+        {
+            return Err("coupling state does not match the structure and the particles".into());
+        }
+        let mut c = Self::new(structure, dynamics, st.powder, interface, settings);
+        let [last, total, max, steps] = st.counters;
+        c.last_iterations = last as usize;
+        c.total_iterations = total;
+        c.max_iterations_seen = max as usize;
+        c.steps = steps;
+        c.f_ps = st.f_ps;
+        c.elastic_pw_j = st.elastic_pw_j;
+        c.interface_work_j = st.interface_work_j;
+        c.hist = st.hist;
+        c.cand_start = st.cand_start;
+        c.cand = st.cand;
+        c.cand_pos = st.cand_pos;
+        c.cand_disp = st.cand_disp;
+        c.dk = st.dk;
+        c.f_trial = st.f_trial;
+        c.r_prev = st.r_prev;
+        c.r_cur = st.r_cur;
+        c.omega = st.omega;
+        c.xcur = st.xcur;
+        c.vcur = st.vcur;
+        Ok(c)
     }
 
     /// Candidate faces per particle: faces whose current bounding box, enlarged by the particle

@@ -28,7 +28,7 @@ pub fn local_extrema(t: &[f64], x: &[f64], t_start: f64) -> Vec<usize> {
 }
 
 /// Table-1 damping ratios.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TableOneRatios {
     /// ζ1 (first → second minimum); `None` if fewer than two minima.
     pub zeta_1: Option<f64>,

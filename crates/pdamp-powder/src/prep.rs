@@ -4,10 +4,15 @@
 //! height, so that the packing density (particle volume / cavity volume) is the prescribed ϕ;
 //! finally relaxed with the plate held. The particles are prepared directly in the cavity's
 //! coordinates, so "extraction and insertion" is removing the box walls and the plate.
+//!
+//! [`Preparation`] holds the whole state of a preparation in progress (particles, walls, wall
+//! spring history, stage and step counters) and is serializable, so a long preparation can be
+//! checkpointed and continued bit for bit; [`prepare`] runs one from start to end.
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
-use crate::dem::wall::{self, EMPTY_SLOTS};
+use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
 use crate::dem::{LogNormal, PlaneWall, Powder, PowderLaw, Rng};
 use crate::fe::Aabb;
 
@@ -43,7 +48,7 @@ impl Default for PrepSettings {
 }
 
 /// Outcome of the preparation.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PrepReport {
     /// Particles.
     pub particles: usize,
@@ -65,6 +70,330 @@ pub struct PrepReport {
     pub wall_time_s: f64,
 }
 
+/// Gravity of the relaxation, compression and of the prepared bed [m/s²].
+const G0: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// Steps between the kinetic-energy checks of the settling.
+const SETTLE_CHUNK: u32 = 200;
+
+/// Stage of a preparation in progress.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+enum Stage {
+    /// Settling under magnified gravity; `chunk` steps of the current block done.
+    Settling { chunk: u32 },
+    /// Relaxation under 1 g before the compression; `done` steps.
+    Relaxing { done: u64 },
+    /// Plate compression: step `q` of `nsteps` with the plate increment `dz` [m].
+    Compressing { q: u64, nsteps: u64, dz: f64 },
+    /// Relaxation with the plate held at the cavity top; `q` steps.
+    Holding { q: u64 },
+    /// Finished.
+    Done,
+}
+
+/// A powder preparation in progress (see the module docs). Serializable: a preparation saved
+/// with [`Preparation::snapshot`] and continued with [`Preparation::run`] ends bit for bit as
+/// an uninterrupted one.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+pub struct Preparation {
+    powder: Powder,
+    planes: Vec<PlaneWall>,
+    hist: Vec<WallSlots>,
+    on_wall: [[f64; 3]; 6],
+    stage: Stage,
+    steps: u64,
+    cavity: Aabb,
+    settings: PrepSettings,
+    e_ref: f64,
+    relax_steps: u64,
+    settled: f64,
+    compressed: bool,
+    bed_top: f64,
+    plate_force: f64,
+    wall_time_s: f64,
+    #[serde(skip)]
+    segment_start: Option<Instant>,
+}
+
+impl Preparation {
+    /// Particles drawn and placed on the grid in `cavity` (gravity along −z during
+    /// preparation, as in the paper), nothing simulated yet.
+    pub fn new(
+        cavity: Aabb,
+        psd: &LogNormal,
+        law: PowderLaw,
+        density_kg_m3: f64,
+        dt: f64,
+        s: &PrepSettings,
+    ) -> Self {
+        let mut rng = Rng::new(s.seed);
+        let vcav = cavity.volume();
+        let diam = psd.fill_volume(s.packing_density * vcav, &mut rng);
+        let spacing = psd.d_max_m * 1.02;
+        let (lx, ly) = (cavity.max[0] - cavity.min[0], cavity.max[1] - cavity.min[1]);
+        let nx = ((lx / spacing).floor() as usize).max(1);
+        let ny = ((ly / spacing).floor() as usize).max(1);
+        let ox = cavity.min[0] + 0.5 * (lx - (nx as f64 - 1.0) * spacing);
+        let oy = cavity.min[1] + 0.5 * (ly - (ny as f64 - 1.0) * spacing);
+        let mut pos = Vec::with_capacity(diam.len());
+        for (q, _) in diam.iter().enumerate() {
+            let layer = q / (nx * ny);
+            let rem = q % (nx * ny);
+            let (i, j) = (rem % nx, rem / nx);
+            let jit = 0.005 * spacing;
+            pos.push([
+                ox + i as f64 * spacing + jit * (rng.uniform() - 0.5),
+                oy + j as f64 * spacing + jit * (rng.uniform() - 0.5),
+                cavity.min[2] + 0.5 * spacing + layer as f64 * spacing,
+            ]);
+        }
+        let radius: Vec<f64> = diam.iter().map(|d| 0.5 * d).collect();
+        let p = Powder::new(
+            law,
+            pos,
+            radius,
+            density_kg_m3,
+            [0.0, 0.0, -9.81 * s.settling_gravity_factor],
+            dt,
+        );
+        let n = p.len();
+        let top_start = p
+            .pos
+            .iter()
+            .zip(&p.radius)
+            .map(|(x, r)| x[2] + r)
+            .fold(cavity.max[2], f64::max)
+            + spacing;
+        let plane = |point: [f64; 3], normal: [f64; 3]| PlaneWall {
+            point,
+            normal,
+            velocity: [0.0; 3],
+        };
+        let planes = vec![
+            plane(cavity.min, [1.0, 0.0, 0.0]),
+            plane(cavity.max, [-1.0, 0.0, 0.0]),
+            plane(cavity.min, [0.0, 1.0, 0.0]),
+            plane(cavity.max, [0.0, -1.0, 0.0]),
+            plane(cavity.min, [0.0, 0.0, 1.0]),
+            plane([cavity.min[0], cavity.min[1], top_start], [0.0, 0.0, -1.0]),
+        ];
+        let mtot: f64 = p.mass.iter().sum();
+        // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
+        let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
+        Self {
+            powder: p,
+            planes,
+            hist: vec![EMPTY_SLOTS; n],
+            on_wall: [[0.0; 3]; 6],
+            stage: Stage::Settling { chunk: 0 },
+            steps: 0,
+            cavity,
+            settings: *s,
+            e_ref,
+            relax_steps: (s.relax_time_s / dt).ceil() as u64,
+            settled: 0.0,
+            compressed: false,
+            bed_top: 0.0,
+            plate_force: 0.0,
+            wall_time_s: 0.0,
+            segment_start: None,
+        }
+    }
+
+    /// Number of particles.
+    pub fn particles(&self) -> usize {
+        self.powder.len()
+    }
+
+    /// Simulated preparation time so far [s].
+    pub fn time_s(&self) -> f64 {
+        self.powder.t
+    }
+
+    /// Checks that a deserialized preparation is self-consistent.
+    pub fn check_consistency(&self) -> Result<(), String> {
+        self.powder.check_consistency()?;
+        if self.hist.len() != self.powder.len() || self.planes.len() != 6 {
+            return Err("preparation state: wall history does not match the particles".into());
+        }
+        Ok(())
+    }
+
+    /// Wall-clock time spent in this preparation so far, over all runs [s].
+    pub fn wall_time_s(&self) -> f64 {
+        self.wall_time_s
+            + self
+                .segment_start
+                .map_or(0.0, |t| t.elapsed().as_secs_f64())
+    }
+
+    /// A copy for a checkpoint (its wall time includes the running segment).
+    pub fn snapshot(&self) -> Self {
+        Self {
+            wall_time_s: self.wall_time_s(),
+            segment_start: None,
+            ..self.clone()
+        }
+    }
+
+    fn step(&mut self) {
+        let p = &mut self.powder;
+        p.predict();
+        p.pair_forces();
+        wall::plane_forces(p, &self.planes, &mut self.hist, &mut self.on_wall);
+        p.finish();
+        self.steps += 1;
+    }
+
+    fn end_settling(&mut self) {
+        // switch to real gravity and let the bed relax briefly
+        self.powder.gravity = G0;
+        self.stage = Stage::Relaxing { done: 0 };
+    }
+
+    fn start_compression(&mut self) {
+        let (p, cavity, s) = (&self.powder, self.cavity, self.settings);
+        let bed_top = p
+            .pos
+            .iter()
+            .zip(&p.radius)
+            .map(|(x, r)| x[2] + r)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let area = (cavity.max[0] - cavity.min[0]) * (cavity.max[1] - cavity.min[1]);
+        self.settled = p.volume() / (area * (bed_top - cavity.min[2]));
+        self.compressed = bed_top > cavity.max[2];
+        self.bed_top = bed_top;
+        let dt = p.dt;
+        if !self.compressed {
+            self.start_holding();
+            return;
+        }
+        // compression: plate from just above the bed down to the cavity top
+        let dist = bed_top - cavity.max[2];
+        let nsteps = (dist / (s.plate_speed_m_s * dt)).ceil() as u64;
+        let dz = dist / nsteps as f64;
+        self.planes[5].point[2] = bed_top;
+        self.planes[5].velocity = [0.0, 0.0, -dz / dt];
+        self.stage = Stage::Compressing { q: 0, nsteps, dz };
+    }
+
+    fn start_holding(&mut self) {
+        self.planes[5].point[2] = self.cavity.max[2];
+        self.planes[5].velocity = [0.0; 3];
+        self.stage = Stage::Holding { q: 0 };
+    }
+
+    /// One step (or one change of stage); false once finished.
+    fn advance(&mut self, progress: &mut dyn FnMut(&str, f64)) -> bool {
+        match self.stage {
+            Stage::Settling { chunk } => {
+                let t_end = self.settings.max_settling_time_s;
+                if chunk == 0 && self.powder.t >= t_end {
+                    self.end_settling();
+                    return true;
+                }
+                self.step();
+                self.stage = Stage::Settling {
+                    chunk: (chunk + 1) % SETTLE_CHUNK,
+                };
+                if chunk + 1 == SETTLE_CHUNK {
+                    let ke = self.powder.kinetic_energy();
+                    progress("settling", self.powder.t / t_end);
+                    let dt = self.powder.dt;
+                    if ke < self.e_ref && self.powder.t > 10.0 * dt * SETTLE_CHUNK as f64 {
+                        self.end_settling();
+                    }
+                }
+            }
+            Stage::Relaxing { done } => {
+                if done < self.relax_steps {
+                    self.step();
+                    self.stage = Stage::Relaxing { done: done + 1 };
+                } else {
+                    self.start_compression();
+                }
+            }
+            Stage::Compressing { q, nsteps, dz } => {
+                if q < nsteps {
+                    self.planes[5].point[2] = self.bed_top - dz * (q + 1) as f64;
+                    self.step();
+                    if q % 500 == 0 {
+                        progress("compressing", q as f64 / nsteps as f64);
+                    }
+                    self.stage = Stage::Compressing {
+                        q: q + 1,
+                        nsteps,
+                        dz,
+                    };
+                } else {
+                    self.start_holding();
+                }
+            }
+            Stage::Holding { q } => {
+                if q < self.relax_steps {
+                    self.step();
+                    self.plate_force = self.on_wall[5][2];
+                    if q % 500 == 0 {
+                        progress("relaxing", q as f64 / self.relax_steps as f64);
+                    }
+                    self.stage = Stage::Holding { q: q + 1 };
+                } else {
+                    self.stage = Stage::Done;
+                }
+            }
+            Stage::Done => return false,
+        }
+        true
+    }
+
+    /// Runs the preparation to its end; `hook` is called after every step (with the state at
+    /// a point where [`Preparation::snapshot`] can be taken) and stops the run at once when it
+    /// returns `Break` (then the result is `Break`; calling `run` again continues).
+    pub fn run(
+        &mut self,
+        progress: &mut dyn FnMut(&str, f64),
+        hook: &mut dyn FnMut(&Preparation) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.segment_start = Some(Instant::now());
+        while self.advance(progress) {
+            if hook(self).is_break() {
+                return ControlFlow::Break(());
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// The prepared powder (at rest, clock and ledger reset) and the report; call after
+    /// [`Preparation::run`] returned `Continue`.
+    pub fn finish(mut self) -> (Powder, PrepReport) {
+        let wall_time_s = self.wall_time_s();
+        let p = &mut self.powder;
+        for v in p.vel.iter_mut() {
+            *v = [0.0; 3];
+        }
+        for w in p.omega.iter_mut() {
+            *w = [0.0; 3];
+        }
+        for w in p.wall_force.iter_mut() {
+            *w = [0.0; 3];
+        }
+        let rep = PrepReport {
+            particles: p.len(),
+            settled_packing_density: self.settled,
+            packing_density: p.volume() / self.cavity.volume(),
+            compressed: self.compressed,
+            plate_force_n: self.plate_force,
+            max_relative_overlap: p.max_relative_overlap(),
+            simulated_time_s: p.t,
+            steps: self.steps,
+            wall_time_s,
+        };
+        p.t = 0.0;
+        p.ledger = Default::default();
+        (self.powder, rep)
+    }
+}
+
 /// Prepares the powder in `cavity` (gravity along −z during preparation, as in the paper).
 pub fn prepare(
     cavity: Aabb,
@@ -75,168 +404,7 @@ pub fn prepare(
     s: &PrepSettings,
     progress: &mut dyn FnMut(&str, f64),
 ) -> (Powder, PrepReport) {
-    let clock = Instant::now();
-    let mut rng = Rng::new(s.seed);
-    let vcav = cavity.volume();
-    let diam = psd.fill_volume(s.packing_density * vcav, &mut rng);
-    let spacing = psd.d_max_m * 1.02;
-    let (lx, ly) = (cavity.max[0] - cavity.min[0], cavity.max[1] - cavity.min[1]);
-    let nx = ((lx / spacing).floor() as usize).max(1);
-    let ny = ((ly / spacing).floor() as usize).max(1);
-    let ox = cavity.min[0] + 0.5 * (lx - (nx as f64 - 1.0) * spacing);
-    let oy = cavity.min[1] + 0.5 * (ly - (ny as f64 - 1.0) * spacing);
-    let mut pos = Vec::with_capacity(diam.len());
-    for (q, _) in diam.iter().enumerate() {
-        let layer = q / (nx * ny);
-        let rem = q % (nx * ny);
-        let (i, j) = (rem % nx, rem / nx);
-        let jit = 0.005 * spacing;
-        pos.push([
-            ox + i as f64 * spacing + jit * (rng.uniform() - 0.5),
-            oy + j as f64 * spacing + jit * (rng.uniform() - 0.5),
-            cavity.min[2] + 0.5 * spacing + layer as f64 * spacing,
-        ]);
-    }
-    let radius: Vec<f64> = diam.iter().map(|d| 0.5 * d).collect();
-    let g0 = [0.0, 0.0, -9.81];
-    let mut p = Powder::new(
-        law,
-        pos,
-        radius,
-        density_kg_m3,
-        [0.0, 0.0, -9.81 * s.settling_gravity_factor],
-        dt,
-    );
-    let n = p.len();
-    let top_start = p
-        .pos
-        .iter()
-        .zip(&p.radius)
-        .map(|(x, r)| x[2] + r)
-        .fold(cavity.max[2], f64::max)
-        + spacing;
-    let mut planes = vec![
-        PlaneWall {
-            point: cavity.min,
-            normal: [1.0, 0.0, 0.0],
-            velocity: [0.0; 3],
-        },
-        PlaneWall {
-            point: cavity.max,
-            normal: [-1.0, 0.0, 0.0],
-            velocity: [0.0; 3],
-        },
-        PlaneWall {
-            point: cavity.min,
-            normal: [0.0, 1.0, 0.0],
-            velocity: [0.0; 3],
-        },
-        PlaneWall {
-            point: cavity.max,
-            normal: [0.0, -1.0, 0.0],
-            velocity: [0.0; 3],
-        },
-        PlaneWall {
-            point: cavity.min,
-            normal: [0.0, 0.0, 1.0],
-            velocity: [0.0; 3],
-        },
-        PlaneWall {
-            point: [cavity.min[0], cavity.min[1], top_start],
-            normal: [0.0, 0.0, -1.0],
-            velocity: [0.0; 3],
-        },
-    ];
-    let mut hist = vec![EMPTY_SLOTS; n];
-    let mut steps = 0u64;
-    let mut on_wall = [[0.0; 3]; 6];
-    let step =
-        |p: &mut Powder, planes: &[PlaneWall], hist: &mut Vec<_>, on_wall: &mut [[f64; 3]; 6]| {
-            p.predict();
-            p.pair_forces();
-            wall::plane_forces(p, planes, hist, on_wall);
-            p.finish();
-        };
-    let mtot: f64 = p.mass.iter().sum();
-    // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
-    let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
-    let t_end = s.max_settling_time_s;
-    while p.t < t_end {
-        for _ in 0..200 {
-            step(&mut p, &planes, &mut hist, &mut on_wall);
-            steps += 1;
-        }
-        let ke = p.kinetic_energy();
-        progress("settling", p.t / t_end);
-        if ke < e_ref && p.t > 10.0 * dt * 200.0 {
-            break;
-        }
-    }
-    // switch to real gravity and let the bed relax briefly
-    p.gravity = g0;
-    let relax_steps = (s.relax_time_s / dt).ceil() as u64;
-    for _ in 0..relax_steps {
-        step(&mut p, &planes, &mut hist, &mut on_wall);
-        steps += 1;
-    }
-    let bed_top = p
-        .pos
-        .iter()
-        .zip(&p.radius)
-        .map(|(x, r)| x[2] + r)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let area = lx * ly;
-    let settled = p.volume() / (area * (bed_top - cavity.min[2]));
-    let compressed = bed_top > cavity.max[2];
-    // compression: plate from just above the bed down to the cavity top
-    let mut plate_force = 0.0;
-    if compressed {
-        planes[5].point[2] = bed_top;
-        planes[5].velocity = [0.0, 0.0, -s.plate_speed_m_s];
-        let dist = bed_top - cavity.max[2];
-        let nsteps = (dist / (s.plate_speed_m_s * dt)).ceil() as u64;
-        let dz = dist / nsteps as f64;
-        planes[5].velocity = [0.0, 0.0, -dz / dt];
-        for q in 0..nsteps {
-            planes[5].point[2] = bed_top - dz * (q + 1) as f64;
-            step(&mut p, &planes, &mut hist, &mut on_wall);
-            steps += 1;
-            if q % 500 == 0 {
-                progress("compressing", q as f64 / nsteps as f64);
-            }
-        }
-    }
-    planes[5].point[2] = cavity.max[2];
-    planes[5].velocity = [0.0; 3];
-    for q in 0..relax_steps {
-        step(&mut p, &planes, &mut hist, &mut on_wall);
-        plate_force = on_wall[5][2];
-        steps += 1;
-        if q % 500 == 0 {
-            progress("relaxing", q as f64 / relax_steps as f64);
-        }
-    }
-    for v in p.vel.iter_mut() {
-        *v = [0.0; 3];
-    }
-    for w in p.omega.iter_mut() {
-        *w = [0.0; 3];
-    }
-    for w in p.wall_force.iter_mut() {
-        *w = [0.0; 3];
-    }
-    let rep = PrepReport {
-        particles: n,
-        settled_packing_density: settled,
-        packing_density: p.volume() / vcav,
-        compressed,
-        plate_force_n: plate_force,
-        max_relative_overlap: p.max_relative_overlap(),
-        simulated_time_s: p.t,
-        steps,
-        wall_time_s: clock.elapsed().as_secs_f64(),
-    };
-    p.t = 0.0;
-    p.ledger = Default::default();
-    (p, rep)
+    let mut prep = Preparation::new(cavity, psd, law, density_kg_m3, dt, s);
+    let _ = prep.run(progress, &mut |_| ControlFlow::Continue(()));
+    prep.finish()
 }

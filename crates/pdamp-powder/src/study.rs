@@ -1,7 +1,9 @@
 //! Parameter studies of paper Sect. 3 (Figs. 2–6, Table 1): one cantilever run per value of a
 //! parameter, each written to its own sub-directory, plus a combined decay plot, an envelope
 //! plot and a Table-1-like `table.csv` (ζ1, ζ2, ζ̄5 per value). Finished runs
-//! (`<dir>/summary.json` present) are skipped, so a study can be resumed.
+//! (`<dir>/summary.json` present) are skipped, so a study can be resumed; each run
+//! checkpoints into `<dir>/checkpoint.bin` and, with `resume`, an interrupted run continues
+//! from its checkpoint ([`cantilever::run_in_dir`]).
 
 use std::path::Path;
 
@@ -90,12 +92,15 @@ pub struct StudyRow {
     pub wall_time_s: f64,
 }
 
-/// Runs the study into `out` and returns the table.
+/// Runs the study into `out` and returns the table; `options` are passed to every run that
+/// is not finished yet (checkpoint interval; `resume` continues an interrupted run from its
+/// checkpoint).
 pub fn run_study(
     base: &CantileverScenario,
     param: StudyParameter,
     values: &[f64],
     out: &Path,
+    options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<Vec<StudyRow>, String> {
     let mut rows = Vec::new();
@@ -137,8 +142,7 @@ pub fn run_study(
         } else {
             let mut prog =
                 |stage: &str, f: f64| progress(stage, (q as f64 + f) / values.len() as f64);
-            let r = cantilever::run(&sc, &mut prog)?;
-            cantilever::write_outputs(&dir, &sc, &r)?;
+            let r = cantilever::run_in_dir(&sc, &dir, options, &mut prog)?;
             let wall = r.wall_time_s + r.prep.as_ref().map_or(0.0, |p| p.wall_time_s);
             (
                 r.time_s.clone(),

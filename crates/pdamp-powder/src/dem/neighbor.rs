@@ -2,8 +2,9 @@
 //! transfer of the tangential-spring history across rebuilds and a reverse index for a
 //! deterministic parallel gather. All buffers are reused: no allocation once warmed up.
 
-/// Pair list with per-pair history.
-#[derive(Debug, Clone, Default)]
+/// Pair list with per-pair history. Serializable for checkpoints (the scratch buffers, which a
+/// rebuild clears or overwrites before reading, are skipped).
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct NeighborList {
     /// Skin distance [m].
     pub skin: f64,
@@ -24,12 +25,19 @@ pub struct NeighborList {
     /// Number of rebuilds so far.
     pub rebuilds: u64,
     // scratch
+    #[serde(skip)]
     old_start: Vec<usize>,
+    #[serde(skip)]
     old_pj: Vec<u32>,
+    #[serde(skip)]
     old_gt: Vec<[f64; 3]>,
+    #[serde(skip)]
     cell_of: Vec<usize>,
+    #[serde(skip)]
     cell_start: Vec<usize>,
+    #[serde(skip)]
     cell_items: Vec<u32>,
+    #[serde(skip)]
     tmp: Vec<u32>,
 }
 
@@ -40,6 +48,35 @@ impl NeighborList {
             skin,
             ..Default::default()
         }
+    }
+
+    /// Checks that a deserialized list fits `n` particles (lengths, monotone offsets, indices
+    /// in range).
+    pub fn check_consistency(&self, n: usize) -> Result<(), String> {
+        let bad = |what: &str| Err(format!("pair list: {what}"));
+        let ne = self.pj.len();
+        if self.pi.len() != ne || self.gt.len() != ne || self.rev.len() != ne {
+            return bad("entry arrays of different lengths");
+        }
+        let offsets_ok = |v: &[usize]| {
+            (v.is_empty() && ne == 0)
+                || (v.len() == n + 1
+                    && v[0] == 0
+                    && v[n] == ne
+                    && v.windows(2).all(|w| w[0] <= w[1]))
+        };
+        if !offsets_ok(&self.start) || !offsets_ok(&self.rev_start) {
+            return bad("offsets do not match the particles");
+        }
+        if self.pi.iter().chain(&self.pj).any(|&i| i as usize >= n)
+            || self.rev.iter().any(|&e| e as usize >= ne)
+        {
+            return bad("index out of range");
+        }
+        if !(self.ref_pos.is_empty() || self.ref_pos.len() == n) {
+            return bad("reference positions do not match the particles");
+        }
+        Ok(())
     }
 
     /// Whether some particle moved more than skin/2 since the last rebuild.

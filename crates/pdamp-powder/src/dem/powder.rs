@@ -15,7 +15,7 @@ use super::law::{self, PowderLaw};
 use super::neighbor::NeighborList;
 
 /// Energy bookkeeping of the particles [J].
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PowderLedger {
     /// Dissipated in particle–particle contacts.
     pub dissipated_pp_j: f64,
@@ -24,6 +24,12 @@ pub struct PowderLedger {
 }
 
 /// Particles and their contacts.
+///
+/// Serializable for checkpoints: every field that carries state from one step to the next
+/// (positions, velocities, spins, forces, accelerations, the pair list with its tangential
+/// springs and reference positions, energies) is written; the per-pair scratch buffers are
+/// skipped because [`Powder::pair_forces`] overwrites every entry before reading it.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub struct Powder {
     /// Contact law.
     pub law: PowderLaw,
@@ -67,11 +73,17 @@ pub struct Powder {
     pub sliding_pp: usize,
     /// Touching pp contacts in the last force pass.
     pub touching_pp: usize,
+    #[serde(skip)]
     pf: Vec<[f64; 3]>,
+    #[serde(skip)]
     ti: Vec<[f64; 3]>,
+    #[serde(skip)]
     tj: Vec<[f64; 3]>,
+    #[serde(skip)]
     e_el: Vec<f64>,
+    #[serde(skip)]
     e_diss: Vec<f64>,
+    #[serde(skip)]
     state: Vec<u8>,
 }
 
@@ -141,6 +153,33 @@ impl Powder {
             e_diss: Vec::new(),
             state: Vec::new(),
         }
+    }
+
+    /// Checks that a deserialized state is self-consistent (array lengths, pair indices), so
+    /// that a damaged checkpoint is refused with a message instead of a panic later.
+    pub fn check_consistency(&self) -> Result<(), String> {
+        let n = self.pos.len();
+        for (k, len) in [
+            ("vel", self.vel.len()),
+            ("omega", self.omega.len()),
+            ("radius", self.radius.len()),
+            ("mass", self.mass.len()),
+            ("inertia", self.inertia.len()),
+            ("force", self.force.len()),
+            ("torque", self.torque.len()),
+            ("wall_force", self.wall_force.len()),
+            ("wall_torque", self.wall_torque.len()),
+            ("acc", self.acc.len()),
+            ("alpha", self.alpha.len()),
+        ] {
+            if len != n {
+                return Err(format!("powder state: {k} has {len} entries, expected {n}"));
+            }
+        }
+        if !(self.radius.iter().all(|&r| r > 0.0) && self.mass.iter().all(|&m| m > 0.0)) {
+            return Err("powder state: radii and masses must be positive".into());
+        }
+        self.nl.check_consistency(n)
     }
 
     /// Number of particles.

@@ -29,7 +29,7 @@ pub fn slot_put(s: &mut WallSlots, id: u32, g: [f64; 3]) {
 }
 
 /// A rigid plane: points `x` with $(\mathbf x-\mathbf p)\cdot\mathbf n \ge 0$ are inside.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlaneWall {
     /// A point on the plane [m].
     pub point: [f64; 3],

@@ -148,6 +148,27 @@ pub struct Dynamics {
     tmp2: Vec<f64>,
 }
 
+/// The dynamic state of a [`Dynamics`] between steps, for checkpoints: everything a step
+/// reads that an earlier step wrote (committed and trial vectors, force vectors at the last
+/// committed state, energies, counters). The effective matrix and its factorization are not
+/// stored: with modified Newton they are those of the reference configuration (rebuilt by
+/// [`Dynamics::new`]); with full Newton they are refactorized before every use.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DynamicsState {
+    /// Time step [s] (checked on restore).
+    pub dt: f64,
+    /// Time [s].
+    pub t: f64,
+    /// d, v, a, d1, v1, a1, F_int,n, F_ext,n, F_int,n+1, F_ext,n+1 (all dofs).
+    pub vectors: [Vec<f64>; 10],
+    /// Strain energy (committed, trial) [J].
+    pub strain_energy: [f64; 2],
+    /// External work [J].
+    pub external_work: f64,
+    /// Newton iterations of the last solve.
+    pub last_iterations: usize,
+}
+
 impl Dynamics {
     /// Starts at `t = 0` with displacement `d0`, velocity `v0` (all dofs; clamped entries
     /// ignored) and zero external interface force; the initial acceleration solves eq. 11.
@@ -206,6 +227,56 @@ impl Dynamics {
             tmp: vec![0.0; nf],
             tmp2: vec![0.0; nf],
         })
+    }
+
+    /// The state for a checkpoint (see [`DynamicsState`]).
+    pub fn save_state(&self) -> DynamicsState {
+        DynamicsState {
+            dt: self.dt,
+            t: self.t,
+            vectors: [
+                self.d.clone(),
+                self.v.clone(),
+                self.a.clone(),
+                self.d1.clone(),
+                self.v1.clone(),
+                self.a1.clone(),
+                self.fint_n.clone(),
+                self.fext_n.clone(),
+                self.fint1.clone(),
+                self.fext1.clone(),
+            ],
+            strain_energy: [self.strain_energy, self.strain_energy1],
+            external_work: self.external_work,
+            last_iterations: self.last_iterations,
+        }
+    }
+
+    /// Continues from `st` (saved by [`Dynamics::save_state`] from a `Dynamics` of the same
+    /// structure, parameters and time step); the next step is then bit for bit that of the
+    /// saved run.
+    pub fn restore_state(&mut self, st: DynamicsState) -> Result<(), String> {
+        if st.dt.to_bits() != self.dt.to_bits() {
+            return Err(format!(
+                "structure state: time step {} s, the scenario has {} s",
+                st.dt, self.dt
+            ));
+        }
+        let n = self.d.len();
+        if let Some(v) = st.vectors.iter().find(|v| v.len() != n) {
+            return Err(format!(
+                "structure state: {} dofs, the structure has {n}",
+                v.len()
+            ));
+        }
+        let [d, v, a, d1, v1, a1, fint_n, fext_n, fint1, fext1] = st.vectors;
+        (self.d, self.v, self.a, self.d1, self.v1, self.a1) = (d, v, a, d1, v1, a1);
+        (self.fint_n, self.fext_n, self.fint1, self.fext1) = (fint_n, fext_n, fint1, fext1);
+        self.t = st.t;
+        [self.strain_energy, self.strain_energy1] = st.strain_energy;
+        self.external_work = st.external_work;
+        self.last_iterations = st.last_iterations;
+        Ok(())
     }
 
     /// Kinetic energy of the committed state [J].

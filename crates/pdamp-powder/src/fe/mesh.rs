@@ -37,7 +37,7 @@ pub struct Face {
 }
 
 /// An axis-aligned box `[min, max]` [m].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Aabb {
     /// Lower corner [m].
     pub min: [f64; 3],

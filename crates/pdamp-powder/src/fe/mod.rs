@@ -11,7 +11,7 @@ pub mod sparse;
 pub mod structure;
 pub mod svk;
 
-pub use gen_alpha::{Dynamics, DynamicsError, GenAlpha, NewtonSettings, Rayleigh};
+pub use gen_alpha::{Dynamics, DynamicsError, DynamicsState, GenAlpha, NewtonSettings, Rayleigh};
 pub use mesh::{Aabb, BoxMeshDivisions, Face, HexMesh, read_abaqus_inp, read_gmsh};
 pub use structure::{LoadRamp, MassKind, Structure, SurfaceLoad};
 pub use svk::SvkMaterial;

@@ -2,10 +2,10 @@
 //! storage) and their sparse Cholesky factorization with faer (supernodal/simplicial $LL^\top$,
 //! AMD ordering; the symbolic factorization is computed once and reused).
 
-use faer::Side;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Par, Side};
 
 /// Square sparse matrix with a fixed pattern (both triangles stored).
 #[derive(Debug, Clone, Default)]
@@ -93,48 +93,65 @@ pub enum SolverError {
     Factor(String),
 }
 
-/// A sparse Cholesky factorization of a [`CsrMatrix`].
+/// A sparse Cholesky factorization of a [`CsrMatrix`]. Factorization and solves run
+/// sequentially (`Par::Seq`): faer's parallel supernodal kernels split the work by the number
+/// of threads, which changes the rounding, so that results would depend on the thread count.
 pub struct Cholesky {
-    symbolic: SymbolicLlt<usize>,
-    llt: Llt<usize, f64>,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
     n: usize,
 }
+
+const PAR: Par = Par::Seq;
 
 impl Cholesky {
     /// Factorizes `a` (symbolic and numeric).
     pub fn new(a: &CsrMatrix) -> Result<Self, SolverError> {
         let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
-        let symbolic = SymbolicLlt::try_new(sym, Side::Lower)
-            .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(
-            symbolic.clone(),
-            SparseColMatRef::new(sym, &a.values),
-            Side::Lower,
-        )
-        .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        Ok(Self {
+        let symbolic =
+            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+                .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
+        let mut c = Self {
             symbolic,
-            llt,
+            values: Vec::new(),
             n: a.n,
-        })
+        };
+        c.refactor(a)?;
+        Ok(c)
     }
 
     /// Numeric refactorization of a matrix with the same pattern.
     pub fn refactor(&mut self, a: &CsrMatrix) -> Result<(), SolverError> {
         let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
-        self.llt = Llt::try_new_with_symbolic(
-            self.symbolic.clone(),
-            SparseColMatRef::new(sym, &a.values),
-            Side::Lower,
+        self.values.resize(self.symbolic.len_val(), 0.0);
+        let mut mem = MemBuffer::try_new(
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f64>(PAR, Default::default()),
         )
         .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
+        self.symbolic
+            .factorize_numeric_llt::<f64>(
+                &mut self.values,
+                SparseColMatRef::new(sym, &a.values),
+                Side::Lower,
+                Default::default(),
+                PAR,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
         Ok(())
     }
 
     /// Solves `A x = b` in place.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.n;
-        self.llt
-            .solve_in_place(faer::MatMut::from_column_major_slice_mut(b, n, 1));
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, PAR));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(b, n, 1),
+            PAR,
+            MemStack::new(&mut mem),
+        );
     }
 }
