@@ -70,6 +70,7 @@ enum MeshArg {
 
 /// Runs `pdamp cor`.
 pub fn run(a: CorArgs) -> Result<()> {
+    let traced = crate::Traced::start(a.materials.as_deref(), 0);
     let set = match &a.materials {
         Some(p) => {
             let text =
@@ -243,6 +244,7 @@ pub fn run(a: CorArgs) -> Result<()> {
             .push(Series::new(label, x, y).with_marker(Marker::Circle));
     }
     line_plot(a.out.join("cor"), &plot)?;
+    traced.write(&a.out)?;
     let fe_times: Vec<f64> = pts
         .iter()
         .filter_map(|p| p.fe.as_ref().map(|r| r.wall_time_s))

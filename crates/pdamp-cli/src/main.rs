@@ -198,6 +198,32 @@ enum LawArg {
     HertzMindlin,
 }
 
+/// `provenance.json` (and a copy of the input file as `input.toml`) for a command whose input
+/// is not a DEM scenario: call [`Traced::start`] before the work, [`Traced::write`] after it.
+pub(crate) struct Traced {
+    provenance: pdamp_io::provenance::Provenance,
+    input: Option<String>,
+}
+
+impl Traced {
+    /// Records the start of a command reading `input` (a file) with random seed `seed`.
+    pub(crate) fn start(input: Option<&std::path::Path>, seed: u64) -> Self {
+        let text = input.and_then(|p| std::fs::read_to_string(p).ok());
+        let title = input.map_or_else(String::new, |p| p.display().to_string());
+        Self {
+            provenance: pdamp_io::provenance::Provenance::of_input(&title, text.as_deref(), seed),
+            input: text,
+        }
+    }
+
+    /// Writes `out/provenance.json` and `out/input.toml`.
+    pub(crate) fn write(&self, out: &std::path::Path) -> Result<()> {
+        self.provenance
+            .write_input(out, self.input.as_deref())
+            .with_context(|| format!("writing the provenance into {}", out.display()))
+    }
+}
+
 fn main() -> std::process::ExitCode {
     // Ctrl-C / SIGTERM: long runs write a checkpoint and stop (see `--resume`).
     let _ = ctrlc::set_handler(pdamp_io::checkpoint::on_signal);
@@ -450,6 +476,7 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
             "failed_points": outcome.failed.iter().map(|(f, x, e)| serde_json::json!({
                 "frequency_hz": f, "amplitude_m": x, "error": e
             })).collect::<Vec<_>>(),
+            "bed_span_along_direction_m": outcome.bed_span_along_direction_m,
             "wall_time_s": start.elapsed().as_secs_f64(),
             "fields_csv": out.join("fields.csv"),
         }))?

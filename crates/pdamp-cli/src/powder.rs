@@ -96,6 +96,11 @@ fn load(path: &PathBuf) -> Result<CantileverScenario> {
     CantileverScenario::from_toml(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
+/// Seed of the powder preparation (0 without powder).
+fn seed_of(sc: &CantileverScenario) -> u64 {
+    sc.powder.as_ref().map_or(0, |p| p.prep.seed)
+}
+
 /// Runs `pdamp powder …`.
 pub fn run(args: PowderArgs) -> Result<()> {
     let bar = indicatif::ProgressBar::new(1000);
@@ -115,9 +120,11 @@ pub fn run(args: PowderArgs) -> Result<()> {
     match args.action {
         PowderAction::Run { scenario, out, ck } => {
             let sc = load(&scenario)?;
+            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
             let r = cantilever::run_in_dir(&sc, &out, ck.options()?, &mut progress)
                 .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
+            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&r)?);
             eprintln!("wrote {}", out.display());
         }
@@ -129,6 +136,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             ck,
         } => {
             let sc = load(&scenario)?;
+            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
             let options = ck.options()?;
             let p = match parameter {
                 ParamArg::PackingDensity => StudyParameter::PackingDensity,
@@ -142,6 +150,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             let rows = study::run_study(&sc, p, &values, &out, options, &mut progress)
                 .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
+            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&rows)?);
             eprintln!("wrote {}", out.join("table.csv").display());
         }

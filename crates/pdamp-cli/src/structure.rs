@@ -93,21 +93,27 @@ pub struct CoupleArgs {
 pub fn run_structure(args: StructureArgs) -> Result<()> {
     match args.action {
         StructureAction::Modes { structure, out } => {
+            let traced = crate::Traced::start(Some(&structure), 0);
             let s = pdamp_structure::report::run_modes(&structure, &out).map_err(|e| anyhow!(e))?;
+            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("modes.csv").display());
             Ok(())
         }
         StructureAction::OptimizeLayers { study, out } => {
+            let traced = crate::Traced::start(Some(&study), 0);
             let s = pdamp_structure::study::run_layer_study_file(&study, &out)
                 .map_err(|e| anyhow!(e))?;
+            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("study.csv").display());
             Ok(())
         }
         StructureAction::DamperPositions { study, out } => {
+            let traced = crate::Traced::start(Some(&study), 0);
             let s = pdamp_structure::position_study::run_position_study_file(&study, &out)
                 .map_err(|e| anyhow!(e))?;
+            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("positions.csv").display());
             Ok(())
@@ -147,6 +153,7 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
 
 /// Runs `pdamp couple`.
 pub fn run_couple(args: CoupleArgs) -> Result<()> {
+    let traced = crate::Traced::start(Some(&args.scenario), 0);
     let bar = indicatif::ProgressBar::new(1000);
     let options = pdamp_io::run::RunOptions {
         checkpoint_interval_s: args.checkpoint_interval_s,
@@ -157,6 +164,7 @@ pub fn run_couple(args: CoupleArgs) -> Result<()> {
     })
     .map_err(|e| anyhow!(e))?;
     bar.finish_and_clear();
+    traced.write(&args.out)?;
     println!("{}", serde_json::to_string_pretty(&s)?);
     eprintln!("wrote {}", args.out.display());
     Ok(())

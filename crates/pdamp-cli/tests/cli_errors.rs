@@ -138,6 +138,66 @@ fn outputs_carry_version_scenario_and_seed() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Commands without a DEM scenario (structure, cor) also write `provenance.json`, with the
+/// input file copied verbatim and its digest.
+#[test]
+fn other_commands_carry_provenance() {
+    let dir = std::env::temp_dir().join(format!("pdamp-cli-prov2-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let structure = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/structure_cantilever_small.toml"
+    );
+    let out = dir.join("modes");
+    let o = pdamp()
+        .args(["structure", "modes", structure, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let prov: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
+            .unwrap();
+    assert_eq!(prov["pdamp_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(prov["scenario_digest"].as_str().unwrap().len(), 16);
+    assert_eq!(
+        std::fs::read_to_string(out.join("input.toml")).unwrap(),
+        std::fs::read_to_string(structure).unwrap()
+    );
+    let out = dir.join("cor");
+    let o = pdamp()
+        .args([
+            "cor",
+            "--sphere-radius-m",
+            "0.005",
+            "--sphere",
+            "s235",
+            "--wall",
+            "s235",
+            "--velocities-m-s",
+            "0.5,1",
+            "--model",
+            "hertz",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let prov: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
+            .unwrap();
+    assert!(
+        prov["command"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|a| a == "cor")
+    );
+    assert!(!out.join("input.toml").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `pdamp run` on a damper scenario takes the excitation point from the command line.
 #[test]
 fn damper_point_from_the_command_line() {

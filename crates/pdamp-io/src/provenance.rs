@@ -40,6 +40,40 @@ impl Provenance {
         }
     }
 
+    /// Provenance of a command whose input is not a DEM scenario — a structure, coupling, study
+    /// or powder file (`input` is its text), or command-line options only (`input = None`,
+    /// e.g. `pdamp cor`). The digest is that of the input's bytes (of the command line without
+    /// an input file); `seed` is the input's seed (0 where it has none).
+    pub fn of_input(title: &str, input: Option<&str>, seed: u64) -> Self {
+        let command: Vec<String> = std::env::args().collect();
+        let digest = match input {
+            Some(text) => crate::checkpoint::digest(text.as_bytes()),
+            None => crate::checkpoint::digest(command[1..].join(" ").as_bytes()),
+        };
+        Self {
+            pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+            command,
+            scenario_title: title.to_string(),
+            scenario_digest: digest,
+            seed,
+            threads: rayon::current_num_threads(),
+            started_unix_s: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+        }
+    }
+
+    /// Writes `dir/provenance.json` and, when there is an input file, a verbatim copy of it as
+    /// `dir/input.toml`, atomically.
+    pub fn write_input(&self, dir: &Path, input: Option<&str>) -> Result<(), std::io::Error> {
+        std::fs::create_dir_all(dir)?;
+        if let Some(text) = input {
+            crate::atomic::write_atomic(dir.join("input.toml"), text.as_bytes())?;
+        }
+        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        crate::atomic::write_atomic(dir.join("provenance.json"), json.as_bytes())
+    }
+
     /// Writes `dir/scenario.toml` (canonical) and `dir/provenance.json`, atomically.
     pub fn write(
         &self,
