@@ -191,6 +191,18 @@ impl Damper {
         }
     }
 
+    /// Span of the settled bed along the excitation direction, relative to the container's
+    /// reference position: (lowest, highest) of x·e ∓ r over the particles, m. With the
+    /// container's inner walls it gives the clearance h of D Eq. 8.1/8.2.
+    pub fn bed_span_along_direction_m(&self) -> (f64, f64) {
+        let p = &self.settled.particles;
+        let origin = self.settled.bodies[self.container].state.position_m;
+        (0..p.len()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), i| {
+            let s = (p.position[i] - origin).dot(&self.direction);
+            (lo.min(s - p.radius[i]), hi.max(s + p.radius[i]))
+        })
+    }
+
     /// The same damper with an early stop on convergence (`cycles` becomes the maximum).
     pub fn with_convergence(mut self, convergence: Option<ConvergenceSpec>) -> Self {
         self.convergence = convergence;

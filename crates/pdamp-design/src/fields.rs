@@ -231,6 +231,9 @@ pub struct FieldsOutcome {
     /// Points that failed (e.g. an unstable simulation): frequency, amplitude and the message.
     /// They are not stored, so a rerun tries them again.
     pub failed: Vec<(f64, f64, String)>,
+    /// Span of the settled bed along the excitation direction (see
+    /// [`crate::damper::Damper::bed_span_along_direction_m`]), m.
+    pub bed_span_along_direction_m: [f64; 2],
 }
 
 /// A point result with every evaluated quantity NaN (a failed point).
@@ -339,10 +342,12 @@ pub fn run_fields_with(
     }
     let points: Vec<PointResult> = results.into_iter().map(|r| r.unwrap()).collect();
     write_fields_csv(&out_dir.join("fields.csv"), &points)?;
+    let (lo, hi) = damper.bed_span_along_direction_m();
     Ok(FieldsOutcome {
         points,
         reused,
         failed,
+        bed_span_along_direction_m: [lo, hi],
     })
 }
 

@@ -27,6 +27,9 @@ pub struct DamperRunSummary {
     pub container_mass_kg: f64,
     /// Settling time, s.
     pub settling_time_s: f64,
+    /// Span of the settled bed along the excitation direction, from the container's reference
+    /// position, [lowest, highest], m (with the inner walls: the clearance h).
+    pub bed_span_along_direction_m: [f64; 2],
     /// Excitation frequency, Hz.
     pub frequency_hz: f64,
     /// Displacement amplitude X, m.
@@ -129,6 +132,10 @@ pub fn run_damper_scenario(
         bed_mass_kg: damper.bed_mass_kg,
         container_mass_kg: damper.container_mass_kg,
         settling_time_s: damper.settling_time_s,
+        bed_span_along_direction_m: {
+            let (lo, hi) = damper.bed_span_along_direction_m();
+            [lo, hi]
+        },
         frequency_hz: f,
         amplitude_m: x,
         acceleration_m_s2: p.acceleration_m_s2,

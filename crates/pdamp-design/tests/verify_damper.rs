@@ -112,6 +112,21 @@ fn single_particle_matches_event_driven_collect_and_collide() {
     assert!(worst < 0.05, "largest rel. diff {worst}");
 }
 
+/// The bed span along the excitation direction: the eight spheres fill the box exactly
+/// (pre-compressed by `pre`): centres at ±(r − pre/2), span ±(2r − pre/2).
+#[test]
+fn bed_span_along_direction_is_the_outer_sphere_surfaces() {
+    let damper = stuck_bed_damper(6, 3);
+    let r = 1e-3;
+    let pre = 2e-6;
+    let (lo, hi) = damper.bed_span_along_direction_m();
+    let expect = (r - 0.5 * pre) + r;
+    assert!(
+        (hi - expect).abs() < 1e-15 && (lo + expect).abs() < 1e-15,
+        "{lo} {hi}"
+    );
+}
+
 /// Must-show 1b: a 2×2×2 block of spheres pre-compressed in a box without clearance, huge
 /// friction: the bed moves with the container, η̄ ≈ 0 and m̄_bed/m_bed ≈ 1 within 3 %.
 #[test]
