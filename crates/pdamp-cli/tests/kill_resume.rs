@@ -60,7 +60,13 @@ fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
                 continue;
             }
             let name = p.strip_prefix(dir).unwrap().to_string_lossy().to_string();
-            if name == "checkpoint.bin" || name == "provenance.json" || name.contains(".tmp-") {
+            // provenance.json and input.toml record the command, not its results (a study's
+            // case directory has neither).
+            if name == "checkpoint.bin"
+                || name == "provenance.json"
+                || name == "input.toml"
+                || name.contains(".tmp-")
+            {
                 continue;
             }
             let mut bytes = std::fs::read(&p).unwrap();

@@ -1450,7 +1450,7 @@ pub fn morton_order(points: &[Vec3], cell_m: f64) -> Vec<usize> {
         .iter()
         .filter(finite)
         .fold(Vec3::repeat(f64::INFINITY), |a, x| a.inf(x));
-    if !lo.iter().all(|c| c.is_finite()) || !(cell_m > 0.0) {
+    if !lo.iter().all(|c| c.is_finite()) || cell_m.is_nan() || cell_m <= 0.0 {
         return (0..points.len()).collect();
     }
     let key = |x: &Vec3| -> u64 {

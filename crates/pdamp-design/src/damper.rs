@@ -141,8 +141,26 @@ impl Damper {
             .position(|b| b.name == spec.container_body)
             .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
         world.bodies[container].motion = Motion::Fixed;
+        let main_gravity = world.gravity_m_s2;
         let settling_time_s = match &scenario.settle {
-            Some(s) => pdamp_io::run::settle_with(&mut world, s, &mut progress),
+            Some(s) => {
+                let t = pdamp_io::run::settle_with(&mut world, s, &mut progress);
+                // Filled under another gravity: turn the container and let the bed come to
+                // rest again before any excitation (a steady state needs a bed at rest).
+                let turned = s
+                    .gravity_m_s2
+                    .is_some_and(|g| Vec3::from(g) != main_gravity);
+                t + if turned {
+                    pdamp_io::run::settle_after_turn(
+                        &mut world,
+                        s.turn_max_duration_s.unwrap_or(s.max_duration_s),
+                        s.kinetic_energy_per_particle_j,
+                        &mut progress,
+                    )
+                } else {
+                    0.0
+                }
+            }
             None => {
                 world.initialize();
                 0.0

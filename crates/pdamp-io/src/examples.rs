@@ -89,6 +89,7 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
             max_duration_s: 0.05,
             kinetic_energy_per_particle_j: 0.0,
             gravity_m_s2: None,
+            turn_max_duration_s: None,
         }),
         damper: None,
         fields: None,

@@ -754,6 +754,11 @@ pub struct SettleSpec {
     /// excited with the axis horizontal [D Sect. 8.1.1].
     #[serde(default)]
     pub gravity_m_s2: Option<[f64; 3]>,
+    /// Longest second settling stage after the "turn" to `simulation.gravity_m_s2`, s (only
+    /// with `gravity_m_s2`; default `max_duration_s`). Used by damper runs and fields, whose
+    /// steady state needs a bed at rest under the run gravity.
+    #[serde(default)]
+    pub turn_max_duration_s: Option<f64>,
 }
 
 impl Scenario {
@@ -1125,6 +1130,13 @@ impl Scenario {
                 return Err(format!(
                     "settle.kinetic_energy_per_particle_j must be >= 0 (J), got {}",
                     st.kinetic_energy_per_particle_j
+                ));
+            }
+            if let Some(t) = st.turn_max_duration_s
+                && !(t.is_finite() && t >= 0.0)
+            {
+                return Err(format!(
+                    "settle.turn_max_duration_s must be >= 0 (seconds), got {t}"
                 ));
             }
             if let Some(g) = st.gravity_m_s2
