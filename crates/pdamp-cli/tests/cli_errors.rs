@@ -3,6 +3,11 @@
 
 use std::process::Command;
 
+/// A JSON output file of a run.
+fn read_json(path: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 fn pdamp() -> Command {
     Command::new(env!("CARGO_BIN_EXE_pdamp"))
 }
@@ -115,11 +120,8 @@ fn outputs_carry_version_scenario_and_seed() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let prov: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
-            .unwrap();
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let prov = read_json(&out.join("provenance.json"));
+    let summary = read_json(&out.join("summary.json"));
     assert_eq!(prov["pdamp_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(prov["seed"], 1);
     assert_eq!(summary["seed"], 1);
@@ -155,9 +157,7 @@ fn other_commands_carry_provenance() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let prov: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
-            .unwrap();
+    let prov = read_json(&out.join("provenance.json"));
     assert_eq!(prov["pdamp_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(prov["scenario_digest"].as_str().unwrap().len(), 16);
     assert_eq!(
@@ -184,9 +184,7 @@ fn other_commands_carry_provenance() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let prov: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("provenance.json")).unwrap())
-            .unwrap();
+    let prov = read_json(&out.join("provenance.json"));
     assert!(
         prov["command"]
             .as_array()

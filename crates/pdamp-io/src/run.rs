@@ -106,6 +106,25 @@ pub fn settle(
     .unwrap_or(max_duration_s)
 }
 
+/// Holds every body that is not driven (settling happens in a container at rest); returns
+/// their motions for [`release_bodies`].
+fn hold_bodies(world: &mut World) -> Vec<Motion> {
+    let motions = world.bodies.iter().map(|b| b.motion.clone()).collect();
+    for b in world.bodies.iter_mut() {
+        if !matches!(b.motion, Motion::Driven) {
+            b.motion = Motion::Fixed;
+        }
+    }
+    motions
+}
+
+/// Gives the bodies back the motions [`hold_bodies`] took.
+fn release_bodies(world: &mut World, motions: Vec<Motion>) {
+    for (b, m) in world.bodies.iter_mut().zip(motions) {
+        b.motion = m;
+    }
+}
+
 /// Settling as in [`settle`], with `hook` called every 200 steps; when it returns `Break` the
 /// loop stops at once (bodies get their motion back, the clock is not restarted) and the result
 /// is `None`. The check of the kinetic energy uses the step counter, so a settling resumed from
@@ -116,12 +135,7 @@ pub fn settle_or_break(
     ke_per_particle_j: f64,
     mut hook: impl FnMut(&World) -> ControlFlow<()>,
 ) -> Option<f64> {
-    let motions: Vec<Motion> = world.bodies.iter().map(|b| b.motion.clone()).collect();
-    for b in world.bodies.iter_mut() {
-        if !matches!(b.motion, Motion::Driven) {
-            b.motion = Motion::Fixed;
-        }
-    }
+    let motions = hold_bodies(world);
     let n = world.particles.len().max(1) as f64;
     let check_every = 200u64;
     let mut stopped = false;
@@ -138,9 +152,7 @@ pub fn settle_or_break(
         }
     }
     let t = world.time_s;
-    for (b, m) in world.bodies.iter_mut().zip(motions) {
-        b.motion = m;
-    }
+    release_bodies(world, motions);
     if stopped {
         return None;
     }
@@ -163,12 +175,7 @@ pub fn settle_after_turn(
     ke_per_particle_j: f64,
     mut tick: impl FnMut(f64),
 ) -> f64 {
-    let motions: Vec<Motion> = world.bodies.iter().map(|b| b.motion.clone()).collect();
-    for b in world.bodies.iter_mut() {
-        if !matches!(b.motion, Motion::Driven) {
-            b.motion = Motion::Fixed;
-        }
-    }
+    let motions = hold_bodies(world);
     let n = world.particles.len().max(1) as f64;
     let t0 = world.time_s;
     let mut risen = false;
@@ -185,9 +192,7 @@ pub fn settle_after_turn(
         }
     }
     let t = world.time_s - t0;
-    for (b, m) in world.bodies.iter_mut().zip(motions) {
-        b.motion = m;
-    }
+    release_bodies(world, motions);
     world.restart_clock();
     t
 }
