@@ -81,8 +81,10 @@ const SETTLE_CHUNK: u32 = 200;
 enum Stage {
     /// Settling under magnified gravity; `chunk` steps of the current block done.
     Settling { chunk: u32 },
-    /// Relaxation under 1 g before the compression; `done` steps.
-    Relaxing { done: u64 },
+    /// Relaxation under 1 g before the compression; `done` steps; `moved`: the kinetic energy
+    /// has exceeded the 1 g rest limit since gravity was reduced (the bed is releasing the
+    /// elastic energy stored under the magnified gravity).
+    Relaxing { done: u64, moved: bool },
     /// Plate compression: step `q` of `nsteps` with the plate increment `dz` [m].
     Compressing { q: u64, nsteps: u64, dz: f64 },
     /// Relaxation with the plate held at the cavity top; `q` steps.
@@ -105,6 +107,8 @@ pub struct Preparation {
     cavity: Aabb,
     settings: PrepSettings,
     e_ref: f64,
+    /// Rest limit of the kinetic energy under 1 g (the settling criterion at g = 9.81 m/s²), J.
+    e_ref_1g: f64,
     relax_steps: u64,
     settled: f64,
     compressed: bool,
@@ -180,6 +184,7 @@ impl Preparation {
         let mtot: f64 = p.mass.iter().sum();
         // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
         let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
+        let e_ref_1g = 1e-4 * mtot * 9.81 * psd.d50_m;
         Self {
             powder: p,
             planes,
@@ -190,6 +195,7 @@ impl Preparation {
             cavity,
             settings: *s,
             e_ref,
+            e_ref_1g,
             relax_steps: (s.relax_time_s / dt).ceil() as u64,
             settled: 0.0,
             compressed: false,
@@ -248,7 +254,10 @@ impl Preparation {
     fn end_settling(&mut self) {
         // switch to real gravity and let the bed relax briefly
         self.powder.gravity = G0;
-        self.stage = Stage::Relaxing { done: 0 };
+        self.stage = Stage::Relaxing {
+            done: 0,
+            moved: false,
+        };
     }
 
     fn start_compression(&mut self) {
@@ -305,13 +314,38 @@ impl Preparation {
                     }
                 }
             }
-            Stage::Relaxing { done } => {
-                if done < self.relax_steps {
-                    self.step();
-                    self.stage = Stage::Relaxing { done: done + 1 };
-                } else {
+            Stage::Relaxing { done, moved } => {
+                // A bed settled under g·f holds f² times the contact elastic energy of a bed at
+                // rest under g (linear springs): when gravity drops to 1 g it springs up and
+                // releases it. Relax at least `relax_time_s`, then until the bed has moved
+                // (kinetic energy above the 1 g rest limit) and come to rest again (below it),
+                // or until `max_settling_time_s` more. Otherwise the prepared bed carries the
+                // excess into the coupled run, where its release looks like damping.
+                let t_max = self.relax_steps
+                    + (self.settings.max_settling_time_s / self.powder.dt).ceil() as u64;
+                let chunk = SETTLE_CHUNK as u64;
+                if done >= t_max
+                    || (done >= self.relax_steps && done % chunk == 0 && done > 0 && {
+                        let ke = self.powder.kinetic_energy();
+                        moved && ke < self.e_ref_1g
+                    })
+                {
                     self.start_compression();
+                    return true;
                 }
+                self.step();
+                let mut moved = moved;
+                if (done + 1) % chunk == 0 {
+                    let ke = self.powder.kinetic_energy();
+                    moved |= ke >= self.e_ref_1g;
+                    if (done + 1) % (50 * chunk) == 0 {
+                        progress("relaxing under 1 g", (done + 1) as f64 / t_max as f64);
+                    }
+                }
+                self.stage = Stage::Relaxing {
+                    done: done + 1,
+                    moved,
+                };
             }
             Stage::Compressing { q, nsteps, dz } => {
                 if q < nsteps {
