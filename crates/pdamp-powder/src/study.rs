@@ -140,8 +140,12 @@ pub fn run_study(
                 },
             )
         } else {
-            let mut prog =
-                |stage: &str, f: f64| progress(stage, (q as f64 + f) / values.len() as f64);
+            // the stage names the run; the fraction is the stage's own (stages restart at 0)
+            let n = values.len();
+            let mut prog = |stage: &str, f: f64| {
+                let label = format!("run {}/{n} ({} = {v}): {stage}", q + 1, param.name());
+                progress(&label, f)
+            };
             let r = cantilever::run_in_dir(&sc, &dir, options, &mut prog)?;
             let wall = r.wall_time_s + r.prep.as_ref().map_or(0.0, |p| p.wall_time_s);
             (
