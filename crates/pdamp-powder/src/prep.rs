@@ -327,7 +327,9 @@ impl Preparation {
                 if done >= t_max
                     || (done >= self.relax_steps && done % chunk == 0 && done > 0 && {
                         let ke = self.powder.kinetic_energy();
-                        moved && ke < self.e_ref_1g
+                        // a bed settled under 1 g has nothing to release: rest suffices
+                        (moved || self.settings.settling_gravity_factor <= 1.0)
+                            && ke < self.e_ref_1g
                     })
                 {
                     self.start_compression();
