@@ -247,7 +247,14 @@ fn run_cli() -> Result<()> {
         .num_threads(threads)
         .build_global()
         .context("cannot start the thread pool")?;
-    match cli.command {
+    // The whole command runs on a worker of the pool: the parallel loops of the time step start
+    // on the thread that calls them instead of waking a worker and putting the caller to sleep
+    // at every loop (with one thread nothing crosses threads at all).
+    rayon::scope(|_| dispatch(cli.command))
+}
+
+fn dispatch(command: Command) -> Result<()> {
+    match command {
         Command::Run {
             scenario,
             out,

@@ -4,6 +4,7 @@
 use crate::body::BodyState;
 use crate::contact::{ContactForce, ContactHistory, ContactKinematics, PairProps};
 use crate::energy::EnergyIncrements;
+use crate::hm_block::{HmInput, HmOutput, HmState, LANES};
 use crate::material::{effective_mass, effective_radius};
 use crate::math::{Vec3, tangential_part};
 use crate::walls::WallContact;
@@ -117,6 +118,23 @@ pub(crate) struct PpChunk {
     sums: (f64, f64, f64),
 }
 
+/// Scratch of the pair loop, one per worker thread (kept between steps: no allocation once
+/// grown, and it stays in that core's cache).
+#[derive(Debug, Default)]
+struct PairScratch {
+    /// The pairs of a chunk that touch or had a contact (index within the chunk's pair range)
+    /// and their first partners.
+    scan_pair: Vec<u32>,
+    scan_first: Vec<u32>,
+    /// Hertz–Mindlin contacts gathered for block evaluation.
+    batch: HmBatch,
+}
+
+thread_local! {
+    static PAIR_SCRATCH: std::cell::RefCell<PairScratch> =
+        std::cell::RefCell::new(PairScratch::default());
+}
+
 impl PpChunk {
     fn alloc(&mut self, k: PpContact) -> u32 {
         match self.free.pop() {
@@ -224,7 +242,7 @@ impl World {
 }
 
 /// How many pairs ahead the pair loop prefetches partner data.
-const PREFETCH_AHEAD: usize = 6;
+const PREFETCH_AHEAD: usize = 8;
 
 /// Hints the processor to load the cache line of `x` (no effect on other targets).
 #[inline(always)]
@@ -305,88 +323,395 @@ fn evaluate_pair(
     (out, a, b, f.normal_energy_j + f.tangential_energy_j)
 }
 
-/// [`evaluate_pair`] for a touching pair (`dist < r_i + r_j`) with LIGGGHTS' `hertz` +
-/// `tangential history` law (no rolling resistance, no adhesion), fused into one pass: contact
-/// kinematics [D Eq. 2.12–2.27], the law (the same operations as `hertz_mindlin_history`:
-/// $k_n = \tfrac43\bar E a$, $S_n = 2\bar E a$, $k_t = 8\bar G a$, $a = \sqrt{\bar R\delta}$,
-/// $\gamma = -2\sqrt{5/6}\,\beta\sqrt{S\bar M}$, spring $\xi$ projected on the tangent plane and
-/// cut at $\mu|F_n|$), and the trapezoidal work of the ledger.
-#[inline]
-#[allow(clippy::too_many_arguments)]
-fn hm_pair_fast(
-    c: &crate::interaction::HmConstants,
-    (ri, rj): (f64, f64),
-    ki: &Kin,
-    kj: &Kin,
-    d: Vec3,
-    dist: f64,
-    st: &mut PairState,
+/// The rows of the half neighbour list that belong to one chunk of first partners.
+struct PairRows<'a> {
+    /// First partners `lo..hi`.
+    lo: usize,
+    hi: usize,
+    /// Index of the chunk's first pair in the list.
+    q0: usize,
+    row_start: &'a [u32],
+    second: &'a [u32],
+}
+
+/// What the pair loop reads, shared by all chunks.
+struct PairContext<'a> {
+    p: &'a crate::particles::ParticleSet,
+    interactions: &'a crate::interaction::InteractionTable,
+    /// Positions and radii `[x, y, z, r]`.
+    xr: &'a [[f64; 4]],
+    /// Velocities, masses and spins.
+    kin: &'a [Kin],
+    /// Adhesion range added to the contact distance, m.
+    reach: f64,
+    /// Hertz–Mindlin constants shared by every pair, if they are.
+    uniform: Option<&'a crate::interaction::HmConstants>,
     dt: f64,
-) -> (PairEval, f64, f64, f64) {
-    let delta = ri + rj - dist;
-    let n = d * (1.0 / dist);
-    let rb_i = ri - 0.5 * delta;
-    let rb_j = rj - 0.5 * delta;
-    let dv = Vec3::from(ki.v) - Vec3::from(kj.v);
-    // v_rel = Δv + ω_i × (−r_b,i n) − ω_j × (r_b,j n) = Δv − (r_b,i ω_i + r_b,j ω_j) × n
-    let v_rel = dv - (Vec3::from(ki.w) * rb_i + Vec3::from(kj.w) * rb_j).cross(&n);
-    let rate = -n.dot(&dv);
-    let h = &mut st.history;
-    if h.impact_velocity_m_s == 0.0 {
-        h.impact_velocity_m_s = rate.max(crate::contact::default_min_impact_velocity());
+    kernel: crate::hm_block::Kernel,
+}
+
+/// Hertz–Mindlin contacts collected for evaluation in blocks (see [`crate::hm_block`]): all
+/// contacts of a chunk are gathered first, then evaluated block by block, then handed out, so
+/// that the kernel reads lanes written long before (no stalled store-to-load forwarding) and the
+/// gather loop keeps many independent loads in flight. Scratch of a chunk; grows, never shrinks.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct HmBatch {
+    inp: Vec<HmInput>,
+    st: Vec<HmState>,
+    out: Vec<HmOutput>,
+    /// First partner, second partner and slab slot of each contact.
+    lane: Vec<(u32, u32, u32)>,
+    len: usize,
+}
+
+impl HmBatch {
+    /// Adds the touching pair (`i`, `j`) at distance vector `d`, its contact in `slot`.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &mut self,
+        hm: &crate::interaction::HmConstants,
+        (i, j): (usize, usize),
+        (ri, rj): (f64, f64),
+        (ki, kj): (&Kin, &Kin),
+        d: Vec3,
+        state: &PairState,
+        slot: u32,
+    ) {
+        let (blk, k) = (self.len / LANES, self.len % LANES);
+        if blk == self.inp.len() {
+            self.inp.push(HmInput::default());
+            self.st.push(HmState::default());
+            self.out.push(HmOutput::default());
+        }
+        let (b, s) = (&mut self.inp[blk], &mut self.st[blk]);
+        (b.dx[k], b.dy[k], b.dz[k]) = (d.x, d.y, d.z);
+        (b.ri[k], b.rj[k]) = (ri, rj);
+        b.vx[k] = ki.v[0] - kj.v[0];
+        b.vy[k] = ki.v[1] - kj.v[1];
+        b.vz[k] = ki.v[2] - kj.v[2];
+        (b.wix[k], b.wiy[k], b.wiz[k]) = (ki.w[0], ki.w[1], ki.w[2]);
+        (b.wjx[k], b.wjy[k], b.wjz[k]) = (kj.w[0], kj.w[1], kj.w[2]);
+        (b.mi[k], b.mj[k]) = (ki.m, kj.m);
+        b.e_eff[k] = hm.e_eff_pa;
+        b.g_eff[k] = hm.g_eff_pa;
+        b.damping[k] = hm.damping;
+        b.mu[k] = hm.mu;
+        b.clip[k] = hm.clip_attractive;
+        let xi = state.history.spring_m;
+        (s.sx[k], s.sy[k], s.sz[k]) = (xi.x, xi.y, xi.z);
+        let f = state.normal_force_prev;
+        (s.fnx[k], s.fny[k], s.fnz[k]) = (f.x, f.y, f.z);
+        let f = state.tangential_force_prev;
+        (s.ftx[k], s.fty[k], s.ftz[k]) = (f.x, f.y, f.z);
+        s.en[k] = state.normal_energy_prev;
+        s.et[k] = state.tangential_energy_prev;
+        if self.len == self.lane.len() {
+            self.lane.push((0, 0, 0));
+        }
+        self.lane[self.len] = (i as u32, j as u32, slot);
+        self.len += 1;
     }
-    let (mi, mj) = (ki.m, kj.m);
-    let r_eff = ri * rj / (ri + rj);
-    let m_eff = mi * mj / (mi + mj);
-    let a = (r_eff * delta).sqrt();
-    let sn = 2.0 * c.e_eff_pa * a;
-    let kn = 4.0 / 3.0 * c.e_eff_pa * a;
-    let gamma_n = c.damping * (sn * m_eff).sqrt();
-    let elastic = kn * delta;
-    let mut dissipative = gamma_n * rate;
-    if c.clip_attractive {
-        dissipative = dissipative.max(-elastic);
+
+    /// Evaluates the collected contacts and hands out their results in the order they were
+    /// added: contact states into the slab, the first partner's force and torque added to
+    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po`, energies
+    /// added to `sums` (normal and tangential dissipation, stored energy).
+    #[allow(clippy::too_many_arguments)]
+    fn flush(
+        &mut self,
+        kernel: crate::hm_block::Kernel,
+        dt: f64,
+        lo: usize,
+        slab: &mut [PpContact],
+        (rf, rt): (&mut [Vec3], &mut [Vec3]),
+        po: &mut [SecondOutput],
+        outs: &mut usize,
+        sums: &mut (f64, f64, f64),
+    ) {
+        let m = self.len;
+        if m == 0 {
+            return;
+        }
+        let nblk = m.div_ceil(LANES);
+        // Unused lanes of the last block repeat its first contact (finite numbers; dropped).
+        let used = m - (nblk - 1) * LANES;
+        for k in used..LANES {
+            copy_lane(&mut self.inp[nblk - 1], &mut self.st[nblk - 1], 0, k);
+        }
+        for ((b, s), o) in self.inp[..nblk]
+            .iter()
+            .zip(&mut self.st[..nblk])
+            .zip(&mut self.out[..nblk])
+        {
+            kernel(b, s, o, dt);
+        }
+        for (e, &(i, j, slot)) in self.lane[..m].iter().enumerate() {
+            let (s, o, k) = (&self.st[e / LANES], &self.out[e / LANES], e % LANES);
+            let st = &mut slab[slot as usize].state;
+            let h = &mut st.history;
+            if h.impact_velocity_m_s == 0.0 {
+                h.impact_velocity_m_s =
+                    o.rate[k].max(crate::contact::default_min_impact_velocity());
+            }
+            h.spring_m = Vec3::new(s.sx[k], s.sy[k], s.sz[k]);
+            st.normal_force_prev = Vec3::new(s.fnx[k], s.fny[k], s.fnz[k]);
+            st.tangential_force_prev = Vec3::new(s.ftx[k], s.fty[k], s.ftz[k]);
+            st.normal_energy_prev = s.en[k];
+            st.tangential_energy_prev = s.et[k];
+            st.active = true;
+            sums.0 += o.dn[k];
+            sums.1 += o.dt[k];
+            sums.2 += o.el[k];
+            let force = Vec3::new(o.fx[k], o.fy[k], o.fz[k]);
+            let a = i as usize - lo;
+            rf[a] += force;
+            rt[a] += Vec3::new(o.tix[k], o.tiy[k], o.tiz[k]);
+            po[*outs] = SecondOutput {
+                force,
+                torque: Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]),
+                second: j,
+            };
+            *outs += 1;
+        }
+        self.len = 0;
     }
-    let vt = v_rel - n * n.dot(&v_rel);
-    let kt = 8.0 * c.g_eff_pa * a;
-    let gamma_t = c.damping * (kt * m_eff).sqrt();
-    let mut xi = h.spring_m + vt * dt;
-    xi -= n * xi.dot(&n);
-    let shear2 = xi.norm_squared();
-    let ft_friction = c.mu * (elastic + dissipative).abs();
-    let ft = if kt * kt * shear2 > ft_friction * ft_friction {
-        let shear_len = shear2.sqrt();
-        let f = -xi * (ft_friction / shear_len);
-        xi = -f / kt;
-        f
-    } else {
-        -kt * xi - gamma_t * vt
-    };
-    h.spring_m = xi;
-    let fn_vec = n * (elastic + dissipative);
-    let e_n = 0.4 * kn * delta * delta;
-    let e_t = 0.5 * kt * xi.norm_squared();
-    // Ledger (no rolling torque): trapezoidal work minus the change of stored energy.
-    let w_n = -0.5 * (st.normal_force_prev + fn_vec).dot(&v_rel) * dt;
-    let w_t = -0.5 * (st.tangential_force_prev + ft).dot(&v_rel) * dt;
-    let d_n = w_n - (e_n - st.normal_energy_prev);
-    let d_t = w_t - (e_t - st.tangential_energy_prev);
-    st.normal_force_prev = fn_vec;
-    st.tangential_force_prev = ft;
-    st.normal_energy_prev = e_n;
-    st.tangential_energy_prev = e_t;
-    st.active = true;
-    let cr = n.cross(&ft);
-    (
-        PairEval {
-            force: fn_vec + ft,
-            torque_first: -rb_i * cr,
-            torque_second: -rb_j * cr,
-        },
-        d_n,
-        d_t,
-        e_n + e_t,
-    )
+}
+
+/// Copies lane `from` of a block's inputs and state to lane `to`.
+fn copy_lane(b: &mut HmInput, s: &mut HmState, from: usize, to: usize) {
+    for a in [
+        &mut b.dx,
+        &mut b.dy,
+        &mut b.dz,
+        &mut b.ri,
+        &mut b.rj,
+        &mut b.vx,
+        &mut b.vy,
+        &mut b.vz,
+        &mut b.wix,
+        &mut b.wiy,
+        &mut b.wiz,
+        &mut b.wjx,
+        &mut b.wjy,
+        &mut b.wjz,
+        &mut b.mi,
+        &mut b.mj,
+        &mut b.e_eff,
+        &mut b.g_eff,
+        &mut b.damping,
+        &mut b.mu,
+        &mut s.sx,
+        &mut s.sy,
+        &mut s.sz,
+        &mut s.fnx,
+        &mut s.fny,
+        &mut s.fnz,
+        &mut s.ftx,
+        &mut s.fty,
+        &mut s.ftz,
+        &mut s.en,
+        &mut s.et,
+    ] {
+        a[to] = a[from];
+    }
+    b.clip[to] = b.clip[from];
+}
+
+impl PairContext<'_> {
+    /// The particle–particle contacts of one chunk of first partners: returns the number of
+    /// second-partner outputs written to `po`; the first partners' forces and torques go to
+    /// `rf`/`rt`, the energies to `chunk.sums`.
+    ///
+    /// Two passes. The scan tests every pair of the rows for contact (squared distance against
+    /// the sum of the radii plus the adhesion range) without branching and keeps the pairs that
+    /// touch or had a contact. The second pass evaluates those in list order: touching pairs
+    /// with the Hertz–Mindlin law go into blocks of [`LANES`] evaluated together
+    /// ([`crate::hm_block`]); other laws and contacts that ended are evaluated one by one (a
+    /// pending block is evaluated first, so that every first partner sums its forces in list
+    /// order). A contact keeps its slot in the chunk's slab while it lasts.
+    fn chunk_pairs(
+        &self,
+        rows: &PairRows,
+        chunk: &mut PpChunk,
+        pc: &mut [u32],
+        po: &mut [SecondOutput],
+        rf: &mut [Vec3],
+        rt: &mut [Vec3],
+    ) -> usize {
+        PAIR_SCRATCH.with_borrow_mut(|scratch| {
+            self.chunk_pairs_with(rows, chunk, pc, po, (rf, rt), scratch)
+        })
+    }
+
+    /// [`Self::chunk_pairs`] with the thread's scratch.
+    fn chunk_pairs_with(
+        &self,
+        rows: &PairRows,
+        chunk: &mut PpChunk,
+        pc: &mut [u32],
+        po: &mut [SecondOutput],
+        (rf, rt): (&mut [Vec3], &mut [Vec3]),
+        scratch: &mut PairScratch,
+    ) -> usize {
+        let (p, interactions, xr, kin, reach, dt) = (
+            self.p,
+            self.interactions,
+            self.xr,
+            self.kin,
+            self.reach,
+            self.dt,
+        );
+        let (lo, hi, q0) = (rows.lo, rows.hi, rows.q0);
+        let second_c = &rows.second[q0..rows.row_start[hi] as usize];
+        let PpChunk {
+            slab,
+            free,
+            orphans,
+            sums,
+        } = chunk;
+        let PairScratch {
+            scan_pair,
+            scan_first,
+            batch,
+        } = scratch;
+        // 1. Scan.
+        if scan_pair.len() < second_c.len() {
+            scan_pair.resize(second_c.len(), 0);
+            scan_first.resize(second_c.len(), 0);
+        }
+        let mut na = 0usize;
+        for i in lo..hi {
+            let [xi0, xi1, xi2, ri0] = xr[i];
+            let ri = ri0 + reach;
+            let (a, b) = (
+                rows.row_start[i] as usize - q0,
+                rows.row_start[i + 1] as usize - q0,
+            );
+            for (qq, (&j, &slot)) in (a..b).zip(second_c[a..b].iter().zip(&pc[a..b])) {
+                let [xj0, xj1, xj2, rj] = xr[j as usize];
+                let (d0, d1, d2) = (xi0 - xj0, xi1 - xj1, xi2 - xj2);
+                let dist2 = (d0 * d0 + d1 * d1) + d2 * d2;
+                let cut = ri + rj;
+                scan_pair[na] = qq as u32;
+                scan_first[na] = i as u32;
+                na += ((dist2 < cut * cut) | (slot != NO_CONTACT)) as usize;
+            }
+        }
+        // 2. Contacts, in list order.
+        rf.iter_mut().for_each(|f| *f = Vec3::zeros());
+        rt.iter_mut().for_each(|t| *t = Vec3::zeros());
+        let mut outs = 0usize;
+        let mut acc = (0.0, 0.0, 0.0);
+        let alloc = |slab: &mut Vec<PpContact>, free: &mut Vec<u32>, i: usize, j: usize| {
+            let k = PpContact {
+                i: i as u32,
+                j: j as u32,
+                state: PairState::default(),
+            };
+            match free.pop() {
+                Some(s) => {
+                    slab[s as usize] = k;
+                    s
+                }
+                None => {
+                    slab.push(k);
+                    (slab.len() - 1) as u32
+                }
+            }
+        };
+        for e in 0..na {
+            // Look ahead: fetch the partner data and contact state of a later contact while this
+            // one is gathered (the slab and the partners' velocities are mostly not in L1).
+            if e + PREFETCH_AHEAD < na {
+                let qn = scan_pair[e + PREFETCH_AHEAD] as usize;
+                prefetch(&kin[second_c[qn] as usize]);
+                let sn = pc[qn];
+                if let Some(k) = slab.get(sn as usize) {
+                    prefetch(k);
+                    prefetch(&k.state.tangential_force_prev);
+                }
+            }
+            let qq = scan_pair[e] as usize;
+            let i = scan_first[e] as usize;
+            let j = second_c[qq] as usize;
+            let slot = pc[qq];
+            let ([xi0, xi1, xi2, ri0], [xj0, xj1, xj2, rj]) = (xr[i], xr[j]);
+            let d = Vec3::new(xi0 - xj0, xi1 - xj1, xi2 - xj2);
+            let dist2 = d.norm_squared();
+            let dist = dist2.sqrt();
+            let cut = ri0 + rj;
+            if reach <= 0.0
+                && dist2 < cut * cut
+                && dist > 0.0
+                && let Some(hm) = self
+                    .uniform
+                    .or_else(|| interactions.hm_fast(p.material[i], p.material[j]))
+            {
+                let s = if slot == NO_CONTACT {
+                    let s = alloc(slab, free, i, j);
+                    pc[qq] = s;
+                    s
+                } else {
+                    slot
+                };
+                batch.push(
+                    hm,
+                    (i, j),
+                    (ri0, rj),
+                    (&kin[i], &kin[j]),
+                    d,
+                    &slab[s as usize].state,
+                    s,
+                );
+                continue;
+            }
+            let touching = interacts(p, interactions, reach, i, j, dist);
+            if !touching && slot == NO_CONTACT {
+                continue;
+            }
+            if touching {
+                batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+            }
+            let s = if slot == NO_CONTACT {
+                alloc(slab, free, i, j)
+            } else {
+                slot
+            };
+            let st = &mut slab[s as usize].state;
+            let (out, x, y, en) = evaluate_pair(p, interactions, i, j, d, dist, touching, st, dt);
+            acc.0 += x;
+            acc.1 += y;
+            acc.2 += en;
+            if touching {
+                pc[qq] = s;
+                rf[i - lo] += out.force;
+                rt[i - lo] += out.torque_first;
+                po[outs] = SecondOutput {
+                    force: out.force,
+                    torque: out.torque_second,
+                    second: j as u32,
+                };
+                outs += 1;
+            } else {
+                pc[qq] = NO_CONTACT;
+                free.push(s);
+            }
+        }
+        batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+        // Contacts that left the neighbour list: close their work integral.
+        for k in orphans.drain(..) {
+            let (i, j) = (k.i as usize, k.j as usize);
+            let d = p.position[i] - p.position[j];
+            let mut st = k.state;
+            let (_, x, y, _) =
+                evaluate_pair(p, interactions, i, j, d, d.norm(), false, &mut st, dt);
+            acc.0 += x;
+            acc.1 += y;
+        }
+        *sums = acc;
+        outs
+    }
 }
 
 /// Velocity, mass and angular velocity of one particle, packed into one cache line for the
@@ -539,6 +864,7 @@ impl World {
         let xr = &*xr;
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
+        let kernel = crate::hm_block::kernel();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
             let mut pcs: Vec<(&mut [u32], &mut [SecondOutput])> = Vec::with_capacity(nchunks);
@@ -561,124 +887,26 @@ impl World {
                 .zip(out_count.par_iter_mut())
                 .enumerate()
                 .for_each(|(c, ((((chunk, (pc, po)), rf), rt), count))| {
-                    let mut outs = 0usize;
-                    let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
-                    let (mut dn, mut dtan, mut el) = (0.0, 0.0, 0.0);
-                    let q0 = nl.row_start[lo] as usize;
-                    let second_c = &nl.second[q0..nl.row_start[hi] as usize];
-                    for i in lo..hi {
-                        let [xi0, xi1, xi2, ri0] = xr[i];
-                        let ri = ri0 + reach;
-                        let mat_i = p.material[i];
-                        let (mut fi, mut ti) = (Vec3::zeros(), Vec3::zeros());
-                        let row = nl.row_start[i] as usize..nl.row_start[i + 1] as usize;
-                        let (a, b) = (row.start - q0, row.end - q0);
-                        for qq in a..b {
-                            // Look ahead: fetch the partner of a later pair (and its velocities
-                            // and contact state if it is in contact) while this one computes.
-                            if let Some(&jn) = second_c.get(qq + PREFETCH_AHEAD) {
-                                prefetch(&xr[jn as usize]);
-                                let sn = pc[qq + PREFETCH_AHEAD];
-                                if sn != NO_CONTACT {
-                                    prefetch(&kin[jn as usize]);
-                                    if let Some(k) = chunk.slab.get(sn as usize) {
-                                        prefetch(k);
-                                    }
-                                }
-                            }
-                            let j = second_c[qq] as usize;
-                            let slot = pc[qq];
-                            let slot_ref = &mut pc[qq];
-                            let [xj0, xj1, xj2, rj] = xr[j];
-                            let d = Vec3::new(xi0 - xj0, xi1 - xj1, xi2 - xj2);
-                            let dist2 = d.norm_squared();
-                            let cut = ri + rj;
-                            if dist2 >= cut * cut && slot == NO_CONTACT {
-                                continue;
-                            }
-                            let dist = dist2.sqrt();
-                            if reach <= 0.0
-                                && dist2 < cut * cut
-                                && dist > 0.0
-                                && let Some(hm) =
-                                    uniform.or_else(|| interactions.hm_fast(mat_i, p.material[j]))
-                            {
-                                let s = if slot == NO_CONTACT {
-                                    let s = chunk.alloc(PpContact {
-                                        i: i as u32,
-                                        j: j as u32,
-                                        state: PairState::default(),
-                                    });
-                                    *slot_ref = s;
-                                    s
-                                } else {
-                                    slot
-                                };
-                                let st = &mut chunk.slab[s as usize].state;
-                                let (out, x, y, e) =
-                                    hm_pair_fast(hm, (ri0, rj), &kin[i], &kin[j], d, dist, st, dt);
-                                dn += x;
-                                dtan += y;
-                                el += e;
-                                fi += out.force;
-                                ti += out.torque_first;
-                                po[outs] = SecondOutput {
-                                    force: out.force,
-                                    torque: out.torque_second,
-                                    second: j as u32,
-                                };
-                                outs += 1;
-                                continue;
-                            }
-                            let touching = interacts(p, interactions, reach, i, j, dist);
-                            if !touching && slot == NO_CONTACT {
-                                continue;
-                            }
-                            let s = if slot == NO_CONTACT {
-                                chunk.alloc(PpContact {
-                                    i: i as u32,
-                                    j: j as u32,
-                                    state: PairState::default(),
-                                })
-                            } else {
-                                slot
-                            };
-                            let st = &mut chunk.slab[s as usize].state;
-                            let (out, x, y, e) =
-                                evaluate_pair(p, interactions, i, j, d, dist, touching, st, dt);
-                            dn += x;
-                            dtan += y;
-                            el += e;
-                            if touching {
-                                *slot_ref = s;
-                                fi += out.force;
-                                ti += out.torque_first;
-                                po[outs] = SecondOutput {
-                                    force: out.force,
-                                    torque: out.torque_second,
-                                    second: j as u32,
-                                };
-                                outs += 1;
-                            } else {
-                                *slot_ref = NO_CONTACT;
-                                chunk.free.push(s);
-                            }
-                        }
-                        rf[i - lo] = fi;
-                        rt[i - lo] = ti;
-                    }
-                    // Contacts that left the neighbour list: close their work integral.
-                    for k in chunk.orphans.drain(..) {
-                        let (i, j) = (k.i as usize, k.j as usize);
-                        let d = p.position[i] - p.position[j];
-                        let mut st = k.state;
-                        let (_, x, y, _) =
-                            evaluate_pair(p, interactions, i, j, d, d.norm(), false, &mut st, dt);
-                        dn += x;
-                        dtan += y;
-                    }
-                    chunk.sums = (dn, dtan, el);
-                    *count = outs as u32;
+                    let lo = c * PP_CHUNK;
+                    let hi = ((c + 1) * PP_CHUNK).min(n);
+                    let rows = PairRows {
+                        lo,
+                        hi,
+                        q0: nl.row_start[lo] as usize,
+                        row_start: &nl.row_start,
+                        second: &nl.second,
+                    };
+                    let ctx = PairContext {
+                        p,
+                        interactions,
+                        xr,
+                        kin,
+                        reach,
+                        uniform,
+                        dt,
+                        kernel,
+                    };
+                    *count = ctx.chunk_pairs(&rows, chunk, pc, po, rf, rt) as u32;
                 });
         }
         // Counting sort of the outputs by second partner. For one particle its entries follow
@@ -1066,12 +1294,54 @@ mod tests {
     use crate::particles::ParticleSet;
     use rand::{RngExt, SeedableRng};
 
-    /// The fused Hertz–Mindlin kernel gives the forces, torques, history, dissipation and
+    /// One contact through the block kernel ([`HmBatch`] with the baseline kernel): the
+    /// outputs of the first partner, dissipation and stored energy, like `evaluate_pair`.
+    fn block_one(
+        hm: &crate::interaction::HmConstants,
+        radii: (f64, f64),
+        kin: (&Kin, &Kin),
+        d: Vec3,
+        st: &mut PairState,
+        dt: f64,
+    ) -> (PairEval, f64, f64, f64) {
+        let mut slab = vec![PpContact {
+            i: 0,
+            j: 1,
+            state: *st,
+        }];
+        let mut batch = HmBatch::default();
+        batch.push(hm, (0, 1), radii, kin, d, st, 0);
+        let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
+        let mut po = vec![SecondOutput::default(); 1];
+        let (mut outs, mut sums) = (0, (0.0, 0.0, 0.0));
+        let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
+        batch.flush(
+            kernel,
+            dt,
+            0,
+            &mut slab,
+            (&mut rf, &mut rt),
+            &mut po,
+            &mut outs,
+            &mut sums,
+        );
+        assert_eq!(outs, 1);
+        *st = slab[0].state;
+        let eval = PairEval {
+            force: rf[0],
+            torque_first: rt[0],
+            torque_second: po[0].torque,
+        };
+        assert_eq!(po[0].force, rf[0]);
+        (eval, sums.0, sums.1, sums.2)
+    }
+
+    /// The block Hertz–Mindlin kernel gives the forces, torques, history, dissipation and
     /// stored energy of the general pipeline (kinematics + `ContactModel::evaluate` + ledger)
     /// within 1e-12 relative, over sequences of random sticking and sliding contacts, for
     /// unequal sizes and materials.
     #[test]
-    fn fused_hertz_mindlin_equals_general_pipeline() {
+    fn block_hertz_mindlin_equals_general_pipeline() {
         let mats = vec![
             Material::new("steel", 7850.0, 2.1e11, 0.3),
             Material::new("glass", 2500.0, 6.3e10, 0.22),
@@ -1122,8 +1392,7 @@ mod tests {
                 assert!(dist < 1.8e-3);
                 let (k0, k1) = (Kin::of(&p, 0), Kin::of(&p, 1));
                 let radii = (p.radius[0], p.radius[1]);
-                let (a, dn_a, dt_a, e_a) =
-                    hm_pair_fast(&hm, radii, &k0, &k1, d, dist, &mut s_fast, dt);
+                let (a, dn_a, dt_a, e_a) = block_one(&hm, radii, (&k0, &k1), d, &mut s_fast, dt);
                 let (b, dn_b, dt_b, e_b) =
                     evaluate_pair(&p, &table, 0, 1, d, dist, true, &mut s_gen, dt);
                 for (x, y) in [

@@ -13,6 +13,7 @@ pub mod energy;
 mod forces;
 pub mod generate;
 pub mod health;
+mod hm_block;
 pub mod integrate;
 pub mod interaction;
 pub mod material;
