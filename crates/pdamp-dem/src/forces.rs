@@ -111,7 +111,10 @@ pub struct PpContact {
 /// order (compact, in the order the pair loop visits it).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PpChunk {
-    slab: Vec<PpContact>,
+    /// Contact states by slot, each in two cache lines of its own.
+    slab: Vec<SlabState>,
+    /// Partners `(i, j)` of each slot (read only when contacts are collected).
+    slab_ij: Vec<(u32, u32)>,
     free: Vec<u32>,
     /// Contacts that are not in the neighbour list (any more): closed by the next evaluation.
     orphans: Vec<PpContact>,
@@ -135,17 +138,48 @@ thread_local! {
         std::cell::RefCell::new(PairScratch::default());
 }
 
+/// The state of one contact in a slab: 128 bytes aligned to a cache line, so that the pair loop
+/// touches exactly two lines per contact.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(crate) struct SlabState {
+    state: PairState,
+}
+
+/// Puts a contact into a free slot of the slab (or a new one); returns the slot.
+fn slab_alloc(
+    slab: &mut Vec<SlabState>,
+    slab_ij: &mut Vec<(u32, u32)>,
+    free: &mut Vec<u32>,
+    k: PpContact,
+) -> u32 {
+    let e = SlabState { state: k.state };
+    match free.pop() {
+        Some(s) => {
+            slab[s as usize] = e;
+            slab_ij[s as usize] = (k.i, k.j);
+            s
+        }
+        None => {
+            slab.push(e);
+            slab_ij.push((k.i, k.j));
+            (slab.len() - 1) as u32
+        }
+    }
+}
+
 impl PpChunk {
     fn alloc(&mut self, k: PpContact) -> u32 {
-        match self.free.pop() {
-            Some(s) => {
-                self.slab[s as usize] = k;
-                s
-            }
-            None => {
-                self.slab.push(k);
-                (self.slab.len() - 1) as u32
-            }
+        slab_alloc(&mut self.slab, &mut self.slab_ij, &mut self.free, k)
+    }
+
+    /// The contact in slot `s`.
+    fn contact(&self, s: u32) -> PpContact {
+        let (i, j) = self.slab_ij[s as usize];
+        PpContact {
+            i,
+            j,
+            state: self.slab[s as usize].state,
         }
     }
 
@@ -172,7 +206,7 @@ impl World {
                 for q in nl.row_start[lo] as usize..nl.row_start[hi] as usize {
                     let s = self.pair_contact[q];
                     if s != NO_CONTACT {
-                        out.push(chunk.slab[s as usize]);
+                        out.push(chunk.contact(s));
                     }
                 }
             }
@@ -210,6 +244,7 @@ impl World {
         self.pp_chunks.resize_with(nchunks, PpChunk::default);
         for c in self.pp_chunks.iter_mut() {
             c.slab.clear();
+            c.slab_ij.clear();
             c.free.clear();
             c.orphans.clear();
         }
@@ -247,15 +282,21 @@ const PREFETCH_AHEAD: usize = 8;
 /// Hints the processor to load the cache line of `x` (no effect on other targets).
 #[inline(always)]
 fn prefetch<T>(x: &T) {
+    prefetch_at((x as *const T).cast::<u8>());
+}
+
+/// Hints the processor to load the cache line at `p` (never dereferenced).
+#[inline(always)]
+fn prefetch_at(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch is only a hint; it never faults, whatever the address.
     #[allow(unused_unsafe)]
     unsafe {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>());
+        _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>());
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
+    let _ = p;
 }
 
 /// Marks a neighbour pair without an active contact in `pair_contact`.
@@ -423,7 +464,7 @@ impl HmBatch {
         kernel: crate::hm_block::Kernel,
         dt: f64,
         lo: usize,
-        slab: &mut [PpContact],
+        slab: &mut [SlabState],
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
         po: &mut [SecondOutput],
         outs: &mut usize,
@@ -566,6 +607,7 @@ impl PairContext<'_> {
         let second_c = &rows.second[q0..rows.row_start[hi] as usize];
         let PpChunk {
             slab,
+            slab_ij,
             free,
             orphans,
             sums,
@@ -603,22 +645,13 @@ impl PairContext<'_> {
         rt.iter_mut().for_each(|t| *t = Vec3::zeros());
         let mut outs = 0usize;
         let mut acc = (0.0, 0.0, 0.0);
-        let alloc = |slab: &mut Vec<PpContact>, free: &mut Vec<u32>, i: usize, j: usize| {
+        let mut alloc = |slab: &mut Vec<SlabState>, free: &mut Vec<u32>, i: usize, j: usize| {
             let k = PpContact {
                 i: i as u32,
                 j: j as u32,
                 state: PairState::default(),
             };
-            match free.pop() {
-                Some(s) => {
-                    slab[s as usize] = k;
-                    s
-                }
-                None => {
-                    slab.push(k);
-                    (slab.len() - 1) as u32
-                }
-            }
+            slab_alloc(slab, slab_ij, free, k)
         };
         for e in 0..na {
             // Look ahead: fetch the partner data and contact state of a later contact while this
@@ -628,8 +661,10 @@ impl PairContext<'_> {
                 prefetch(&kin[second_c[qn] as usize]);
                 let sn = pc[qn];
                 if let Some(k) = slab.get(sn as usize) {
-                    prefetch(k);
-                    prefetch(&k.state.tangential_force_prev);
+                    // both cache lines of the slot
+                    let p = (k as *const SlabState).cast::<u8>();
+                    prefetch_at(p);
+                    prefetch_at(p.wrapping_add(64));
                 }
             }
             let qq = scan_pair[e] as usize;
@@ -825,9 +860,8 @@ impl World {
             let mut all = Vec::new();
             for c in pp_chunks.iter() {
                 all.extend(
-                    c.slab
-                        .iter()
-                        .copied()
+                    (0..c.slab.len() as u32)
+                        .map(|s| c.contact(s))
                         .filter(|k| (k.j as usize) < n && k.state.active),
                 );
                 all.extend(c.orphans.iter().copied().filter(|k| (k.j as usize) < n));
@@ -1304,11 +1338,7 @@ mod tests {
         st: &mut PairState,
         dt: f64,
     ) -> (PairEval, f64, f64, f64) {
-        let mut slab = vec![PpContact {
-            i: 0,
-            j: 1,
-            state: *st,
-        }];
+        let mut slab = vec![SlabState { state: *st }];
         let mut batch = HmBatch::default();
         batch.push(hm, (0, 1), radii, kin, d, st, 0);
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
