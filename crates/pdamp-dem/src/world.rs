@@ -6,6 +6,7 @@ use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
 use crate::forces::{PpChunk, WallSlot};
 use crate::integrate::{GearState, Integrator};
+use rayon::prelude::*;
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
 use crate::math::Vec3;
@@ -97,6 +98,8 @@ pub struct World {
     pub(crate) pp_chunks: Vec<PpChunk>,
     pub(crate) wall_slots: Vec<Vec<WallSlot>>,
     pub(crate) scratch_force: Vec<Vec3>,
+    /// Per-block kinetic and potential energy (scratch of `refresh_state_energies`).
+    pub(crate) scratch_energy: Vec<[f64; 2]>,
     /// Positions and radii packed per particle for the pair loop (scratch).
     pub(crate) scratch_xr: Vec<[f64; 4]>,
     /// Velocities, masses and spins packed per particle for the pair loop (scratch).
@@ -140,6 +143,7 @@ impl World {
             pp_chunks: Vec::new(),
             wall_slots: Vec::new(),
             scratch_force: Vec::new(),
+            scratch_energy: Vec::new(),
             scratch_xr: Vec::new(),
             scratch_kin: Vec::new(),
             scratch_torque: Vec::new(),
@@ -379,8 +383,31 @@ impl World {
 
     /// Recomputes kinetic and potential energy in the ledger from the state.
     pub(crate) fn refresh_state_energies(&mut self) {
-        self.ledger.kinetic_j = self.particles.kinetic_energy();
-        self.ledger.potential_j = self.particles.potential_energy(&self.gravity_m_s2);
+        // In parallel over blocks of particles, the blocks added in order (the result does not
+        // depend on the thread count).
+        const BLOCK: usize = 2048;
+        let p = &self.particles;
+        let g = self.gravity_m_s2;
+        let sums = &mut self.scratch_energy;
+        sums.clear();
+        sums.resize(p.len().div_ceil(BLOCK), [0.0; 2]);
+        sums.par_iter_mut().enumerate().for_each(|(b, e)| {
+            let r = b * BLOCK..((b + 1) * BLOCK).min(p.len());
+            let (mut kin, mut pot) = (0.0, 0.0);
+            for i in r {
+                kin += 0.5 * p.mass[i] * p.velocity[i].norm_squared()
+                    + 0.5 * p.angular_velocity[i].norm_squared() / p.inv_inertia[i];
+                pot += p.mass[i] * g.dot(&p.position[i]);
+            }
+            *e = [kin, pot];
+        });
+        let (mut kin, mut pot) = (0.0, 0.0);
+        for e in sums.iter() {
+            kin += e[0];
+            pot += e[1];
+        }
+        self.ledger.kinetic_j = kin;
+        self.ledger.potential_j = -pot;
     }
 
     /// Advances by one time step (or one accepted step under Gear step control).
