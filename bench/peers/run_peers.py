@@ -37,6 +37,28 @@ def ensure_liggghts():
     subprocess.run(prefix + ["apt-get", "install", "-y", "liggghts"], check=True)
 
 
+def _spin(n):
+    x = 0
+    for i in range(n):
+        x += i ^ (x >> 3)
+    return x
+
+
+def parallel_capacity(n=6_000_000):
+    """Speed-up of this machine itself from 1 to 2 processes on a pure CPU loop (no memory
+    traffic): the ceiling for any code's 1 -> 2 thread speed-up here (shared or throttled
+    virtual cores give less than 2)."""
+    import multiprocessing as mp
+    t0 = time.perf_counter()
+    _spin(n)
+    t1 = time.perf_counter() - t0
+    with mp.Pool(2) as pool:
+        t0 = time.perf_counter()
+        pool.map(_spin, [n, n])
+        t2 = time.perf_counter() - t0
+    return 2.0 * t1 / t2
+
+
 def pdamp_binary():
     if os.environ.get("PDAMP_BIN"):
         return os.environ["PDAMP_BIN"]
@@ -122,6 +144,8 @@ def main():
     args = ap.parse_args()
     ensure_liggghts()
     exe = pdamp_binary()
+    capacity = parallel_capacity()
+    print(f"this machine: 1 -> 2 processes on a pure CPU loop: speed-up {capacity:.2f}", flush=True)
     os.makedirs(args.work, exist_ok=True)
     results = []
     for n in [int(x) for x in args.sizes.split(",")]:
@@ -159,7 +183,8 @@ def main():
             print(f"N={n:6d}: speed-up 1 -> 2 threads: pdamp {sp:.2f}, LIGGGHTS {sl:.2f}")
     out = os.path.join(args.work, "results.json")
     with open(out, "w") as f:
-        json.dump({"load_average": os.getloadavg(), "results": results}, f, indent=2)
+        json.dump({"load_average": os.getloadavg(), "machine_parallel_capacity": capacity,
+                   "results": results}, f, indent=2)
     print(f"results in {out}", file=sys.stderr)
     if not all(r["same_physics"] for r in results):
         print("dissipated power differs by more than 10 % somewhere", file=sys.stderr)
