@@ -6,12 +6,12 @@ use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
 use crate::forces::{PpChunk, WallSlot};
 use crate::integrate::{GearState, Integrator};
-use rayon::prelude::*;
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
 use crate::math::Vec3;
 use crate::neighbor::NeighborList;
 use crate::particles::ParticleSet;
+use rayon::prelude::*;
 
 /// Counters of work done, for diagnostics and benchmarks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -1,6 +1,8 @@
 //! Parameter studies of paper Sect. 3 (Figs. 2–6, Table 1): one cantilever run per value of a
 //! parameter, each written to its own sub-directory, plus a combined decay plot, an envelope
-//! plot and a Table-1-like `table.csv` (ζ1, ζ2, ζ̄5 per value). Finished runs
+//! plot and a Table-1-like `table.csv` (ζ1, ζ2, ζ̄5 per value, with the period, the
+//! preparation's settled and final packing density, whether the plate compressed the bed, the
+//! energy closure and the wall times). Finished runs
 //! (`<dir>/summary.json` present) are skipped, so a study can be resumed; each run
 //! checkpoints into `<dir>/checkpoint.bin` and, with `resume`, an interrupted run continues
 //! from its checkpoint ([`cantilever::run_in_dir`]).
@@ -88,8 +90,73 @@ pub struct StudyRow {
     pub damping: damping::TableOneRatios,
     /// Particles.
     pub particles: usize,
+    /// Preparation report (settled and final packing density, compression, plate force).
+    pub prep: Option<crate::prep::PrepReport>,
+    /// Energy closure of the coupled run (largest drift of the balance / largest stored energy).
+    pub energy_closure: f64,
+    /// Mean fixed-point iterations per coupled step.
+    pub mean_iterations: f64,
     /// Wall time of preparation + coupled run [s].
     pub wall_time_s: f64,
+}
+
+impl StudyRow {
+    /// The row of a finished run.
+    fn of(value: f64, r: &cantilever::CantileverResult) -> Self {
+        StudyRow {
+            value,
+            damping: r.damping,
+            particles: r.particles,
+            prep: r.prep.clone(),
+            energy_closure: r.energy_closure,
+            mean_iterations: r.mean_iterations,
+            wall_time_s: r.wall_time_s + r.prep.as_ref().map_or(0.0, |p| p.wall_time_s),
+        }
+    }
+}
+
+/// Columns of `table.csv` (units in the names; `compressed` is 1 or 0).
+pub const TABLE_COLUMNS: [&str; 15] = [
+    "zeta_1",
+    "zeta_2",
+    "zeta_5",
+    "period_s",
+    "particles",
+    "settled_packing_density",
+    "packing_density",
+    "compressed",
+    "plate_force_n",
+    "max_relative_overlap",
+    "energy_closure",
+    "mean_coupling_iterations",
+    "prep_wall_time_s",
+    "run_wall_time_s",
+    "wall_time_s",
+];
+
+/// One line of `table.csv`: the parameter value, then [`TABLE_COLUMNS`].
+fn table_line(r: &StudyRow) -> [f64; 16] {
+    let nan = f64::NAN;
+    let prep = r.prep.as_ref();
+    let prep_wall = prep.map_or(0.0, |p| p.wall_time_s);
+    [
+        r.value,
+        r.damping.zeta_1.unwrap_or(nan),
+        r.damping.zeta_2.unwrap_or(nan),
+        r.damping.zeta_5.unwrap_or(nan),
+        r.damping.period_s.unwrap_or(nan),
+        r.particles as f64,
+        prep.map_or(nan, |p| p.settled_packing_density),
+        prep.map_or(nan, |p| p.packing_density),
+        prep.map_or(nan, |p| f64::from(u8::from(p.compressed))),
+        prep.map_or(nan, |p| p.plate_force_n),
+        prep.map_or(nan, |p| p.max_relative_overlap),
+        r.energy_closure,
+        r.mean_iterations,
+        prep_wall,
+        r.wall_time_s - prep_wall,
+        r.wall_time_s,
+    ]
 }
 
 /// Runs the study into `out` and returns the table; `options` are passed to every run that
@@ -125,20 +192,20 @@ pub fn run_study(
                 &std::fs::read_to_string(dir.join("summary.json")).map_err(|e| e.to_string())?,
             )
             .map_err(|e| e.to_string())?;
-            let wall = js["result"]["wall_time_s"].as_f64().unwrap_or(0.0)
-                + js["result"]["prep"]["wall_time_s"].as_f64().unwrap_or(0.0);
-            let particles = js["result"]["particles"].as_u64().unwrap_or(0) as usize;
-            let d = damping::table_one(&t, &x, t_rel);
-            (
-                t,
-                x,
-                StudyRow {
-                    value: v,
-                    damping: d,
-                    particles,
-                    wall_time_s: wall,
-                },
-            )
+            let res = &js["result"];
+            let f = |k: &str| res[k].as_f64().unwrap_or(f64::NAN);
+            let prep: Option<crate::prep::PrepReport> =
+                serde_json::from_value(res["prep"].clone()).unwrap_or(None);
+            let row = StudyRow {
+                value: v,
+                damping: damping::table_one(&t, &x, t_rel),
+                particles: res["particles"].as_u64().unwrap_or(0) as usize,
+                energy_closure: f("energy_closure"),
+                mean_iterations: f("mean_iterations"),
+                wall_time_s: f("wall_time_s") + prep.as_ref().map_or(0.0, |p| p.wall_time_s),
+                prep,
+            };
+            (t, x, row)
         } else {
             // the stage names the run; the fraction is the stage's own (stages restart at 0)
             let n = values.len();
@@ -147,17 +214,8 @@ pub fn run_study(
                 progress(&label, f)
             };
             let r = cantilever::run_in_dir(&sc, &dir, options, &mut prog)?;
-            let wall = r.wall_time_s + r.prep.as_ref().map_or(0.0, |p| p.wall_time_s);
-            (
-                r.time_s.clone(),
-                r.tip_m.clone(),
-                StudyRow {
-                    value: v,
-                    damping: r.damping,
-                    particles: r.particles,
-                    wall_time_s: wall,
-                },
-            )
+            let row = StudyRow::of(v, &r);
+            (r.time_s, r.tip_m, row)
         };
         let label = format!("{} = {v}", param.name());
         decay.series.push(pdamp_plot::Series::new(
@@ -173,33 +231,10 @@ pub fn run_study(
         ));
         rows.push(row);
     }
-    let nan = f64::NAN;
-    let table: Vec<[f64; 6]> = rows
-        .iter()
-        .map(|r| {
-            [
-                r.value,
-                r.damping.zeta_1.unwrap_or(nan),
-                r.damping.zeta_2.unwrap_or(nan),
-                r.damping.zeta_5.unwrap_or(nan),
-                r.particles as f64,
-                r.wall_time_s,
-            ]
-        })
-        .collect();
-    pdamp_io::csv::write_csv_atomic(
-        out.join("table.csv"),
-        &[
-            param.name(),
-            "zeta_1",
-            "zeta_2",
-            "zeta_5",
-            "particles",
-            "wall_time_s",
-        ],
-        table,
-    )
-    .map_err(|e| e.to_string())?;
+    let mut header = vec![param.name()];
+    header.extend(TABLE_COLUMNS);
+    pdamp_io::csv::write_csv_atomic(out.join("table.csv"), &header, rows.iter().map(table_line))
+        .map_err(|e| e.to_string())?;
     pdamp_plot::line_plot(out.join("decay"), &decay).map_err(|e| e.to_string())?;
     pdamp_plot::line_plot(out.join("envelope"), &env).map_err(|e| e.to_string())?;
     Ok(rows)
