@@ -59,8 +59,6 @@ pub(crate) struct SecondOutput {
     force: Vec3,
     /// Torque on the second partner, N·m.
     torque: Vec3,
-    /// Second partner.
-    second: u32,
 }
 
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
@@ -91,6 +89,9 @@ fn account(
 }
 
 const CHUNK: usize = 1024;
+
+use crate::particles::kinetic_energy_j;
+use crate::world::ENERGY_BLOCK;
 
 /// A particle–particle contact that was active (touching, or within the adhesion range) at the
 /// last force evaluation: the partners `i < j` and the contact state.
@@ -253,6 +254,8 @@ impl World {
         self.pair_contact.clear();
         self.pair_contact
             .resize(if list_ok { nl.num_pairs() } else { 0 }, NO_CONTACT);
+        self.pair_out_at.clear();
+        self.pair_out_at.resize(self.pair_contact.len(), NO_OUTPUT);
         for k in contacts {
             let (i, j) = (k.i as usize, k.j as usize);
             if i >= n || j >= n {
@@ -301,6 +304,10 @@ fn prefetch_at(p: *const u8) {
 
 /// Marks a neighbour pair without an active contact in `pair_contact`.
 pub(crate) const NO_CONTACT: u32 = u32::MAX;
+
+/// Marks a neighbour pair without an output in `pair_out_at`: index of the zero entry that
+/// heads `pair_out` (the gather adds it without a branch).
+pub(crate) const NO_OUTPUT: u32 = 0;
 
 /// Particles per chunk of the particle–particle pass.
 pub(crate) const PP_CHUNK: usize = 256;
@@ -400,19 +407,20 @@ pub(crate) struct HmBatch {
     inp: Vec<HmInput>,
     st: Vec<HmState>,
     out: Vec<HmOutput>,
-    /// First partner, second partner and slab slot of each contact.
+    /// First partner, pair index within the chunk and slab slot of each contact.
     lane: Vec<(u32, u32, u32)>,
     len: usize,
 }
 
 impl HmBatch {
-    /// Adds the touching pair (`i`, `j`) at distance vector `d`, its contact in `slot`.
+    /// Adds the touching pair of first partner `i` (pair `qq` of the chunk) at distance
+    /// vector `d`, its contact in `slot`.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn push(
         &mut self,
         hm: &crate::interaction::HmConstants,
-        (i, j): (usize, usize),
+        (i, qq): (usize, usize),
         (ri, rj): (f64, f64),
         (ki, kj): (&Kin, &Kin),
         d: Vec3,
@@ -450,14 +458,15 @@ impl HmBatch {
         if self.len == self.lane.len() {
             self.lane.push((0, 0, 0));
         }
-        self.lane[self.len] = (i as u32, j as u32, slot);
+        self.lane[self.len] = (i as u32, qq as u32, slot);
         self.len += 1;
     }
 
     /// Evaluates the collected contacts and hands out their results in the order they were
     /// added: contact states into the slab, the first partner's force and torque added to
-    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po`, energies
-    /// added to `sums` (normal and tangential dissipation, stored energy).
+    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po` (its place
+    /// `out_base + k` noted in `pa` of the pair), energies added to `sums` (normal and
+    /// tangential dissipation, stored energy).
     #[allow(clippy::too_many_arguments)]
     fn flush(
         &mut self,
@@ -466,7 +475,7 @@ impl HmBatch {
         lo: usize,
         slab: &mut [SlabState],
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
-        po: &mut [SecondOutput],
+        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
         outs: &mut usize,
         sums: &mut (f64, f64, f64),
     ) {
@@ -487,7 +496,7 @@ impl HmBatch {
         {
             kernel(b, s, o, dt);
         }
-        for (e, &(i, j, slot)) in self.lane[..m].iter().enumerate() {
+        for (e, &(i, qq, slot)) in self.lane[..m].iter().enumerate() {
             let (s, o, k) = (&self.st[e / LANES], &self.out[e / LANES], e % LANES);
             let st = &mut slab[slot as usize].state;
             let h = &mut st.history;
@@ -511,8 +520,8 @@ impl HmBatch {
             po[*outs] = SecondOutput {
                 force,
                 torque: Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]),
-                second: j,
             };
+            pa[qq as usize] = out_base + *outs as u32;
             *outs += 1;
         }
         self.len = 0;
@@ -560,9 +569,10 @@ fn copy_lane(b: &mut HmInput, s: &mut HmState, from: usize, to: usize) {
 }
 
 impl PairContext<'_> {
-    /// The particle–particle contacts of one chunk of first partners: returns the number of
-    /// second-partner outputs written to `po`; the first partners' forces and torques go to
-    /// `rf`/`rt`, the energies to `chunk.sums`.
+    /// The particle–particle contacts of one chunk of first partners: the second-partner
+    /// outputs are written to `po` in list order, and for every pair of the chunk `pa` holds
+    /// the index of its output in `pair_out` (`out_base` + place in `po`) or [`NO_OUTPUT`]; the
+    /// first partners' forces and torques go to `rf`/`rt`, the energies to `chunk.sums`.
     ///
     /// Two passes. The scan tests every pair of the rows for contact (squared distance against
     /// the sum of the radii plus the adhesion range) without branching and keeps the pairs that
@@ -576,12 +586,12 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        po: &mut [SecondOutput],
+        out: (&mut [SecondOutput], &mut [u32], u32),
         rf: &mut [Vec3],
         rt: &mut [Vec3],
-    ) -> usize {
+    ) {
         PAIR_SCRATCH.with_borrow_mut(|scratch| {
-            self.chunk_pairs_with(rows, chunk, pc, po, (rf, rt), scratch)
+            self.chunk_pairs_with(rows, chunk, pc, out, (rf, rt), scratch)
         })
     }
 
@@ -591,10 +601,10 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        po: &mut [SecondOutput],
+        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
         scratch: &mut PairScratch,
-    ) -> usize {
+    ) {
         let (p, interactions, xr, kin, reach, dt) = (
             self.p,
             self.interactions,
@@ -692,7 +702,7 @@ impl PairContext<'_> {
                 };
                 batch.push(
                     hm,
-                    (i, j),
+                    (i, qq),
                     (ri0, rj),
                     (&kin[i], &kin[j]),
                     d,
@@ -706,7 +716,16 @@ impl PairContext<'_> {
                 continue;
             }
             if touching {
-                batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+                batch.flush(
+                    self.kernel,
+                    dt,
+                    lo,
+                    slab,
+                    (rf, rt),
+                    (po, pa, out_base),
+                    &mut outs,
+                    &mut acc,
+                );
             }
             let s = if slot == NO_CONTACT {
                 alloc(slab, free, i, j)
@@ -725,15 +744,25 @@ impl PairContext<'_> {
                 po[outs] = SecondOutput {
                     force: out.force,
                     torque: out.torque_second,
-                    second: j as u32,
                 };
+                pa[qq] = out_base + outs as u32;
                 outs += 1;
             } else {
                 pc[qq] = NO_CONTACT;
+                pa[qq] = NO_OUTPUT;
                 free.push(s);
             }
         }
-        batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+        batch.flush(
+            self.kernel,
+            dt,
+            lo,
+            slab,
+            (rf, rt),
+            (po, pa, out_base),
+            &mut outs,
+            &mut acc,
+        );
         // Contacts that left the neighbour list: close their work integral.
         for k in orphans.drain(..) {
             let (i, j) = (k.i as usize, k.j as usize);
@@ -745,7 +774,6 @@ impl PairContext<'_> {
             acc.1 += y;
         }
         *sums = acc;
-        outs
     }
 }
 
@@ -764,10 +792,15 @@ impl Kin {
     /// The packed state of particle `i`.
     #[inline]
     fn of(p: &crate::particles::ParticleSet, i: usize) -> Self {
-        let (u, w) = (p.velocity[i], p.angular_velocity[i]);
+        Self::new(&p.velocity[i], p.mass[i], &p.angular_velocity[i])
+    }
+
+    /// Packs velocity `u`, mass `m` and angular velocity `w`.
+    #[inline(always)]
+    pub(crate) fn new(u: &Vec3, m: f64, w: &Vec3) -> Self {
         Kin {
             v: [u.x, u.y, u.z],
-            m: p.mass[i],
+            m,
             w: [w.x, w.y, w.z],
             _pad: 0.0,
         }
@@ -815,16 +848,25 @@ impl World {
     /// state (0 for the initial evaluation): it integrates history variables and contact work.
     /// Returns the energy increments of this evaluation.
     pub(crate) fn evaluate_forces(&mut self, dt: f64) -> EnergyIncrements {
+        self.evaluate_forces_and_kick(dt, None)
+    }
+
+    /// [`World::evaluate_forces`]; with `kick = Some(h)` the pass that sums each particle's
+    /// forces also advances its velocities by the half step `h` (velocity Verlet's second
+    /// half-kick) and sums the kinetic and potential energy after it into the ledger, in blocks
+    /// of [`ENERGY_BLOCK`] particles added in order (as [`World::refresh_state_energies`]).
+    pub(crate) fn evaluate_forces_and_kick(
+        &mut self,
+        dt: f64,
+        kick: Option<f64>,
+    ) -> EnergyIncrements {
         let t_pairs = self.tick();
         let World {
             particles: p,
             interactions,
             neighbors,
             pair_out,
-            out_count,
-            second_start,
-            second_list,
-            scratch_fill: fill,
+            pair_out_at,
             row_force,
             row_torque,
             pair_contact,
@@ -838,6 +880,11 @@ impl World {
             wall_skip,
             scratch_xr: xr,
             scratch_kin: kin,
+            packed_fresh,
+            scratch_velocity: vel_out,
+            scratch_angular_velocity: ang_out,
+            scratch_energy: energy_out,
+            scratch_wall_loads: wall_loads,
             ..
         } = self;
         let p = &*p;
@@ -851,8 +898,9 @@ impl World {
         //    chunk's slab (history updated in place); a contact that ended closes its work
         //    integral and frees its slot. The first partner's force and torque are summed here;
         //    the second partner's share goes to the chunk's output list (`pair_out`, written
-        //    sequentially), which a counting sort by second partner then indexes for the gather
-        //    (fixed order, the first partner ascending: thread-count independent).
+        //    sequentially), and the pair notes where (`pair_out_at`). The second partner gathers
+        //    its shares through the list's transposed index (pairs by second partner, the first
+        //    partner ascending): a fixed order, whatever the thread count.
         let nchunks = n.div_ceil(PP_CHUNK);
         let m = nl.num_pairs();
         if pp_chunks.len() != nchunks || pair_contact.len() != m {
@@ -870,57 +918,68 @@ impl World {
             pp_chunks.resize_with(nchunks, PpChunk::default);
             pair_contact.clear();
             pair_contact.resize(m, NO_CONTACT);
+            pair_out_at.clear();
+            pair_out_at.resize(m, NO_OUTPUT);
             for k in all {
                 pp_chunks[k.i as usize / PP_CHUNK].orphans.push(k);
             }
         }
-        // Every chunk writes the outputs of its contacts densely from the start of its pair range.
-        pair_out.resize(m, SecondOutput::default());
-        out_count.resize(nchunks, 0);
+        // Every chunk writes the outputs of its contacts densely from the start of its pair
+        // range; entry 0 stays zero (the output of pairs without a contact).
+        pair_out.resize(m + 1, SecondOutput::default());
+        if pair_out_at.len() != m {
+            // Only reached with a list whose contacts were never attached (no outputs yet).
+            pair_out_at.clear();
+            pair_out_at.resize(m, NO_OUTPUT);
+        }
         row_force.resize(n, Vec3::zeros());
         row_torque.resize(n, Vec3::zeros());
         let reach = nl.extra_range_m;
         // Positions and radii packed together: one load per partner in the pair loop.
         // Velocities, masses and spins packed likewise: one cache line per contact partner.
-        xr.resize(n, [0.0; 4]);
-        kin.resize(n, Kin::default());
-        xr.par_chunks_mut(CHUNK)
-            .zip(kin.par_chunks_mut(CHUNK))
-            .enumerate()
-            .for_each(|(c, (out, kout))| {
-                for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
-                    let i = c * CHUNK + k;
-                    let x = p.position[i];
-                    *v = [x.x, x.y, x.z, p.radius[i]];
-                    *kv = Kin::of(p, i);
-                }
-            });
+        if !std::mem::take(packed_fresh) || xr.len() != n || kin.len() != n {
+            xr.resize(n, [0.0; 4]);
+            kin.resize(n, Kin::default());
+            xr.par_chunks_mut(CHUNK)
+                .zip(kin.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, (out, kout))| {
+                    for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
+                        let i = c * CHUNK + k;
+                        let x = p.position[i];
+                        *v = [x.x, x.y, x.z, p.radius[i]];
+                        *kv = Kin::of(p, i);
+                    }
+                });
+        }
         let xr = &*xr;
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
         let kernel = crate::hm_block::kernel();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
-            let mut pcs: Vec<(&mut [u32], &mut [SecondOutput])> = Vec::with_capacity(nchunks);
-            let (mut rest_c, mut rest_o): (&mut [u32], &mut [SecondOutput]) =
-                (pair_contact, pair_out);
+            type ChunkSlices<'a> = (&'a mut [u32], &'a mut [SecondOutput], &'a mut [u32]);
+            let mut pcs: Vec<ChunkSlices> = Vec::with_capacity(nchunks);
+            let (mut rest_c, mut rest_o, mut rest_a): ChunkSlices =
+                (pair_contact, &mut pair_out[1..], pair_out_at);
             for c in 0..nchunks {
                 let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
                 let len = (nl.row_start[hi] - nl.row_start[lo]) as usize;
                 let (a, b) = rest_c.split_at_mut(len);
                 let (x, y) = rest_o.split_at_mut(len);
-                pcs.push((a, x));
+                let (u, w) = rest_a.split_at_mut(len);
+                pcs.push((a, x, u));
                 rest_c = b;
                 rest_o = y;
+                rest_a = w;
             }
             pp_chunks
                 .par_iter_mut()
                 .zip(pcs.into_par_iter())
                 .zip(row_force.par_chunks_mut(PP_CHUNK))
                 .zip(row_torque.par_chunks_mut(PP_CHUNK))
-                .zip(out_count.par_iter_mut())
                 .enumerate()
-                .for_each(|(c, ((((chunk, (pc, po)), rf), rt), count))| {
+                .for_each(|(c, (((chunk, (pc, po, pa)), rf), rt))| {
                     let lo = c * PP_CHUNK;
                     let hi = ((c + 1) * PP_CHUNK).min(n);
                     let rows = PairRows {
@@ -940,34 +999,9 @@ impl World {
                         dt,
                         kernel,
                     };
-                    *count = ctx.chunk_pairs(&rows, chunk, pc, po, rf, rt) as u32;
+                    let out_base = 1 + rows.q0 as u32;
+                    ctx.chunk_pairs(&rows, chunk, pc, (po, pa, out_base), rf, rt);
                 });
-        }
-        // Counting sort of the outputs by second partner. For one particle its entries follow
-        // the chunks and, within a chunk, the pair loop: the first partner ascending (the order
-        // of the transposed neighbour index), whatever the thread count.
-        second_start.clear();
-        second_start.resize(n + 1, 0);
-        for (c, &cnt) in out_count.iter().enumerate() {
-            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
-            for o in &pair_out[base..base + cnt as usize] {
-                second_start[o.second as usize + 1] += 1;
-            }
-        }
-        for k in 0..n {
-            second_start[k + 1] += second_start[k];
-        }
-        let total = second_start[n] as usize;
-        second_list.resize(total, 0);
-        fill.clear();
-        fill.extend_from_slice(&second_start[..n]);
-        for (c, &cnt) in out_count.iter().enumerate() {
-            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
-            for (k, o) in pair_out[base..base + cnt as usize].iter().enumerate() {
-                let f = &mut fill[o.second as usize];
-                second_list[*f as usize] = (base + k) as u32;
-                *f += 1;
-            }
         }
         let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
 
@@ -991,8 +1025,8 @@ impl World {
         let wall_candidate = &*wall_candidate;
         let bodies_ref = &*bodies;
         let pair_out = &*pair_out;
-        let second_start = &*second_start;
-        let second_list = &*second_list;
+        let pair_out_at = &*pair_out_at;
+        let (col_start, col_pairs) = (&nl.col_start, &nl.col_pairs);
         let rows_f = &*row_force;
         let rows_t = &*row_torque;
         let g = *gravity_m_s2;
@@ -1000,10 +1034,21 @@ impl World {
         let mut torque = std::mem::take(&mut self.scratch_torque);
         force.resize(n, Vec3::zeros());
         torque.resize(n, Vec3::zeros());
-        let pw: Vec<EnergyIncrements> = force
-            .par_chunks_mut(CHUNK)
-            .zip(torque.par_chunks_mut(CHUNK))
-            .zip(wall_slots.par_chunks_mut(CHUNK))
+        vel_out.resize(n, Vec3::zeros());
+        ang_out.resize(n, Vec3::zeros());
+        energy_out.clear();
+        energy_out.resize(n.div_ceil(ENERGY_BLOCK), [0.0; 2]);
+        wall_loads.resize_with(n.div_ceil(ENERGY_BLOCK), Vec::new);
+        // Blocks of ENERGY_BLOCK particles; the energy increments are kept per CHUNK within a
+        // block and added in order (the sums do not depend on the block size).
+        const SUB: usize = ENERGY_BLOCK / CHUNK;
+        let pw: Vec<[EnergyIncrements; SUB]> = force
+            .par_chunks_mut(ENERGY_BLOCK)
+            .zip(torque.par_chunks_mut(ENERGY_BLOCK))
+            .zip(wall_slots.par_chunks_mut(ENERGY_BLOCK))
+            .zip(vel_out.par_chunks_mut(ENERGY_BLOCK))
+            .zip(ang_out.par_chunks_mut(ENERGY_BLOCK))
+            .zip(energy_out.par_iter_mut().zip(wall_loads.par_iter_mut()))
             .enumerate()
             .map_init(
                 || {
@@ -1012,48 +1057,68 @@ impl World {
                         Vec::<WallSlot>::with_capacity(16),
                     )
                 },
-                |(contacts, fresh), (c, ((fs, ts), slots))| {
-                    let mut inc = EnergyIncrements::default();
-                    for (k, ((f_out, t_out), slot_list)) in fs
+                |(contacts, fresh), (c, (((((fs, ts), slots), vs), ws), (e_out, loads)))| {
+                    let mut incs = [EnergyIncrements::default(); SUB];
+                    loads.clear();
+                    let (mut kinetic, mut pot) = (0.0, 0.0);
+                    for (k, ((((f_out, t_out), slot_list), v_out), w_out)) in fs
                         .iter_mut()
                         .zip(ts.iter_mut())
                         .zip(slots.iter_mut())
+                        .zip(vs.iter_mut())
+                        .zip(ws.iter_mut())
                         .enumerate()
                     {
-                        let i = c * CHUNK + k;
+                        let i = c * ENERGY_BLOCK + k;
+                        let inc = &mut incs[k / CHUNK];
                         let mut f = g * p.mass[i] + p.external_force[i] + rows_f[i];
                         let mut t = rows_t[i];
                         inc.external_work_j += p.external_force[i].dot(&p.velocity[i]) * dt;
-                        // Contacts where `i` is the second partner, in neighbour-list order.
-                        let range = second_start[i] as usize..second_start[i + 1] as usize;
-                        for &g in &second_list[range] {
-                            let o = &pair_out[g as usize];
+                        // Contacts where `i` is the second partner, in neighbour-list order (pairs
+                        // without one add the zero entry).
+                        let range = col_start[i] as usize..col_start[i + 1] as usize;
+                        for &q in &col_pairs[range] {
+                            let o = &pair_out[pair_out_at[q as usize] as usize];
                             f -= o.force;
                             t += o.torque;
                         }
-                        if !wall_candidate[i] && slot_list.is_empty() {
-                            *f_out = f;
-                            *t_out = t;
-                            continue;
+                        if wall_candidate[i] || !slot_list.is_empty() {
+                            wall_contacts_of(
+                                i,
+                                p,
+                                interactions,
+                                bodies_ref,
+                                &body_step,
+                                dt,
+                                slot_list,
+                                contacts,
+                                fresh,
+                                &mut f,
+                                &mut t,
+                                inc,
+                            );
+                            // This particle's loads on the bodies, in slot order.
+                            for s in slot_list.iter() {
+                                let b = &bodies_ref[s.body as usize];
+                                let torque = (s.point - b.state.position_m).cross(&(-s.force))
+                                    - s.rolling_torque;
+                                loads.push((s.body, s.force, torque));
+                            }
                         }
-                        wall_contacts_of(
-                            i,
-                            p,
-                            interactions,
-                            bodies_ref,
-                            &body_step,
-                            dt,
-                            slot_list,
-                            contacts,
-                            fresh,
-                            &mut f,
-                            &mut t,
-                            &mut inc,
-                        );
                         *f_out = f;
                         *t_out = t;
+                        if let Some(half) = kick {
+                            let (m, ii) = (p.mass[i], p.inv_inertia[i]);
+                            let v = p.velocity[i] + f * (half / m);
+                            let w = p.angular_velocity[i] + t * (half * ii);
+                            kinetic += kinetic_energy_j(m, &v, &w, ii);
+                            pot += m * g.dot(&p.position[i]);
+                            *v_out = v;
+                            *w_out = w;
+                        }
                     }
-                    inc
+                    *e_out = [kinetic, pot];
+                    incs
                 },
             )
             .collect();
@@ -1062,6 +1127,14 @@ impl World {
         std::mem::swap(&mut self.particles.torque, &mut torque);
         self.scratch_force = force;
         self.scratch_torque = torque;
+        if kick.is_some() {
+            std::mem::swap(&mut self.particles.velocity, &mut self.scratch_velocity);
+            std::mem::swap(
+                &mut self.particles.angular_velocity,
+                &mut self.scratch_angular_velocity,
+            );
+            self.set_state_energies_from_blocks();
+        }
 
         self.tock(t_particles, |p| &mut p.particle_forces_s);
         let t_loads = self.tick();
@@ -1070,13 +1143,10 @@ impl World {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
         }
-        for slots in &self.wall_slots {
-            for s in slots {
-                let b = &mut self.bodies[s.body as usize];
-                b.contact_force_n -= s.force;
-                b.contact_torque_nm +=
-                    (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
-            }
+        for &(body, force, torque) in self.scratch_wall_loads.iter().flatten() {
+            let b = &mut self.bodies[body as usize];
+            b.contact_force_n -= force;
+            b.contact_torque_nm += torque;
         }
 
         let mut inc = EnergyIncrements::default();
@@ -1085,8 +1155,8 @@ impl World {
             inc.dissipated_tangential_pp_j += dtan;
             inc.elastic_j += el;
         }
-        for w in pw {
-            inc += w;
+        for w in pw.iter().flatten() {
+            inc += *w;
         }
         self.tock(t_loads, |p| &mut p.energies_s);
         inc
@@ -1340,9 +1410,10 @@ mod tests {
     ) -> (PairEval, f64, f64, f64) {
         let mut slab = vec![SlabState { state: *st }];
         let mut batch = HmBatch::default();
-        batch.push(hm, (0, 1), radii, kin, d, st, 0);
+        batch.push(hm, (0, 0), radii, kin, d, st, 0);
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
         let mut po = vec![SecondOutput::default(); 1];
+        let mut pa = vec![NO_OUTPUT; 1];
         let (mut outs, mut sums) = (0, (0.0, 0.0, 0.0));
         let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
         batch.flush(
@@ -1351,11 +1422,12 @@ mod tests {
             0,
             &mut slab,
             (&mut rf, &mut rt),
-            &mut po,
+            (&mut po, &mut pa, 7),
             &mut outs,
             &mut sums,
         );
         assert_eq!(outs, 1);
+        assert_eq!(pa[0], 7, "the pair notes where its output went");
         *st = slab[0].state;
         let eval = PairEval {
             force: rf[0],
