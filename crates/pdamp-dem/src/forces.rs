@@ -305,55 +305,6 @@ fn prefetch_at(p: *const u8) {
 /// Marks a neighbour pair without an active contact in `pair_contact`.
 pub(crate) const NO_CONTACT: u32 = u32::MAX;
 
-/// `pair_out_at` as all chunks of the pair loop write it at once: every pair has an entry of
-/// its own (its place `pair_col[q]` in the transposed index, a permutation of the pairs), so no
-/// two chunks write the same entry, and nobody reads it during the loop.
-#[derive(Clone, Copy)]
-pub(crate) struct OutAt<'a> {
-    entries: *mut u32,
-    len: usize,
-    /// Place in the transposed index of each pair (of one chunk, once narrowed).
-    pair_col: &'a [u32],
-    _borrow: std::marker::PhantomData<&'a mut [u32]>,
-}
-
-// SAFETY: the chunks write disjoint entries (see the type's docs) of a slice borrowed mutably
-// for the lifetime of the value.
-unsafe impl Send for OutAt<'_> {}
-// SAFETY: as above.
-unsafe impl Sync for OutAt<'_> {}
-
-impl<'a> OutAt<'a> {
-    /// Wraps `entries` (one per pair, at the pair's place `pair_col[q]`).
-    pub(crate) fn new(entries: &'a mut [u32], pair_col: &'a [u32]) -> Self {
-        assert_eq!(entries.len(), pair_col.len());
-        Self {
-            entries: entries.as_mut_ptr(),
-            len: entries.len(),
-            pair_col,
-            _borrow: std::marker::PhantomData,
-        }
-    }
-
-    /// The same entries, for the `len` pairs from pair `q0` on.
-    fn narrow(self, q0: usize, len: usize) -> Self {
-        Self {
-            pair_col: &self.pair_col[q0..q0 + len],
-            ..self
-        }
-    }
-
-    /// Notes `v` for pair `qq` (of the narrowed range).
-    #[inline(always)]
-    fn set(&self, qq: usize, v: u32) {
-        let k = self.pair_col[qq] as usize;
-        assert!(k < self.len);
-        // SAFETY: `k` lies inside the borrowed slice, and pair `qq` is the only writer of entry
-        // `k` (`pair_col` is a permutation).
-        unsafe { *self.entries.add(k) = v }
-    }
-}
-
 /// Marks a neighbour pair without an output in `pair_out_at`: index of the zero entry that
 /// heads `pair_out` (the gather adds it without a branch).
 pub(crate) const NO_OUTPUT: u32 = 0;
@@ -524,7 +475,7 @@ impl HmBatch {
         lo: usize,
         slab: &mut [SlabState],
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
-        (po, pa, out_base): (&mut [SecondOutput], OutAt, u32),
+        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
         outs: &mut usize,
         sums: &mut (f64, f64, f64),
     ) {
@@ -570,7 +521,7 @@ impl HmBatch {
                 force,
                 torque: Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]),
             };
-            pa.set(qq as usize, out_base + *outs as u32);
+            pa[qq as usize] = out_base + *outs as u32;
             *outs += 1;
         }
         self.len = 0;
@@ -635,7 +586,7 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        out: (&mut [SecondOutput], OutAt, u32),
+        out: (&mut [SecondOutput], &mut [u32], u32),
         rf: &mut [Vec3],
         rt: &mut [Vec3],
     ) {
@@ -650,7 +601,7 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        (po, pa, out_base): (&mut [SecondOutput], OutAt, u32),
+        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
         scratch: &mut PairScratch,
     ) {
@@ -794,11 +745,11 @@ impl PairContext<'_> {
                     force: out.force,
                     torque: out.torque_second,
                 };
-                pa.set(qq, out_base + outs as u32);
+                pa[qq] = out_base + outs as u32;
                 outs += 1;
             } else {
                 pc[qq] = NO_CONTACT;
-                pa.set(qq, NO_OUTPUT);
+                pa[qq] = NO_OUTPUT;
                 free.push(s);
             }
         }
@@ -909,7 +860,6 @@ impl World {
         dt: f64,
         kick: Option<f64>,
     ) -> EnergyIncrements {
-        self.neighbors.ensure_pair_col();
         let t_pairs = self.tick();
         let World {
             particles: p,
@@ -1008,19 +958,20 @@ impl World {
         let kernel = crate::hm_block::kernel();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
-            type ChunkSlices<'a> = (&'a mut [u32], &'a mut [SecondOutput], OutAt<'a>);
-            let out_at = OutAt::new(pair_out_at, &nl.pair_col);
+            type ChunkSlices<'a> = (&'a mut [u32], &'a mut [SecondOutput], &'a mut [u32]);
             let mut pcs: Vec<ChunkSlices> = Vec::with_capacity(nchunks);
-            let (mut rest_c, mut rest_o): (&mut [u32], &mut [SecondOutput]) =
-                (pair_contact, &mut pair_out[1..]);
+            let (mut rest_c, mut rest_o, mut rest_a): ChunkSlices =
+                (pair_contact, &mut pair_out[1..], pair_out_at);
             for c in 0..nchunks {
                 let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
                 let len = (nl.row_start[hi] - nl.row_start[lo]) as usize;
                 let (a, b) = rest_c.split_at_mut(len);
                 let (x, y) = rest_o.split_at_mut(len);
-                pcs.push((a, x, out_at.narrow(nl.row_start[lo] as usize, len)));
+                let (u, w) = rest_a.split_at_mut(len);
+                pcs.push((a, x, u));
                 rest_c = b;
                 rest_o = y;
+                rest_a = w;
             }
             pp_chunks
                 .par_iter_mut()
@@ -1075,7 +1026,7 @@ impl World {
         let bodies_ref = &*bodies;
         let pair_out = &*pair_out;
         let pair_out_at = &*pair_out_at;
-        let col_start = &nl.col_start;
+        let (col_start, col_pairs) = (&nl.col_start, &nl.col_pairs);
         let rows_f = &*row_force;
         let rows_t = &*row_torque;
         let g = *gravity_m_s2;
@@ -1120,15 +1071,17 @@ impl World {
                     {
                         let i = c * ENERGY_BLOCK + k;
                         let inc = &mut incs[k / CHUNK];
+                        let mut f = g * p.mass[i] + p.external_force[i] + rows_f[i];
+                        let mut t = rows_t[i];
                         inc.external_work_j += p.external_force[i].dot(&p.velocity[i]) * dt;
-                        // Contacts where `i` is the second partner, in neighbour-list order.
+                        // Contacts where `i` is the second partner, in neighbour-list order (pairs
+                        // without one add the zero entry).
                         let range = col_start[i] as usize..col_start[i + 1] as usize;
-                        let (mut f, mut t) = gather_second(
-                            pair_out,
-                            &pair_out_at[range],
-                            g * p.mass[i] + p.external_force[i] + rows_f[i],
-                            rows_t[i],
-                        );
+                        for &q in &col_pairs[range] {
+                            let o = &pair_out[pair_out_at[q as usize] as usize];
+                            f -= o.force;
+                            t += o.torque;
+                        }
                         if wall_candidate[i] || !slot_list.is_empty() {
                             wall_contacts_of(
                                 i,
@@ -1208,21 +1161,6 @@ impl World {
         self.tock(t_loads, |p| &mut p.energies_s);
         inc
     }
-}
-
-/// `f` minus the forces and `t` plus the torques of the second-partner outputs at `at`, in
-/// order (pairs without a contact point at the zero entry). A function of its own so that the
-/// sums stay in registers (in the per-particle loop they would go through the stack, a
-/// store-to-load chain per pair).
-#[inline(never)]
-fn gather_second(pair_out: &[SecondOutput], at: &[u32], f: Vec3, t: Vec3) -> (Vec3, Vec3) {
-    let (mut f, mut t) = (f, t);
-    for &k in at {
-        let o = &pair_out[k as usize];
-        f -= o.force;
-        t += o.torque;
-    }
-    (f, t)
 }
 
 /// Marks the particles that may touch a wall before the next refresh: those that touch a wall
@@ -1476,7 +1414,6 @@ mod tests {
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
         let mut po = vec![SecondOutput::default(); 1];
         let mut pa = vec![NO_OUTPUT; 1];
-        let pair_col = [0u32];
         let (mut outs, mut sums) = (0, (0.0, 0.0, 0.0));
         let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
         batch.flush(
@@ -1485,7 +1422,7 @@ mod tests {
             0,
             &mut slab,
             (&mut rf, &mut rt),
-            (&mut po, OutAt::new(&mut pa, &pair_col), 7),
+            (&mut po, &mut pa, 7),
             &mut outs,
             &mut sums,
         );

@@ -28,9 +28,6 @@ pub struct NeighborList {
     pub col_start: Vec<u32>,
     /// Pair indices grouped by second partner.
     pub col_pairs: Vec<u32>,
-    /// For every pair: its place in `col_pairs` (the inverse permutation; derived, not stored).
-    #[serde(skip)]
-    pub pair_col: Vec<u32>,
     /// Positions at the last build, m.
     pub reference_position: Vec<Vec3>,
     /// Number of builds so far.
@@ -43,18 +40,6 @@ impl NeighborList {
         Self {
             skin_m,
             ..Default::default()
-        }
-    }
-
-    /// Fills `pair_col` from `col_pairs` if it does not match the list (after a restore).
-    pub fn ensure_pair_col(&mut self) {
-        let m = self.col_pairs.len();
-        if self.pair_col.len() != m {
-            self.pair_col.clear();
-            self.pair_col.resize(m, 0);
-            for (k, &q) in self.col_pairs.iter().enumerate() {
-                self.pair_col[q as usize] = k as u32;
-            }
         }
     }
 
@@ -158,8 +143,6 @@ impl NeighborList {
             self.col_pairs[fill[j as usize] as usize] = p as u32;
             fill[j as usize] += 1;
         }
-        self.pair_col.clear();
-        self.ensure_pair_col();
 
         self.reference_position.clear();
         self.reference_position.extend_from_slice(position);

@@ -71,9 +71,8 @@ pub struct World {
     /// Outputs of the contacts for their second partners: entry 0 is zero, chunk `c` writes
     /// its outputs from `1 + row_start` of its first particle on.
     pub(crate) pair_out: Vec<crate::forces::SecondOutput>,
-    /// For every neighbour pair, at its place in the transposed index (`col_pairs`, so that a
-    /// particle finds its entries side by side): index of its output in `pair_out` at the last
-    /// evaluation, or `NO_OUTPUT` (0).
+    /// For every neighbour pair: index of its output in `pair_out` at the last evaluation, or
+    /// `NO_OUTPUT` (0).
     pub(crate) pair_out_at: Vec<u32>,
     /// Force and torque on every particle from the pairs where it is the first partner (scratch).
     pub(crate) row_force: Vec<Vec3>,
