@@ -59,6 +59,8 @@ pub(crate) struct SecondOutput {
     force: Vec3,
     /// Torque on the second partner, N·m.
     torque: Vec3,
+    /// Second partner.
+    second: u32,
 }
 
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
@@ -89,9 +91,6 @@ fn account(
 }
 
 const CHUNK: usize = 1024;
-
-use crate::particles::kinetic_energy_j;
-use crate::world::ENERGY_BLOCK;
 
 /// A particle–particle contact that was active (touching, or within the adhesion range) at the
 /// last force evaluation: the partners `i < j` and the contact state.
@@ -254,8 +253,6 @@ impl World {
         self.pair_contact.clear();
         self.pair_contact
             .resize(if list_ok { nl.num_pairs() } else { 0 }, NO_CONTACT);
-        self.pair_out_at.clear();
-        self.pair_out_at.resize(self.pair_contact.len(), NO_OUTPUT);
         for k in contacts {
             let (i, j) = (k.i as usize, k.j as usize);
             if i >= n || j >= n {
@@ -304,10 +301,6 @@ fn prefetch_at(p: *const u8) {
 
 /// Marks a neighbour pair without an active contact in `pair_contact`.
 pub(crate) const NO_CONTACT: u32 = u32::MAX;
-
-/// Marks a neighbour pair without an output in `pair_out_at`: index of the zero entry that
-/// heads `pair_out` (the gather adds it without a branch).
-pub(crate) const NO_OUTPUT: u32 = 0;
 
 /// Particles per chunk of the particle–particle pass.
 pub(crate) const PP_CHUNK: usize = 256;
@@ -407,20 +400,19 @@ pub(crate) struct HmBatch {
     inp: Vec<HmInput>,
     st: Vec<HmState>,
     out: Vec<HmOutput>,
-    /// First partner, pair index within the chunk and slab slot of each contact.
+    /// First partner, second partner and slab slot of each contact.
     lane: Vec<(u32, u32, u32)>,
     len: usize,
 }
 
 impl HmBatch {
-    /// Adds the touching pair of first partner `i` (pair `qq` of the chunk) at distance
-    /// vector `d`, its contact in `slot`.
+    /// Adds the touching pair (`i`, `j`) at distance vector `d`, its contact in `slot`.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn push(
         &mut self,
         hm: &crate::interaction::HmConstants,
-        (i, qq): (usize, usize),
+        (i, j): (usize, usize),
         (ri, rj): (f64, f64),
         (ki, kj): (&Kin, &Kin),
         d: Vec3,
@@ -458,15 +450,14 @@ impl HmBatch {
         if self.len == self.lane.len() {
             self.lane.push((0, 0, 0));
         }
-        self.lane[self.len] = (i as u32, qq as u32, slot);
+        self.lane[self.len] = (i as u32, j as u32, slot);
         self.len += 1;
     }
 
     /// Evaluates the collected contacts and hands out their results in the order they were
     /// added: contact states into the slab, the first partner's force and torque added to
-    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po` (its place
-    /// `out_base + k` noted in `pa` of the pair), energies added to `sums` (normal and
-    /// tangential dissipation, stored energy).
+    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po`, energies
+    /// added to `sums` (normal and tangential dissipation, stored energy).
     #[allow(clippy::too_many_arguments)]
     fn flush(
         &mut self,
@@ -475,7 +466,7 @@ impl HmBatch {
         lo: usize,
         slab: &mut [SlabState],
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
-        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
+        po: &mut [SecondOutput],
         outs: &mut usize,
         sums: &mut (f64, f64, f64),
     ) {
@@ -496,7 +487,7 @@ impl HmBatch {
         {
             kernel(b, s, o, dt);
         }
-        for (e, &(i, qq, slot)) in self.lane[..m].iter().enumerate() {
+        for (e, &(i, j, slot)) in self.lane[..m].iter().enumerate() {
             let (s, o, k) = (&self.st[e / LANES], &self.out[e / LANES], e % LANES);
             let st = &mut slab[slot as usize].state;
             let h = &mut st.history;
@@ -520,8 +511,8 @@ impl HmBatch {
             po[*outs] = SecondOutput {
                 force,
                 torque: Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]),
+                second: j,
             };
-            pa[qq as usize] = out_base + *outs as u32;
             *outs += 1;
         }
         self.len = 0;
@@ -569,10 +560,9 @@ fn copy_lane(b: &mut HmInput, s: &mut HmState, from: usize, to: usize) {
 }
 
 impl PairContext<'_> {
-    /// The particle–particle contacts of one chunk of first partners: the second-partner
-    /// outputs are written to `po` in list order, and for every pair of the chunk `pa` holds
-    /// the index of its output in `pair_out` (`out_base` + place in `po`) or [`NO_OUTPUT`]; the
-    /// first partners' forces and torques go to `rf`/`rt`, the energies to `chunk.sums`.
+    /// The particle–particle contacts of one chunk of first partners: returns the number of
+    /// second-partner outputs written to `po`; the first partners' forces and torques go to
+    /// `rf`/`rt`, the energies to `chunk.sums`.
     ///
     /// Two passes. The scan tests every pair of the rows for contact (squared distance against
     /// the sum of the radii plus the adhesion range) without branching and keeps the pairs that
@@ -586,12 +576,12 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        out: (&mut [SecondOutput], &mut [u32], u32),
+        po: &mut [SecondOutput],
         rf: &mut [Vec3],
         rt: &mut [Vec3],
-    ) {
+    ) -> usize {
         PAIR_SCRATCH.with_borrow_mut(|scratch| {
-            self.chunk_pairs_with(rows, chunk, pc, out, (rf, rt), scratch)
+            self.chunk_pairs_with(rows, chunk, pc, po, (rf, rt), scratch)
         })
     }
 
@@ -601,10 +591,10 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        (po, pa, out_base): (&mut [SecondOutput], &mut [u32], u32),
+        po: &mut [SecondOutput],
         (rf, rt): (&mut [Vec3], &mut [Vec3]),
         scratch: &mut PairScratch,
-    ) {
+    ) -> usize {
         let (p, interactions, xr, kin, reach, dt) = (
             self.p,
             self.interactions,
@@ -702,7 +692,7 @@ impl PairContext<'_> {
                 };
                 batch.push(
                     hm,
-                    (i, qq),
+                    (i, j),
                     (ri0, rj),
                     (&kin[i], &kin[j]),
                     d,
@@ -716,16 +706,7 @@ impl PairContext<'_> {
                 continue;
             }
             if touching {
-                batch.flush(
-                    self.kernel,
-                    dt,
-                    lo,
-                    slab,
-                    (rf, rt),
-                    (po, pa, out_base),
-                    &mut outs,
-                    &mut acc,
-                );
+                batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
             }
             let s = if slot == NO_CONTACT {
                 alloc(slab, free, i, j)
@@ -744,25 +725,15 @@ impl PairContext<'_> {
                 po[outs] = SecondOutput {
                     force: out.force,
                     torque: out.torque_second,
+                    second: j as u32,
                 };
-                pa[qq] = out_base + outs as u32;
                 outs += 1;
             } else {
                 pc[qq] = NO_CONTACT;
-                pa[qq] = NO_OUTPUT;
                 free.push(s);
             }
         }
-        batch.flush(
-            self.kernel,
-            dt,
-            lo,
-            slab,
-            (rf, rt),
-            (po, pa, out_base),
-            &mut outs,
-            &mut acc,
-        );
+        batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
         // Contacts that left the neighbour list: close their work integral.
         for k in orphans.drain(..) {
             let (i, j) = (k.i as usize, k.j as usize);
@@ -774,6 +745,7 @@ impl PairContext<'_> {
             acc.1 += y;
         }
         *sums = acc;
+        outs
     }
 }
 
@@ -792,15 +764,10 @@ impl Kin {
     /// The packed state of particle `i`.
     #[inline]
     fn of(p: &crate::particles::ParticleSet, i: usize) -> Self {
-        Self::new(&p.velocity[i], p.mass[i], &p.angular_velocity[i])
-    }
-
-    /// Packs velocity `u`, mass `m` and angular velocity `w`.
-    #[inline(always)]
-    pub(crate) fn new(u: &Vec3, m: f64, w: &Vec3) -> Self {
+        let (u, w) = (p.velocity[i], p.angular_velocity[i]);
         Kin {
             v: [u.x, u.y, u.z],
-            m,
+            m: p.mass[i],
             w: [w.x, w.y, w.z],
             _pad: 0.0,
         }
@@ -848,25 +815,16 @@ impl World {
     /// state (0 for the initial evaluation): it integrates history variables and contact work.
     /// Returns the energy increments of this evaluation.
     pub(crate) fn evaluate_forces(&mut self, dt: f64) -> EnergyIncrements {
-        self.evaluate_forces_and_kick(dt, None)
-    }
-
-    /// [`World::evaluate_forces`]; with `kick = Some(h)` the pass that sums each particle's
-    /// forces also advances its velocities by the half step `h` (velocity Verlet's second
-    /// half-kick) and sums the kinetic and potential energy after it into the ledger, in blocks
-    /// of [`ENERGY_BLOCK`] particles added in order (as [`World::refresh_state_energies`]).
-    pub(crate) fn evaluate_forces_and_kick(
-        &mut self,
-        dt: f64,
-        kick: Option<f64>,
-    ) -> EnergyIncrements {
         let t_pairs = self.tick();
         let World {
             particles: p,
             interactions,
             neighbors,
             pair_out,
-            pair_out_at,
+            out_count,
+            second_start,
+            second_list,
+            scratch_fill: fill,
             row_force,
             row_torque,
             pair_contact,
@@ -880,11 +838,6 @@ impl World {
             wall_skip,
             scratch_xr: xr,
             scratch_kin: kin,
-            packed_fresh,
-            scratch_velocity: vel_out,
-            scratch_angular_velocity: ang_out,
-            scratch_energy: energy_out,
-            scratch_wall_loads: wall_loads,
             ..
         } = self;
         let p = &*p;
@@ -898,9 +851,8 @@ impl World {
         //    chunk's slab (history updated in place); a contact that ended closes its work
         //    integral and frees its slot. The first partner's force and torque are summed here;
         //    the second partner's share goes to the chunk's output list (`pair_out`, written
-        //    sequentially), and the pair notes where (`pair_out_at`). The second partner gathers
-        //    its shares through the list's transposed index (pairs by second partner, the first
-        //    partner ascending): a fixed order, whatever the thread count.
+        //    sequentially), which a counting sort by second partner then indexes for the gather
+        //    (fixed order, the first partner ascending: thread-count independent).
         let nchunks = n.div_ceil(PP_CHUNK);
         let m = nl.num_pairs();
         if pp_chunks.len() != nchunks || pair_contact.len() != m {
@@ -918,68 +870,57 @@ impl World {
             pp_chunks.resize_with(nchunks, PpChunk::default);
             pair_contact.clear();
             pair_contact.resize(m, NO_CONTACT);
-            pair_out_at.clear();
-            pair_out_at.resize(m, NO_OUTPUT);
             for k in all {
                 pp_chunks[k.i as usize / PP_CHUNK].orphans.push(k);
             }
         }
-        // Every chunk writes the outputs of its contacts densely from the start of its pair
-        // range; entry 0 stays zero (the output of pairs without a contact).
-        pair_out.resize(m + 1, SecondOutput::default());
-        if pair_out_at.len() != m {
-            // Only reached with a list whose contacts were never attached (no outputs yet).
-            pair_out_at.clear();
-            pair_out_at.resize(m, NO_OUTPUT);
-        }
+        // Every chunk writes the outputs of its contacts densely from the start of its pair range.
+        pair_out.resize(m, SecondOutput::default());
+        out_count.resize(nchunks, 0);
         row_force.resize(n, Vec3::zeros());
         row_torque.resize(n, Vec3::zeros());
         let reach = nl.extra_range_m;
         // Positions and radii packed together: one load per partner in the pair loop.
         // Velocities, masses and spins packed likewise: one cache line per contact partner.
-        if !std::mem::take(packed_fresh) || xr.len() != n || kin.len() != n {
-            xr.resize(n, [0.0; 4]);
-            kin.resize(n, Kin::default());
-            xr.par_chunks_mut(CHUNK)
-                .zip(kin.par_chunks_mut(CHUNK))
-                .enumerate()
-                .for_each(|(c, (out, kout))| {
-                    for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
-                        let i = c * CHUNK + k;
-                        let x = p.position[i];
-                        *v = [x.x, x.y, x.z, p.radius[i]];
-                        *kv = Kin::of(p, i);
-                    }
-                });
-        }
+        xr.resize(n, [0.0; 4]);
+        kin.resize(n, Kin::default());
+        xr.par_chunks_mut(CHUNK)
+            .zip(kin.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (out, kout))| {
+                for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
+                    let i = c * CHUNK + k;
+                    let x = p.position[i];
+                    *v = [x.x, x.y, x.z, p.radius[i]];
+                    *kv = Kin::of(p, i);
+                }
+            });
         let xr = &*xr;
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
         let kernel = crate::hm_block::kernel();
         {
             // Disjoint slices per chunk: pairs of its rows, and its particles.
-            type ChunkSlices<'a> = (&'a mut [u32], &'a mut [SecondOutput], &'a mut [u32]);
-            let mut pcs: Vec<ChunkSlices> = Vec::with_capacity(nchunks);
-            let (mut rest_c, mut rest_o, mut rest_a): ChunkSlices =
-                (pair_contact, &mut pair_out[1..], pair_out_at);
+            let mut pcs: Vec<(&mut [u32], &mut [SecondOutput])> = Vec::with_capacity(nchunks);
+            let (mut rest_c, mut rest_o): (&mut [u32], &mut [SecondOutput]) =
+                (pair_contact, pair_out);
             for c in 0..nchunks {
                 let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
                 let len = (nl.row_start[hi] - nl.row_start[lo]) as usize;
                 let (a, b) = rest_c.split_at_mut(len);
                 let (x, y) = rest_o.split_at_mut(len);
-                let (u, w) = rest_a.split_at_mut(len);
-                pcs.push((a, x, u));
+                pcs.push((a, x));
                 rest_c = b;
                 rest_o = y;
-                rest_a = w;
             }
             pp_chunks
                 .par_iter_mut()
                 .zip(pcs.into_par_iter())
                 .zip(row_force.par_chunks_mut(PP_CHUNK))
                 .zip(row_torque.par_chunks_mut(PP_CHUNK))
+                .zip(out_count.par_iter_mut())
                 .enumerate()
-                .for_each(|(c, (((chunk, (pc, po, pa)), rf), rt))| {
+                .for_each(|(c, ((((chunk, (pc, po)), rf), rt), count))| {
                     let lo = c * PP_CHUNK;
                     let hi = ((c + 1) * PP_CHUNK).min(n);
                     let rows = PairRows {
@@ -999,9 +940,34 @@ impl World {
                         dt,
                         kernel,
                     };
-                    let out_base = 1 + rows.q0 as u32;
-                    ctx.chunk_pairs(&rows, chunk, pc, (po, pa, out_base), rf, rt);
+                    *count = ctx.chunk_pairs(&rows, chunk, pc, po, rf, rt) as u32;
                 });
+        }
+        // Counting sort of the outputs by second partner. For one particle its entries follow
+        // the chunks and, within a chunk, the pair loop: the first partner ascending (the order
+        // of the transposed neighbour index), whatever the thread count.
+        second_start.clear();
+        second_start.resize(n + 1, 0);
+        for (c, &cnt) in out_count.iter().enumerate() {
+            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
+            for o in &pair_out[base..base + cnt as usize] {
+                second_start[o.second as usize + 1] += 1;
+            }
+        }
+        for k in 0..n {
+            second_start[k + 1] += second_start[k];
+        }
+        let total = second_start[n] as usize;
+        second_list.resize(total, 0);
+        fill.clear();
+        fill.extend_from_slice(&second_start[..n]);
+        for (c, &cnt) in out_count.iter().enumerate() {
+            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
+            for (k, o) in pair_out[base..base + cnt as usize].iter().enumerate() {
+                let f = &mut fill[o.second as usize];
+                second_list[*f as usize] = (base + k) as u32;
+                *f += 1;
+            }
         }
         let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
 
@@ -1025,8 +991,8 @@ impl World {
         let wall_candidate = &*wall_candidate;
         let bodies_ref = &*bodies;
         let pair_out = &*pair_out;
-        let pair_out_at = &*pair_out_at;
-        let (col_start, col_pairs) = (&nl.col_start, &nl.col_pairs);
+        let second_start = &*second_start;
+        let second_list = &*second_list;
         let rows_f = &*row_force;
         let rows_t = &*row_torque;
         let g = *gravity_m_s2;
@@ -1034,21 +1000,10 @@ impl World {
         let mut torque = std::mem::take(&mut self.scratch_torque);
         force.resize(n, Vec3::zeros());
         torque.resize(n, Vec3::zeros());
-        vel_out.resize(n, Vec3::zeros());
-        ang_out.resize(n, Vec3::zeros());
-        energy_out.clear();
-        energy_out.resize(n.div_ceil(ENERGY_BLOCK), [0.0; 2]);
-        wall_loads.resize_with(n.div_ceil(ENERGY_BLOCK), Vec::new);
-        // Blocks of ENERGY_BLOCK particles; the energy increments are kept per CHUNK within a
-        // block and added in order (the sums do not depend on the block size).
-        const SUB: usize = ENERGY_BLOCK / CHUNK;
-        let pw: Vec<[EnergyIncrements; SUB]> = force
-            .par_chunks_mut(ENERGY_BLOCK)
-            .zip(torque.par_chunks_mut(ENERGY_BLOCK))
-            .zip(wall_slots.par_chunks_mut(ENERGY_BLOCK))
-            .zip(vel_out.par_chunks_mut(ENERGY_BLOCK))
-            .zip(ang_out.par_chunks_mut(ENERGY_BLOCK))
-            .zip(energy_out.par_iter_mut().zip(wall_loads.par_iter_mut()))
+        let pw: Vec<EnergyIncrements> = force
+            .par_chunks_mut(CHUNK)
+            .zip(torque.par_chunks_mut(CHUNK))
+            .zip(wall_slots.par_chunks_mut(CHUNK))
             .enumerate()
             .map_init(
                 || {
@@ -1057,68 +1012,48 @@ impl World {
                         Vec::<WallSlot>::with_capacity(16),
                     )
                 },
-                |(contacts, fresh), (c, (((((fs, ts), slots), vs), ws), (e_out, loads)))| {
-                    let mut incs = [EnergyIncrements::default(); SUB];
-                    loads.clear();
-                    let (mut kinetic, mut pot) = (0.0, 0.0);
-                    for (k, ((((f_out, t_out), slot_list), v_out), w_out)) in fs
+                |(contacts, fresh), (c, ((fs, ts), slots))| {
+                    let mut inc = EnergyIncrements::default();
+                    for (k, ((f_out, t_out), slot_list)) in fs
                         .iter_mut()
                         .zip(ts.iter_mut())
                         .zip(slots.iter_mut())
-                        .zip(vs.iter_mut())
-                        .zip(ws.iter_mut())
                         .enumerate()
                     {
-                        let i = c * ENERGY_BLOCK + k;
-                        let inc = &mut incs[k / CHUNK];
+                        let i = c * CHUNK + k;
                         let mut f = g * p.mass[i] + p.external_force[i] + rows_f[i];
                         let mut t = rows_t[i];
                         inc.external_work_j += p.external_force[i].dot(&p.velocity[i]) * dt;
-                        // Contacts where `i` is the second partner, in neighbour-list order (pairs
-                        // without one add the zero entry).
-                        let range = col_start[i] as usize..col_start[i + 1] as usize;
-                        for &q in &col_pairs[range] {
-                            let o = &pair_out[pair_out_at[q as usize] as usize];
+                        // Contacts where `i` is the second partner, in neighbour-list order.
+                        let range = second_start[i] as usize..second_start[i + 1] as usize;
+                        for &g in &second_list[range] {
+                            let o = &pair_out[g as usize];
                             f -= o.force;
                             t += o.torque;
                         }
-                        if wall_candidate[i] || !slot_list.is_empty() {
-                            wall_contacts_of(
-                                i,
-                                p,
-                                interactions,
-                                bodies_ref,
-                                &body_step,
-                                dt,
-                                slot_list,
-                                contacts,
-                                fresh,
-                                &mut f,
-                                &mut t,
-                                inc,
-                            );
-                            // This particle's loads on the bodies, in slot order.
-                            for s in slot_list.iter() {
-                                let b = &bodies_ref[s.body as usize];
-                                let torque = (s.point - b.state.position_m).cross(&(-s.force))
-                                    - s.rolling_torque;
-                                loads.push((s.body, s.force, torque));
-                            }
+                        if !wall_candidate[i] && slot_list.is_empty() {
+                            *f_out = f;
+                            *t_out = t;
+                            continue;
                         }
+                        wall_contacts_of(
+                            i,
+                            p,
+                            interactions,
+                            bodies_ref,
+                            &body_step,
+                            dt,
+                            slot_list,
+                            contacts,
+                            fresh,
+                            &mut f,
+                            &mut t,
+                            &mut inc,
+                        );
                         *f_out = f;
                         *t_out = t;
-                        if let Some(half) = kick {
-                            let (m, ii) = (p.mass[i], p.inv_inertia[i]);
-                            let v = p.velocity[i] + f * (half / m);
-                            let w = p.angular_velocity[i] + t * (half * ii);
-                            kinetic += kinetic_energy_j(m, &v, &w, ii);
-                            pot += m * g.dot(&p.position[i]);
-                            *v_out = v;
-                            *w_out = w;
-                        }
                     }
-                    *e_out = [kinetic, pot];
-                    incs
+                    inc
                 },
             )
             .collect();
@@ -1127,14 +1062,6 @@ impl World {
         std::mem::swap(&mut self.particles.torque, &mut torque);
         self.scratch_force = force;
         self.scratch_torque = torque;
-        if kick.is_some() {
-            std::mem::swap(&mut self.particles.velocity, &mut self.scratch_velocity);
-            std::mem::swap(
-                &mut self.particles.angular_velocity,
-                &mut self.scratch_angular_velocity,
-            );
-            self.set_state_energies_from_blocks();
-        }
 
         self.tock(t_particles, |p| &mut p.particle_forces_s);
         let t_loads = self.tick();
@@ -1143,10 +1070,13 @@ impl World {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
         }
-        for &(body, force, torque) in self.scratch_wall_loads.iter().flatten() {
-            let b = &mut self.bodies[body as usize];
-            b.contact_force_n -= force;
-            b.contact_torque_nm += torque;
+        for slots in &self.wall_slots {
+            for s in slots {
+                let b = &mut self.bodies[s.body as usize];
+                b.contact_force_n -= s.force;
+                b.contact_torque_nm +=
+                    (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
+            }
         }
 
         let mut inc = EnergyIncrements::default();
@@ -1155,8 +1085,8 @@ impl World {
             inc.dissipated_tangential_pp_j += dtan;
             inc.elastic_j += el;
         }
-        for w in pw.iter().flatten() {
-            inc += *w;
+        for w in pw {
+            inc += w;
         }
         self.tock(t_loads, |p| &mut p.energies_s);
         inc
@@ -1410,10 +1340,9 @@ mod tests {
     ) -> (PairEval, f64, f64, f64) {
         let mut slab = vec![SlabState { state: *st }];
         let mut batch = HmBatch::default();
-        batch.push(hm, (0, 0), radii, kin, d, st, 0);
+        batch.push(hm, (0, 1), radii, kin, d, st, 0);
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
         let mut po = vec![SecondOutput::default(); 1];
-        let mut pa = vec![NO_OUTPUT; 1];
         let (mut outs, mut sums) = (0, (0.0, 0.0, 0.0));
         let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
         batch.flush(
@@ -1422,12 +1351,11 @@ mod tests {
             0,
             &mut slab,
             (&mut rf, &mut rt),
-            (&mut po, &mut pa, 7),
+            &mut po,
             &mut outs,
             &mut sums,
         );
         assert_eq!(outs, 1);
-        assert_eq!(pa[0], 7, "the pair notes where its output went");
         *st = slab[0].state;
         let eval = PairEval {
             force: rf[0],

@@ -2,9 +2,8 @@
 //! step-size controller of Meyer & Seifried [D Sect. 2.5, Eq. 2.95–2.106, Tab. 2.2/2.3].
 
 use crate::energy::EnergyIncrements;
-use crate::forces::{Kin, PpContact, WallSlot};
+use crate::forces::{PpContact, WallSlot};
 use crate::math::Vec3;
-use crate::neighbor::{merge_top_two, top_two};
 use crate::world::World;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -51,9 +50,6 @@ pub enum Integrator {
     Gear(GearParams),
 }
 
-/// Particles per task of the drift pass.
-const DRIFT_CHUNK: usize = 4096;
-
 /// Gear corrector coefficients for order p = 5 [D Tab. 2.2].
 const GEAR5: [f64; 5] = [19.0 / 90.0, 3.0 / 4.0, 1.0, 1.0 / 2.0, 1.0 / 12.0];
 
@@ -73,67 +69,41 @@ pub struct GearState {
 }
 
 impl World {
-    /// One velocity-Verlet step. The first half-kick and the drift are one pass over the
-    /// particles, which also packs the state for the pair loop and measures the displacements
-    /// for the neighbour-list criterion; the second half-kick (and the kinetic and potential
-    /// energy after it) is done by the force evaluation's per-particle pass
-    /// ([`World::evaluate_forces_and_kick`]).
     pub(crate) fn step_velocity_verlet(&mut self) -> EnergyIncrements {
         let dt = self.dt_s;
         let t = self.tick();
+        let p = &mut self.particles;
         let half = 0.5 * dt;
-        let n = self.particles.len();
-        let World {
-            particles: p,
-            neighbors,
-            scratch_xr: xr,
-            scratch_kin: kin,
-            ..
-        } = self;
-        xr.resize(n, [0.0; 4]);
-        kin.resize(n, Kin::default());
-        let reference = &neighbors.reference_position;
-        let measure = reference.len() == n;
-        let top = p
-            .position
-            .par_chunks_mut(DRIFT_CHUNK)
-            .zip(p.velocity.par_chunks_mut(DRIFT_CHUNK))
-            .zip(p.angular_velocity.par_chunks_mut(DRIFT_CHUNK))
-            .zip(xr.par_chunks_mut(DRIFT_CHUNK))
-            .zip(kin.par_chunks_mut(DRIFT_CHUNK))
-            .enumerate()
-            .map(|(c, ((((xs, vs), ws), xrs), ks))| {
-                let lo = c * DRIFT_CHUNK;
-                let mut top = (0.0f64, 0.0f64);
-                for (k, ((((x, v), w), xr), kv)) in xs
-                    .iter_mut()
-                    .zip(vs.iter_mut())
-                    .zip(ws.iter_mut())
-                    .zip(xrs.iter_mut())
-                    .zip(ks.iter_mut())
-                    .enumerate()
-                {
-                    let i = lo + k;
-                    let m = p.mass[i];
-                    *v += p.force[i] * (half / m);
-                    *w += p.torque[i] * (half * p.inv_inertia[i]);
-                    *x += *v * dt;
-                    *xr = [x.x, x.y, x.z, p.radius[i]];
-                    *kv = Kin::new(v, m, w);
-                    if measure {
-                        top = top_two(top, (*x - reference[i]).norm_squared());
-                    }
-                }
-                top
-            })
-            .reduce(|| (0.0, 0.0), merge_top_two);
-        self.packed_fresh = true;
-        self.drift_displacement = measure.then_some(top);
+        p.position
+            .par_iter_mut()
+            .zip(p.velocity.par_iter_mut())
+            .zip(p.angular_velocity.par_iter_mut())
+            .zip(p.force.par_iter())
+            .zip(p.torque.par_iter())
+            .zip(p.mass.par_iter().zip(p.inv_inertia.par_iter()))
+            .for_each(|(((((x, v), w), f), t), (m, ii))| {
+                *v += f * (half / m);
+                *w += t * (half * ii);
+                *x += *v * dt;
+            });
         self.advance_bodies(dt);
         self.tock(t, |p| &mut p.integrate_s);
         self.update_neighbors();
-        let inc = self.evaluate_forces_and_kick(dt, Some(half));
+        let inc = self.evaluate_forces(dt);
         self.counters.force_evaluations += 1;
+        let t = self.tick();
+        let p = &mut self.particles;
+        p.velocity
+            .par_iter_mut()
+            .zip(p.angular_velocity.par_iter_mut())
+            .zip(p.force.par_iter())
+            .zip(p.torque.par_iter())
+            .zip(p.mass.par_iter().zip(p.inv_inertia.par_iter()))
+            .for_each(|((((v, w), f), t), (m, ii))| {
+                *v += f * (half / m);
+                *w += t * (half * ii);
+            });
+        self.tock(t, |p| &mut p.integrate_s);
         inc
     }
 

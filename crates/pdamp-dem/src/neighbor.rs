@@ -54,22 +54,31 @@ impl NeighborList {
         if self.reference_position.len() != position.len() || self.builds == 0 {
             return true;
         }
-        let top = position
+        let (a, b) = position
             .par_iter()
             .zip(self.reference_position.par_iter())
             .map(|(x, x0)| (x - x0).norm_squared())
-            .fold(|| (0.0f64, 0.0f64), top_two)
-            .reduce(|| (0.0, 0.0), merge_top_two);
-        self.needs_rebuild_after(position.len(), top)
-    }
-
-    /// [`Self::needs_rebuild`] for `n` particles whose two largest squared displacements since
-    /// the last build are known (`top`, m², as [`top_two`] collects them).
-    pub fn needs_rebuild_after(&self, n: usize, top: (f64, f64)) -> bool {
-        if self.reference_position.len() != n || self.builds == 0 {
-            return true;
-        }
-        top.0.sqrt() + top.1.sqrt() >= self.skin_m
+            .fold(
+                || (0.0f64, 0.0f64),
+                |(a, b), d| {
+                    if d > a {
+                        (d, a)
+                    } else if d > b {
+                        (a, d)
+                    } else {
+                        (a, b)
+                    }
+                },
+            )
+            .reduce(
+                || (0.0, 0.0),
+                |(a1, b1), (a2, b2)| {
+                    let mut v = [a1, b1, a2, b2];
+                    v.sort_by(|x, y| y.total_cmp(x));
+                    (v[0], v[1])
+                },
+            );
+        a.sqrt() + b.sqrt() >= self.skin_m
     }
 
     /// Rebuilds the list with a cell grid. (Contact history is not stored here: the world keeps
@@ -148,25 +157,6 @@ impl NeighborList {
         self.reference_position.extend_from_slice(position);
         self.builds += 1;
     }
-}
-
-/// Keeps the two largest of a running maximum pair `(a ≥ b)` and `d`.
-#[inline(always)]
-pub fn top_two((a, b): (f64, f64), d: f64) -> (f64, f64) {
-    if d > a {
-        (d, a)
-    } else if d > b {
-        (a, d)
-    } else {
-        (a, b)
-    }
-}
-
-/// The two largest of two pairs from [`top_two`].
-pub fn merge_top_two((a1, b1): (f64, f64), (a2, b2): (f64, f64)) -> (f64, f64) {
-    let mut v = [a1, b1, a2, b2];
-    v.sort_by(|x, y| y.total_cmp(x));
-    (v[0], v[1])
 }
 
 /// A uniform grid of cubic cells over the bounding box of the particles (counting-sorted).

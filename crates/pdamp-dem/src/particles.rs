@@ -91,12 +91,8 @@ impl ParticleSet {
     pub fn kinetic_energy(&self) -> f64 {
         (0..self.len())
             .map(|i| {
-                kinetic_energy_j(
-                    self.mass[i],
-                    &self.velocity[i],
-                    &self.angular_velocity[i],
-                    self.inv_inertia[i],
-                )
+                0.5 * self.mass[i] * self.velocity[i].norm_squared()
+                    + 0.5 * self.angular_velocity[i].norm_squared() / self.inv_inertia[i]
             })
             .sum()
     }
@@ -116,10 +112,4 @@ impl ParticleSet {
             .sum::<Vec3>()
             / m
     }
-}
-
-/// Kinetic energy of one sphere, J: $\tfrac12 m |v|^2 + \tfrac12 |\omega|^2 / I^{-1}$.
-#[inline(always)]
-pub(crate) fn kinetic_energy_j(mass: f64, v: &Vec3, w: &Vec3, inv_inertia: f64) -> f64 {
-    0.5 * mass * v.norm_squared() + 0.5 * w.norm_squared() / inv_inertia
 }

@@ -68,12 +68,15 @@ pub struct World {
     /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    /// Outputs of the contacts for their second partners: entry 0 is zero, chunk `c` writes
-    /// its outputs from `1 + row_start` of its first particle on.
+    /// Outputs of the contacts for their second partners: chunk `c` writes `out_count[c]`
+    /// entries from the start of its pair range (`row_start` of its first particle).
     pub(crate) pair_out: Vec<crate::forces::SecondOutput>,
-    /// For every neighbour pair: index of its output in `pair_out` at the last evaluation, or
-    /// `NO_OUTPUT` (0).
-    pub(crate) pair_out_at: Vec<u32>,
+    pub(crate) out_count: Vec<u32>,
+    /// Counting sort of `pair_out` by second partner: entries of particle `j` are
+    /// `second_list[second_start[j]..second_start[j + 1]]`.
+    pub(crate) second_start: Vec<u32>,
+    pub(crate) second_list: Vec<u32>,
+    pub(crate) scratch_fill: Vec<u32>,
     /// Force and torque on every particle from the pairs where it is the first partner (scratch).
     pub(crate) row_force: Vec<Vec3>,
     pub(crate) row_torque: Vec<Vec3>,
@@ -101,26 +104,10 @@ pub struct World {
     pub(crate) scratch_xr: Vec<[f64; 4]>,
     /// Velocities, masses and spins packed per particle for the pair loop (scratch).
     pub(crate) scratch_kin: Vec<crate::forces::Kin>,
-    /// `scratch_xr` and `scratch_kin` hold the current state (written by the integrator's drift
-    /// pass; the next force evaluation uses them instead of packing again).
-    pub(crate) packed_fresh: bool,
-    /// The two largest squared displacements since the last neighbour-list build, m², when the
-    /// integrator's drift pass has just measured them.
-    pub(crate) drift_displacement: Option<(f64, f64)>,
     pub(crate) scratch_torque: Vec<Vec3>,
-    /// Velocities and spins after the second half-kick (scratch, swapped in).
-    pub(crate) scratch_velocity: Vec<Vec3>,
-    pub(crate) scratch_angular_velocity: Vec<Vec3>,
-    /// Per block of particles: body, force on the particle and torque on the body of each wall
-    /// contact, in particle order (scratch of the force evaluation).
-    pub(crate) scratch_wall_loads: Vec<Vec<(u16, Vec3, Vec3)>>,
     pub(crate) gear: Option<GearState>,
     pub(crate) initialized: bool,
 }
-
-/// Particles per block of the kinetic/potential energy sums (fixed: the result does not depend
-/// on the thread count).
-pub(crate) const ENERGY_BLOCK: usize = 2048;
 
 impl World {
     /// A world with the given materials; every material pair uses `default_model` until
@@ -141,7 +128,10 @@ impl World {
             profile: None,
             neighbors: NeighborList::new(0.0),
             pair_out: Vec::new(),
-            pair_out_at: Vec::new(),
+            out_count: Vec::new(),
+            second_start: Vec::new(),
+            second_list: Vec::new(),
+            scratch_fill: Vec::new(),
             row_force: Vec::new(),
             row_torque: Vec::new(),
             pair_contact: Vec::new(),
@@ -156,11 +146,6 @@ impl World {
             scratch_energy: Vec::new(),
             scratch_xr: Vec::new(),
             scratch_kin: Vec::new(),
-            scratch_velocity: Vec::new(),
-            scratch_angular_velocity: Vec::new(),
-            scratch_wall_loads: Vec::new(),
-            packed_fresh: false,
-            drift_displacement: None,
             scratch_torque: Vec::new(),
             gear: None,
             initialized: false,
@@ -382,14 +367,7 @@ impl World {
     }
 
     fn update_neighbors_untimed(&mut self) {
-        let rebuild = match self.drift_displacement.take() {
-            Some(top) => self
-                .neighbors
-                .needs_rebuild_after(self.particles.len(), top),
-            None => self.neighbors.needs_rebuild(&self.particles.position),
-        };
-        if rebuild {
-            // The packed state stays valid: a rebuild moves no particle.
+        if self.neighbors.needs_rebuild(&self.particles.position) {
             // Contacts are attached to the pairs of the list: take them off, rebuild, put them
             // back onto the new pairs (in (i, j) order, which also compacts the slabs).
             let mut contacts = std::mem::take(&mut self.remap_scratch);
@@ -407,32 +385,24 @@ impl World {
     pub(crate) fn refresh_state_energies(&mut self) {
         // In parallel over blocks of particles, the blocks added in order (the result does not
         // depend on the thread count).
+        const BLOCK: usize = 2048;
         let p = &self.particles;
         let g = self.gravity_m_s2;
         let sums = &mut self.scratch_energy;
         sums.clear();
-        sums.resize(p.len().div_ceil(ENERGY_BLOCK), [0.0; 2]);
+        sums.resize(p.len().div_ceil(BLOCK), [0.0; 2]);
         sums.par_iter_mut().enumerate().for_each(|(b, e)| {
-            let r = b * ENERGY_BLOCK..((b + 1) * ENERGY_BLOCK).min(p.len());
+            let r = b * BLOCK..((b + 1) * BLOCK).min(p.len());
             let (mut kin, mut pot) = (0.0, 0.0);
             for i in r {
-                kin += crate::particles::kinetic_energy_j(
-                    p.mass[i],
-                    &p.velocity[i],
-                    &p.angular_velocity[i],
-                    p.inv_inertia[i],
-                );
+                kin += 0.5 * p.mass[i] * p.velocity[i].norm_squared()
+                    + 0.5 * p.angular_velocity[i].norm_squared() / p.inv_inertia[i];
                 pot += p.mass[i] * g.dot(&p.position[i]);
             }
             *e = [kin, pot];
         });
-        self.set_state_energies_from_blocks();
-    }
-
-    /// Sums the per-block kinetic and potential energies of `scratch_energy` into the ledger.
-    pub(crate) fn set_state_energies_from_blocks(&mut self) {
         let (mut kin, mut pot) = (0.0, 0.0);
-        for e in self.scratch_energy.iter() {
+        for e in sums.iter() {
             kin += e[0];
             pot += e[1];
         }
@@ -446,18 +416,12 @@ impl World {
             self.initialize();
         }
         let inc: EnergyIncrements = match self.integrator.clone() {
-            // Kinetic and potential energy are summed by the integrator's last pass.
             Integrator::VelocityVerlet => self.step_velocity_verlet(),
-            Integrator::Gear(params) => {
-                let inc = self.step_gear(&params);
-                let t = self.tick();
-                self.refresh_state_energies();
-                self.tock(t, |p| &mut p.energies_s);
-                inc
-            }
+            Integrator::Gear(params) => self.step_gear(&params),
         };
         let t = self.tick();
         self.ledger.add(&inc);
+        self.refresh_state_energies();
         self.tock(t, |p| &mut p.energies_s);
         self.counters.steps += 1;
     }
