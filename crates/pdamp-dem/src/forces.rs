@@ -189,6 +189,26 @@ impl PpChunk {
 }
 
 impl World {
+    /// Adds the particles that hold wall contacts but are missing from the wall pass's list
+    /// (after wall contacts were restored from a backup); keeps the list ascending.
+    pub(crate) fn include_wall_holders(&mut self) {
+        let list = &self.wall_list;
+        let mut k = 0;
+        let mut missing = Vec::new();
+        for (i, s) in self.wall_slots.iter().enumerate() {
+            while k < list.len() && (list[k] as usize) < i {
+                k += 1;
+            }
+            if !s.is_empty() && list.get(k) != Some(&(i as u32)) {
+                missing.push(i as u32);
+            }
+        }
+        if !missing.is_empty() {
+            self.wall_list.extend(missing);
+            self.wall_list.sort_unstable();
+        }
+    }
+
     /// All active particle–particle contacts, sorted by `(i, j)`, appended to `out` (those of
     /// partners that no longer exist are dropped).
     pub(crate) fn collect_pp_contacts(&self, out: &mut Vec<PpContact>) {
@@ -455,19 +475,15 @@ impl HmBatch {
     }
 
     /// Evaluates the collected contacts and hands out their results in the order they were
-    /// added: contact states into the slab, the first partner's force and torque added to
-    /// `rf`/`rt` (index `i − lo`), the second partner's share appended to `po`, energies
-    /// added to `sums` (normal and tangential dissipation, stored energy).
+    /// added: contact states into the slab, forces and torques to both partners through `acc`,
+    /// energies added to `sums` (normal and tangential dissipation, stored energy).
     #[allow(clippy::too_many_arguments)]
     fn flush(
         &mut self,
         kernel: crate::hm_block::Kernel,
         dt: f64,
-        lo: usize,
         slab: &mut [SlabState],
-        (rf, rt): (&mut [Vec3], &mut [Vec3]),
-        po: &mut [SecondOutput],
-        outs: &mut usize,
+        acc: &mut BlockAcc,
         sums: &mut (f64, f64, f64),
     ) {
         let m = self.len;
@@ -505,15 +521,8 @@ impl HmBatch {
             sums.1 += o.dt[k];
             sums.2 += o.el[k];
             let force = Vec3::new(o.fx[k], o.fy[k], o.fz[k]);
-            let a = i as usize - lo;
-            rf[a] += force;
-            rt[a] += Vec3::new(o.tix[k], o.tiy[k], o.tiz[k]);
-            po[*outs] = SecondOutput {
-                force,
-                torque: Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]),
-                second: j,
-            };
-            *outs += 1;
+            acc.first(i as usize, force, Vec3::new(o.tix[k], o.tiy[k], o.tiz[k]));
+            acc.second(j as usize, force, Vec3::new(o.tjx[k], o.tjy[k], o.tjz[k]));
         }
         self.len = 0;
     }
@@ -576,25 +585,9 @@ impl PairContext<'_> {
         rows: &PairRows,
         chunk: &mut PpChunk,
         pc: &mut [u32],
-        po: &mut [SecondOutput],
-        rf: &mut [Vec3],
-        rt: &mut [Vec3],
-    ) -> usize {
-        PAIR_SCRATCH.with_borrow_mut(|scratch| {
-            self.chunk_pairs_with(rows, chunk, pc, po, (rf, rt), scratch)
-        })
-    }
-
-    /// [`Self::chunk_pairs`] with the thread's scratch.
-    fn chunk_pairs_with(
-        &self,
-        rows: &PairRows,
-        chunk: &mut PpChunk,
-        pc: &mut [u32],
-        po: &mut [SecondOutput],
-        (rf, rt): (&mut [Vec3], &mut [Vec3]),
+        acc: &mut BlockAcc,
         scratch: &mut PairScratch,
-    ) -> usize {
+    ) {
         let (p, interactions, xr, kin, reach, dt) = (
             self.p,
             self.interactions,
@@ -641,10 +634,7 @@ impl PairContext<'_> {
             }
         }
         // 2. Contacts, in list order.
-        rf.iter_mut().for_each(|f| *f = Vec3::zeros());
-        rt.iter_mut().for_each(|t| *t = Vec3::zeros());
-        let mut outs = 0usize;
-        let mut acc = (0.0, 0.0, 0.0);
+        let mut sum = (0.0, 0.0, 0.0);
         let mut alloc = |slab: &mut Vec<SlabState>, free: &mut Vec<u32>, i: usize, j: usize| {
             let k = PpContact {
                 i: i as u32,
@@ -706,7 +696,7 @@ impl PairContext<'_> {
                 continue;
             }
             if touching {
-                batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+                batch.flush(self.kernel, dt, slab, acc, &mut sum);
             }
             let s = if slot == NO_CONTACT {
                 alloc(slab, free, i, j)
@@ -715,25 +705,19 @@ impl PairContext<'_> {
             };
             let st = &mut slab[s as usize].state;
             let (out, x, y, en) = evaluate_pair(p, interactions, i, j, d, dist, touching, st, dt);
-            acc.0 += x;
-            acc.1 += y;
-            acc.2 += en;
+            sum.0 += x;
+            sum.1 += y;
+            sum.2 += en;
             if touching {
                 pc[qq] = s;
-                rf[i - lo] += out.force;
-                rt[i - lo] += out.torque_first;
-                po[outs] = SecondOutput {
-                    force: out.force,
-                    torque: out.torque_second,
-                    second: j as u32,
-                };
-                outs += 1;
+                acc.first(i, out.force, out.torque_first);
+                acc.second(j, out.force, out.torque_second);
             } else {
                 pc[qq] = NO_CONTACT;
                 free.push(s);
             }
         }
-        batch.flush(self.kernel, dt, lo, slab, (rf, rt), po, &mut outs, &mut acc);
+        batch.flush(self.kernel, dt, slab, acc, &mut sum);
         // Contacts that left the neighbour list: close their work integral.
         for k in orphans.drain(..) {
             let (i, j) = (k.i as usize, k.j as usize);
@@ -741,13 +725,121 @@ impl PairContext<'_> {
             let mut st = k.state;
             let (_, x, y, _) =
                 evaluate_pair(p, interactions, i, j, d, d.norm(), false, &mut st, dt);
-            acc.0 += x;
-            acc.1 += y;
+            sum.0 += x;
+            sum.1 += y;
         }
-        *sums = acc;
-        outs
+        *sums = sum;
     }
 }
+
+/// Where the pair pass of one block sums forces and torques: directly into the block's own
+/// particles `lo..hi`, and for a second partner in a later block into that block's list.
+pub(crate) struct BlockAcc<'a> {
+    lo: usize,
+    hi: usize,
+    force: &'a mut [Vec3],
+    torque: &'a mut [Vec3],
+    /// Outgoing lists of this block, by target block.
+    cross: &'a mut [Vec<SecondOutput>],
+    /// Block of every chunk of first partners.
+    chunk_block: &'a [u32],
+}
+
+impl BlockAcc<'_> {
+    /// Adds the force and torque on the first partner `i` (always in this block).
+    #[inline(always)]
+    fn first(&mut self, i: usize, force: Vec3, torque: Vec3) {
+        let a = i - self.lo;
+        self.force[a] += force;
+        self.torque[a] += torque;
+    }
+
+    /// Adds the share of the second partner `j`: the opposite force, and its torque.
+    #[inline(always)]
+    fn second(&mut self, j: usize, force: Vec3, torque: Vec3) {
+        if j < self.hi {
+            let a = j - self.lo;
+            self.force[a] -= force;
+            self.torque[a] += torque;
+        } else {
+            let b = self.chunk_block[j / PP_CHUNK] as usize;
+            self.cross[b].push(SecondOutput {
+                force,
+                torque,
+                second: j as u32,
+            });
+        }
+    }
+}
+
+/// Particles per block of the pair pass, about (see [`force_blocks`]).
+const BLOCK_PARTICLES: usize = 8192;
+
+/// Cuts the chunks of first partners into blocks for the pair pass: `K` = the largest power of
+/// two not above `n / BLOCK_PARTICLES` (at least 1, at most 16, at most the number of chunks),
+/// contiguous runs of chunks of about equal work (neighbour pairs plus four per contact of the
+/// last evaluation). Depends on the state only, never on the thread count. Writes the first
+/// chunk of every block (and the end) to `block_start`, the block of every chunk to
+/// `chunk_block`; returns `K`.
+fn force_blocks(
+    nl: &crate::neighbor::NeighborList,
+    chunks: &[PpChunk],
+    n: usize,
+    block_start: &mut Vec<usize>,
+    chunk_block: &mut Vec<u32>,
+) -> usize {
+    let nchunks = n.div_ceil(PP_CHUNK);
+    let mut k = 1usize;
+    while k * 2 <= (n / BLOCK_PARTICLES).min(16) {
+        k *= 2;
+    }
+    let k = k.min(nchunks.max(1));
+    block_start.clear();
+    block_start.push(0);
+    chunk_block.clear();
+    chunk_block.resize(nchunks, 0);
+    if k > 1 {
+        let work = |c: usize| -> u64 {
+            let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
+            let pairs = u64::from(nl.row_start[hi] - nl.row_start[lo]);
+            let ch = &chunks[c];
+            pairs + 4 * (ch.slab.len() - ch.free.len()) as u64 + 1
+        };
+        let total: u64 = (0..nchunks).map(work).sum();
+        let mut run = 0u64;
+        for c in 0..nchunks {
+            run += work(c);
+            let b = block_start.len();
+            // Cut after this chunk once the run reaches the block's share, leaving at least one
+            // chunk for each later block.
+            let left = nchunks - (c + 1);
+            if b < k && left >= k - b && (run * k as u64 >= total * b as u64 || left == k - b) {
+                block_start.push(c + 1);
+            }
+        }
+        while block_start.len() < k {
+            // (only for fewer chunks than the shares could place)
+            let last = *block_start.last().unwrap();
+            block_start.push((last + 1).min(nchunks));
+        }
+    }
+    block_start.push(nchunks);
+    for b in 0..block_start.len() - 1 {
+        for c in block_start[b]..block_start[b + 1] {
+            chunk_block[c] = b as u32;
+        }
+    }
+    block_start.len() - 1
+}
+
+/// Particles per task of the wall pass.
+const WALL_CHUNK: usize = 64;
+
+/// A raw pointer shared by the tasks of a parallel pass that write disjoint entries.
+struct SharedMut<T>(*mut T);
+// SAFETY: only used where the tasks touch disjoint entries (see the uses).
+unsafe impl<T: Send> Sync for SharedMut<T> {}
+unsafe impl<T: Send> Send for SharedMut<T> {}
 
 /// Velocity, mass and angular velocity of one particle, packed into one cache line for the
 /// contact laws of the pair loop (scratch, refreshed every evaluation).
@@ -820,13 +912,10 @@ impl World {
             particles: p,
             interactions,
             neighbors,
-            pair_out,
-            out_count,
-            second_start,
-            second_list,
-            scratch_fill: fill,
-            row_force,
-            row_torque,
+            cross_out,
+            block_start,
+            chunk_block,
+            wall_list,
             pair_contact,
             pp_chunks,
             wall_slots,
@@ -874,11 +963,19 @@ impl World {
                 pp_chunks[k.i as usize / PP_CHUNK].orphans.push(k);
             }
         }
-        // Every chunk writes the outputs of its contacts densely from the start of its pair range.
-        pair_out.resize(m, SecondOutput::default());
-        out_count.resize(nchunks, 0);
-        row_force.resize(n, Vec3::zeros());
-        row_torque.resize(n, Vec3::zeros());
+        // Blocks of chunks, one rayon task each. A block sums the forces of its own particles
+        // directly (first and second partners, in pair-loop order); the share of a second
+        // partner in a later block goes to that block's list and is added after the pass, the
+        // earlier blocks first. Blocks are cut by the work of the chunks (pairs and contacts),
+        // never by the thread count: results do not depend on it.
+        let nblocks = force_blocks(
+            nl,
+            pp_chunks,
+            n,
+            block_start,
+            chunk_block,
+        );
+        cross_out.resize_with(nblocks * nblocks, Vec::new);
         let reach = nl.extra_range_m;
         // Positions and radii packed together: one load per partner in the pair loop.
         // Velocities, masses and spins packed likewise: one cache line per contact partner.
@@ -899,36 +996,72 @@ impl World {
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
         let kernel = crate::hm_block::kernel();
-        {
-            // Disjoint slices per chunk: pairs of its rows, and its particles.
-            let mut pcs: Vec<(&mut [u32], &mut [SecondOutput])> = Vec::with_capacity(nchunks);
-            let (mut rest_c, mut rest_o): (&mut [u32], &mut [SecondOutput]) =
-                (pair_contact, pair_out);
-            for c in 0..nchunks {
-                let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
-                let len = (nl.row_start[hi] - nl.row_start[lo]) as usize;
-                let (a, b) = rest_c.split_at_mut(len);
-                let (x, y) = rest_o.split_at_mut(len);
-                pcs.push((a, x));
-                rest_c = b;
-                rest_o = y;
+        let g = *gravity_m_s2;
+        let mut force = std::mem::take(&mut self.scratch_force);
+        let mut torque = std::mem::take(&mut self.scratch_torque);
+        force.resize(n, Vec3::zeros());
+        torque.resize(n, Vec3::zeros());
+        let block_start = &*block_start;
+        let chunk_block = &*chunk_block;
+        let ext_work: Vec<f64> = {
+            // Disjoint slices per block: its chunks, their pairs' contact slots, its particles'
+            // forces and torques, its outgoing lists.
+            struct BlockParts<'a> {
+                chunks: &'a mut [PpChunk],
+                pc: &'a mut [u32],
+                force: &'a mut [Vec3],
+                torque: &'a mut [Vec3],
+                cross: &'a mut [Vec<SecondOutput>],
             }
-            pp_chunks
-                .par_iter_mut()
-                .zip(pcs.into_par_iter())
-                .zip(row_force.par_chunks_mut(PP_CHUNK))
-                .zip(row_torque.par_chunks_mut(PP_CHUNK))
-                .zip(out_count.par_iter_mut())
+            let mut parts: Vec<BlockParts> = Vec::with_capacity(nblocks);
+            let (mut rest_k, mut rest_c, mut rest_f, mut rest_t, mut rest_x) = (
+                &mut pp_chunks[..],
+                &mut pair_contact[..],
+                &mut force[..],
+                &mut torque[..],
+                &mut cross_out[..],
+            );
+            for b in 0..nblocks {
+                let (c0, c1) = (block_start[b], block_start[b + 1]);
+                let (lo, hi) = ((c0 * PP_CHUNK).min(n), (c1 * PP_CHUNK).min(n));
+                let pairs = (nl.row_start[hi] - nl.row_start[lo]) as usize;
+                let (k, kr) = rest_k.split_at_mut(c1 - c0);
+                let (c, cr) = rest_c.split_at_mut(pairs);
+                let (f, fr) = rest_f.split_at_mut(hi - lo);
+                let (t, tr) = rest_t.split_at_mut(hi - lo);
+                let (x, xr_) = rest_x.split_at_mut(nblocks);
+                parts.push(BlockParts {
+                    chunks: k,
+                    pc: c,
+                    force: f,
+                    torque: t,
+                    cross: x,
+                });
+                (rest_k, rest_c, rest_f, rest_t, rest_x) = (kr, cr, fr, tr, xr_);
+            }
+            parts
+                .into_par_iter()
                 .enumerate()
-                .for_each(|(c, ((((chunk, (pc, po)), rf), rt), count))| {
-                    let lo = c * PP_CHUNK;
-                    let hi = ((c + 1) * PP_CHUNK).min(n);
-                    let rows = PairRows {
+                .map(|(b, part)| {
+                    let (c0, c1) = (block_start[b], block_start[b + 1]);
+                    let (lo, hi) = ((c0 * PP_CHUNK).min(n), (c1 * PP_CHUNK).min(n));
+                    // Gravity and external loads first.
+                    let mut ext = 0.0;
+                    for (k, (f, t)) in part.force.iter_mut().zip(part.torque.iter_mut()).enumerate()
+                    {
+                        let i = lo + k;
+                        *f = g * p.mass[i] + p.external_force[i];
+                        *t = Vec3::zeros();
+                        ext += p.external_force[i].dot(&p.velocity[i]) * dt;
+                    }
+                    part.cross.iter_mut().for_each(Vec::clear);
+                    let mut acc = BlockAcc {
                         lo,
                         hi,
-                        q0: nl.row_start[lo] as usize,
-                        row_start: &nl.row_start,
-                        second: &nl.second,
+                        force: part.force,
+                        torque: part.torque,
+                        cross: part.cross,
+                        chunk_block,
                     };
                     let ctx = PairContext {
                         p,
@@ -940,34 +1073,59 @@ impl World {
                         dt,
                         kernel,
                     };
-                    *count = ctx.chunk_pairs(&rows, chunk, pc, po, rf, rt) as u32;
+                    let q_block = nl.row_start[lo] as usize;
+                    PAIR_SCRATCH.with_borrow_mut(|scratch| {
+                        for (ck, chunk) in part.chunks.iter_mut().enumerate() {
+                            let c = c0 + ck;
+                            let (clo, chi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
+                            let rows = PairRows {
+                                lo: clo,
+                                hi: chi,
+                                q0: nl.row_start[clo] as usize,
+                                row_start: &nl.row_start,
+                                second: &nl.second,
+                            };
+                            let (qa, qb) = (
+                                nl.row_start[clo] as usize - q_block,
+                                nl.row_start[chi] as usize - q_block,
+                            );
+                            ctx.chunk_pairs(&rows, chunk, &mut part.pc[qa..qb], &mut acc, scratch);
+                        }
+                    });
+                    debug_assert!(acc.hi == hi);
+                    ext
+                })
+                .collect()
+        };
+        // Shares of second partners from earlier blocks, the earliest first.
+        {
+            let mut parts: Vec<(&mut [Vec3], &mut [Vec3])> = Vec::with_capacity(nblocks);
+            let (mut rest_f, mut rest_t) = (&mut force[..], &mut torque[..]);
+            for b in 0..nblocks {
+                let (lo, hi) = (
+                    (block_start[b] * PP_CHUNK).min(n),
+                    (block_start[b + 1] * PP_CHUNK).min(n),
+                );
+                let (f, fr) = rest_f.split_at_mut(hi - lo);
+                let (t, tr) = rest_t.split_at_mut(hi - lo);
+                parts.push((f, t));
+                (rest_f, rest_t) = (fr, tr);
+            }
+            let cross_out = &*cross_out;
+            parts
+                .into_par_iter()
+                .enumerate()
+                .skip(1)
+                .for_each(|(b, (f, t))| {
+                    let lo = (block_start[b] * PP_CHUNK).min(n);
+                    for a in 0..b {
+                        for o in &cross_out[a * nblocks + b] {
+                            let k = o.second as usize - lo;
+                            f[k] -= o.force;
+                            t[k] += o.torque;
+                        }
+                    }
                 });
-        }
-        // Counting sort of the outputs by second partner. For one particle its entries follow
-        // the chunks and, within a chunk, the pair loop: the first partner ascending (the order
-        // of the transposed neighbour index), whatever the thread count.
-        second_start.clear();
-        second_start.resize(n + 1, 0);
-        for (c, &cnt) in out_count.iter().enumerate() {
-            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
-            for o in &pair_out[base..base + cnt as usize] {
-                second_start[o.second as usize + 1] += 1;
-            }
-        }
-        for k in 0..n {
-            second_start[k + 1] += second_start[k];
-        }
-        let total = second_start[n] as usize;
-        second_list.resize(total, 0);
-        fill.clear();
-        fill.extend_from_slice(&second_start[..n]);
-        for (c, &cnt) in out_count.iter().enumerate() {
-            let base = nl.row_start[(c * PP_CHUNK).min(n)] as usize;
-            for (k, o) in pair_out[base..base + cnt as usize].iter().enumerate() {
-                let f = &mut fill[o.second as usize];
-                second_list[*f as usize] = (base + k) as u32;
-                *f += 1;
-            }
         }
         let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
 
@@ -975,7 +1133,7 @@ impl World {
         if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
             pr.pair_forces_s += t.elapsed().as_secs_f64();
         }
-        // 2. Per particle: gather pair forces, walls, gravity, external.
+        // 2. Walls, for the particles that may touch one.
         let body_step: Vec<BodyState> = bodies.iter().map(|b| b.step_state(dt)).collect();
         refresh_wall_candidates(
             p,
@@ -987,76 +1145,53 @@ impl World {
             wall_ref,
             wall_ref_builds,
             *wall_skip,
+            wall_slots,
+            wall_list,
         );
-        let wall_candidate = &*wall_candidate;
         let bodies_ref = &*bodies;
-        let pair_out = &*pair_out;
-        let second_start = &*second_start;
-        let second_list = &*second_list;
-        let rows_f = &*row_force;
-        let rows_t = &*row_torque;
-        let g = *gravity_m_s2;
-        let mut force = std::mem::take(&mut self.scratch_force);
-        let mut torque = std::mem::take(&mut self.scratch_torque);
-        force.resize(n, Vec3::zeros());
-        torque.resize(n, Vec3::zeros());
-        let pw: Vec<EnergyIncrements> = force
-            .par_chunks_mut(CHUNK)
-            .zip(torque.par_chunks_mut(CHUNK))
-            .zip(wall_slots.par_chunks_mut(CHUNK))
-            .enumerate()
-            .map_init(
-                || {
-                    (
-                        Vec::<WallContact>::with_capacity(16),
-                        Vec::<WallSlot>::with_capacity(16),
-                    )
-                },
-                |(contacts, fresh), (c, ((fs, ts), slots))| {
-                    let mut inc = EnergyIncrements::default();
-                    for (k, ((f_out, t_out), slot_list)) in fs
-                        .iter_mut()
-                        .zip(ts.iter_mut())
-                        .zip(slots.iter_mut())
-                        .enumerate()
-                    {
-                        let i = c * CHUNK + k;
-                        let mut f = g * p.mass[i] + p.external_force[i] + rows_f[i];
-                        let mut t = rows_t[i];
-                        inc.external_work_j += p.external_force[i].dot(&p.velocity[i]) * dt;
-                        // Contacts where `i` is the second partner, in neighbour-list order.
-                        let range = second_start[i] as usize..second_start[i + 1] as usize;
-                        for &g in &second_list[range] {
-                            let o = &pair_out[g as usize];
-                            f -= o.force;
-                            t += o.torque;
+        let pw: Vec<EnergyIncrements> = {
+            let fp = SharedMut(force.as_mut_ptr());
+            let tp = SharedMut(torque.as_mut_ptr());
+            let sp = SharedMut(wall_slots.as_mut_ptr());
+            let (fp, tp, sp) = (&fp, &tp, &sp);
+            wall_list
+                .par_chunks(WALL_CHUNK)
+                .map_init(
+                    || {
+                        (
+                            Vec::<WallContact>::with_capacity(16),
+                            Vec::<WallSlot>::with_capacity(16),
+                        )
+                    },
+                    |(contacts, fresh), list| {
+                        let mut inc = EnergyIncrements::default();
+                        for &i in list {
+                            let i = i as usize;
+                            // SAFETY: the list holds every particle at most once and `i < n`
+                            // (the three arrays have `n` entries), so the chunks of the list
+                            // touch disjoint entries.
+                            let (f, t, slots) =
+                                unsafe { (&mut *fp.0.add(i), &mut *tp.0.add(i), &mut *sp.0.add(i)) };
+                            wall_contacts_of(
+                                i,
+                                p,
+                                interactions,
+                                bodies_ref,
+                                &body_step,
+                                dt,
+                                slots,
+                                contacts,
+                                fresh,
+                                f,
+                                t,
+                                &mut inc,
+                            );
                         }
-                        if !wall_candidate[i] && slot_list.is_empty() {
-                            *f_out = f;
-                            *t_out = t;
-                            continue;
-                        }
-                        wall_contacts_of(
-                            i,
-                            p,
-                            interactions,
-                            bodies_ref,
-                            &body_step,
-                            dt,
-                            slot_list,
-                            contacts,
-                            fresh,
-                            &mut f,
-                            &mut t,
-                            &mut inc,
-                        );
-                        *f_out = f;
-                        *t_out = t;
-                    }
-                    inc
-                },
-            )
-            .collect();
+                        inc
+                    },
+                )
+                .collect()
+        };
 
         std::mem::swap(&mut self.particles.force, &mut force);
         std::mem::swap(&mut self.particles.torque, &mut torque);
@@ -1070,8 +1205,8 @@ impl World {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
         }
-        for slots in &self.wall_slots {
-            for s in slots {
+        for &i in &self.wall_list {
+            for s in &self.wall_slots[i as usize] {
                 let b = &mut self.bodies[s.body as usize];
                 b.contact_force_n -= s.force;
                 b.contact_torque_nm +=
@@ -1084,6 +1219,9 @@ impl World {
             inc.dissipated_normal_pp_j += dn;
             inc.dissipated_tangential_pp_j += dtan;
             inc.elastic_j += el;
+        }
+        for e in ext_work {
+            inc.external_work_j += e;
         }
         for w in pw {
             inc += w;
@@ -1109,6 +1247,8 @@ fn refresh_wall_candidates(
     reference: &mut Vec<(Vec3, crate::math::Rotation, usize)>,
     ref_builds: &mut u64,
     enabled: bool,
+    slots: &[Vec<WallSlot>],
+    list: &mut Vec<u32>,
 ) {
     let n = p.len();
     let skin = nl.skin_m;
@@ -1125,7 +1265,6 @@ fn refresh_wall_candidates(
     if fresh {
         return;
     }
-    candidate.resize(n, true);
     reference.clear();
     reference.extend(
         bodies
@@ -1133,6 +1272,25 @@ fn refresh_wall_candidates(
             .map(|b| (b.state.position_m, b.state.orientation, b.walls.len())),
     );
     *ref_builds = nl.builds;
+    refresh_candidate_flags(p, interactions, nl, bodies, body_step, candidate, enabled);
+    list.clear();
+    list.extend(
+        (0..n as u32).filter(|&i| candidate[i as usize] || !slots[i as usize].is_empty()),
+    );
+}
+
+/// The candidate flags of [`refresh_wall_candidates`].
+fn refresh_candidate_flags(
+    p: &crate::particles::ParticleSet,
+    interactions: &crate::interaction::InteractionTable,
+    nl: &crate::neighbor::NeighborList,
+    bodies: &[crate::body::RigidBody],
+    body_step: &[BodyState],
+    candidate: &mut Vec<bool>,
+    enabled: bool,
+) {
+    let (n, skin) = (p.len(), nl.skin_m);
+    candidate.resize(n, true);
     if !enabled || skin <= 0.0 {
         candidate.iter_mut().for_each(|c| *c = true);
         return;
@@ -1342,27 +1500,24 @@ mod tests {
         let mut batch = HmBatch::default();
         batch.push(hm, (0, 1), radii, kin, d, st, 0);
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
-        let mut po = vec![SecondOutput::default(); 1];
-        let (mut outs, mut sums) = (0, (0.0, 0.0, 0.0));
+        let mut sums = (0.0, 0.0, 0.0);
         let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
-        batch.flush(
-            kernel,
-            dt,
-            0,
-            &mut slab,
-            (&mut rf, &mut rt),
-            &mut po,
-            &mut outs,
-            &mut sums,
-        );
-        assert_eq!(outs, 1);
+        let mut acc = BlockAcc {
+            lo: 0,
+            hi: 2,
+            force: &mut rf,
+            torque: &mut rt,
+            cross: &mut [],
+            chunk_block: &[0],
+        };
+        batch.flush(kernel, dt, &mut slab, &mut acc, &mut sums);
         *st = slab[0].state;
         let eval = PairEval {
             force: rf[0],
             torque_first: rt[0],
-            torque_second: po[0].torque,
+            torque_second: rt[1],
         };
-        assert_eq!(po[0].force, rf[0]);
+        assert_eq!(-rf[1], rf[0]);
         (eval, sums.0, sums.1, sums.2)
     }
 

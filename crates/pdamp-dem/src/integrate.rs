@@ -199,6 +199,7 @@ impl World {
                 }
                 self.set_pp_contacts(&gear.backup_pairs);
                 self.wall_slots.clone_from(&gear.backup_walls);
+                self.include_wall_holders();
                 inc = self.evaluate_forces(dt);
                 self.counters.force_evaluations += 1;
                 // Corrector [D Eq. 2.100–2.103].

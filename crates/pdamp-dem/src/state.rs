@@ -168,6 +168,8 @@ impl World {
         self.neighbors = s.neighbors;
         self.set_pp_contacts(&s.contacts);
         self.wall_slots = s.wall_slots;
+        // The wall pass visits the candidates and the particles with wall contacts: recompute.
+        self.wall_ref.clear();
         self.gear = s.gear;
         self.initialized = s.initialized;
         Ok(())

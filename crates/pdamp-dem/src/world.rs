@@ -68,18 +68,17 @@ pub struct World {
     /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    /// Outputs of the contacts for their second partners: chunk `c` writes `out_count[c]`
-    /// entries from the start of its pair range (`row_start` of its first particle).
-    pub(crate) pair_out: Vec<crate::forces::SecondOutput>,
-    pub(crate) out_count: Vec<u32>,
-    /// Counting sort of `pair_out` by second partner: entries of particle `j` are
-    /// `second_list[second_start[j]..second_start[j + 1]]`.
-    pub(crate) second_start: Vec<u32>,
-    pub(crate) second_list: Vec<u32>,
-    pub(crate) scratch_fill: Vec<u32>,
-    /// Force and torque on every particle from the pairs where it is the first partner (scratch).
-    pub(crate) row_force: Vec<Vec3>,
-    pub(crate) row_torque: Vec<Vec3>,
+    /// Outputs of the contacts whose second partner lies in a later block of the pair pass
+    /// (see `force_blocks`): list `b × K + b'` holds those of block `b` for block `b'`, in
+    /// pair-loop order.
+    pub(crate) cross_out: Vec<Vec<crate::forces::SecondOutput>>,
+    /// First chunk of every block of the pair pass, and the end (`K + 1` entries).
+    pub(crate) block_start: Vec<usize>,
+    /// Block of every chunk of first partners.
+    pub(crate) chunk_block: Vec<u32>,
+    /// Particles that may touch a wall or hold wall contacts, ascending (rebuilt with the
+    /// candidates).
+    pub(crate) wall_list: Vec<u32>,
     /// For every neighbour pair: slot of its contact in the slab of the first partner's chunk,
     /// or `NO_CONTACT`.
     pub(crate) pair_contact: Vec<u32>,
@@ -127,13 +126,10 @@ impl World {
             counters: Counters::default(),
             profile: None,
             neighbors: NeighborList::new(0.0),
-            pair_out: Vec::new(),
-            out_count: Vec::new(),
-            second_start: Vec::new(),
-            second_list: Vec::new(),
-            scratch_fill: Vec::new(),
-            row_force: Vec::new(),
-            row_torque: Vec::new(),
+            cross_out: Vec::new(),
+            block_start: Vec::new(),
+            chunk_block: Vec::new(),
+            wall_list: Vec::new(),
             pair_contact: Vec::new(),
             remap_scratch: Vec::new(),
             wall_candidate: Vec::new(),
