@@ -1291,10 +1291,10 @@ impl Scenario {
                      particle count, the radius or placement.gap_m"
                 )
             })?;
-            // Number the group's particles along a Morton curve (spatial neighbours close in
+            // Number the group's particles by layers of cells (spatial neighbours close in
             // memory: the DEM's pair loop then finds its partners in cache).
             let r_max = radii.iter().cloned().fold(0.0, f64::max);
-            let order = pdamp_dem::generate::morton_order(&pos, 2.0 * r_max);
+            let order = pdamp_dem::generate::layer_order(&pos, 2.0 * r_max);
             for (x, r) in order.iter().map(|&k| (&pos[k], &radii[k])) {
                 let id = world.add_particle(*x, *r, mat);
                 world.particles.velocity[id] = Vec3::from(grp.initial_velocity_m_s);
