@@ -40,7 +40,7 @@ def ensure_liggghts():
 def _spin(n):
     x = 0
     for i in range(n):
-        x += i ^ (x >> 3)
+        x = (x + (i ^ (x >> 3))) & 0xFFFFFFFF  # stays a machine-size integer
     return x
 
 

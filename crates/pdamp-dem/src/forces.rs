@@ -1474,7 +1474,10 @@ fn wall_contacts_of(
         inc.dissipated_normal_pw_j += dn;
         inc.dissipated_tangential_pw_j += dtan;
     }
-    std::mem::swap(slots, fresh);
+    // Copied back rather than swapped: every particle keeps its own buffer (allocated once),
+    // so the wall pass reads the same memory step after step.
+    slots.clear();
+    slots.extend_from_slice(fresh);
 }
 
 #[cfg(test)]
