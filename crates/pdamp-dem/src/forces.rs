@@ -131,6 +131,9 @@ struct PairScratch {
     scan_first: Vec<u32>,
     /// Hertz–Mindlin contacts gathered for block evaluation.
     batch: HmBatch,
+    /// Wall contacts found for one particle, and its new wall slots.
+    wall_contacts: Vec<WallContact>,
+    wall_fresh: Vec<WallSlot>,
 }
 
 thread_local! {
@@ -580,6 +583,7 @@ impl PairContext<'_> {
     /// ([`crate::hm_block`]); other laws and contacts that ended are evaluated one by one (a
     /// pending block is evaluated first, so that every first partner sums its forces in list
     /// order). A contact keeps its slot in the chunk's slab while it lasts.
+    #[inline(never)]
     fn chunk_pairs(
         &self,
         rows: &PairRows,
@@ -609,6 +613,7 @@ impl PairContext<'_> {
             scan_pair,
             scan_first,
             batch,
+            ..
         } = scratch;
         // 1. Scan.
         if scan_pair.len() < second_c.len() {
@@ -832,14 +837,6 @@ fn force_blocks(
     block_start.len() - 1
 }
 
-/// Particles per task of the wall pass.
-const WALL_CHUNK: usize = 64;
-
-/// A raw pointer shared by the tasks of a parallel pass that write disjoint entries.
-struct SharedMut<T>(*mut T);
-// SAFETY: only used where the tasks touch disjoint entries (see the uses).
-unsafe impl<T: Send> Sync for SharedMut<T> {}
-unsafe impl<T: Send> Send for SharedMut<T> {}
 
 /// Velocity, mass and angular velocity of one particle, packed into one cache line for the
 /// contact laws of the pair loop (scratch, refreshed every evaluation).
@@ -1003,22 +1000,43 @@ impl World {
         torque.resize(n, Vec3::zeros());
         let block_start = &*block_start;
         let chunk_block = &*chunk_block;
-        let ext_work: Vec<f64> = {
+        // Walls: the particles that may touch one (a sorted list), handled by the block task
+        // right after the pairs of their chunk, while their data is in cache.
+        let body_step: Vec<BodyState> = bodies.iter().map(|b| b.step_state(dt)).collect();
+        wall_slots.resize(n, Vec::new());
+        refresh_wall_candidates(
+            p,
+            interactions,
+            nl,
+            bodies,
+            &body_step,
+            wall_candidate,
+            wall_ref,
+            wall_ref_builds,
+            *wall_skip,
+            wall_slots,
+            wall_list,
+        );
+        let bodies_ref = &*bodies;
+        let wall_list_ref = &*wall_list;
+        let block_out: Vec<(f64, EnergyIncrements)> = {
             // Disjoint slices per block: its chunks, their pairs' contact slots, its particles'
-            // forces and torques, its outgoing lists.
+            // forces, torques and wall slots, its outgoing lists.
             struct BlockParts<'a> {
                 chunks: &'a mut [PpChunk],
                 pc: &'a mut [u32],
                 force: &'a mut [Vec3],
                 torque: &'a mut [Vec3],
+                slots: &'a mut [Vec<WallSlot>],
                 cross: &'a mut [Vec<SecondOutput>],
             }
             let mut parts: Vec<BlockParts> = Vec::with_capacity(nblocks);
-            let (mut rest_k, mut rest_c, mut rest_f, mut rest_t, mut rest_x) = (
+            let (mut rest_k, mut rest_c, mut rest_f, mut rest_t, mut rest_s, mut rest_x) = (
                 &mut pp_chunks[..],
                 &mut pair_contact[..],
                 &mut force[..],
                 &mut torque[..],
+                &mut wall_slots[..],
                 &mut cross_out[..],
             );
             for b in 0..nblocks {
@@ -1029,15 +1047,17 @@ impl World {
                 let (c, cr) = rest_c.split_at_mut(pairs);
                 let (f, fr) = rest_f.split_at_mut(hi - lo);
                 let (t, tr) = rest_t.split_at_mut(hi - lo);
+                let (w, wr) = rest_s.split_at_mut(hi - lo);
                 let (x, xr_) = rest_x.split_at_mut(nblocks);
                 parts.push(BlockParts {
                     chunks: k,
                     pc: c,
                     force: f,
                     torque: t,
+                    slots: w,
                     cross: x,
                 });
-                (rest_k, rest_c, rest_f, rest_t, rest_x) = (kr, cr, fr, tr, xr_);
+                (rest_k, rest_c, rest_f, rest_t, rest_s, rest_x) = (kr, cr, fr, tr, wr, xr_);
             }
             parts
                 .into_par_iter()
@@ -1074,6 +1094,8 @@ impl World {
                         kernel,
                     };
                     let q_block = nl.row_start[lo] as usize;
+                    let mut walls = EnergyIncrements::default();
+                    let mut w = wall_list_ref.partition_point(|&i| (i as usize) < lo);
                     PAIR_SCRATCH.with_borrow_mut(|scratch| {
                         for (ck, chunk) in part.chunks.iter_mut().enumerate() {
                             let c = c0 + ck;
@@ -1090,10 +1112,29 @@ impl World {
                                 nl.row_start[chi] as usize - q_block,
                             );
                             ctx.chunk_pairs(&rows, chunk, &mut part.pc[qa..qb], &mut acc, scratch);
+                            // The chunk's particles have all their pair forces from this block.
+                            while let Some(&i) = wall_list_ref.get(w)
+                                && (i as usize) < chi
+                            {
+                                let (i, a) = (i as usize, i as usize - lo);
+                                wall_contacts_of(
+                                    (p.material[i], &xr[i], &kin[i]),
+                                    interactions,
+                                    bodies_ref,
+                                    &body_step,
+                                    dt,
+                                    &mut part.slots[a],
+                                    &mut scratch.wall_contacts,
+                                    &mut scratch.wall_fresh,
+                                    &mut acc.force[a],
+                                    &mut acc.torque[a],
+                                    &mut walls,
+                                );
+                                w += 1;
+                            }
                         }
                     });
-                    debug_assert!(acc.hi == hi);
-                    ext
+                    (ext, walls)
                 })
                 .collect()
         };
@@ -1129,76 +1170,14 @@ impl World {
         }
         let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
 
-        let t_particles = self.profile.map(|_| std::time::Instant::now());
-        if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
-            pr.pair_forces_s += t.elapsed().as_secs_f64();
-        }
-        // 2. Walls, for the particles that may touch one.
-        let body_step: Vec<BodyState> = bodies.iter().map(|b| b.step_state(dt)).collect();
-        refresh_wall_candidates(
-            p,
-            interactions,
-            nl,
-            bodies,
-            &body_step,
-            wall_candidate,
-            wall_ref,
-            wall_ref_builds,
-            *wall_skip,
-            wall_slots,
-            wall_list,
-        );
-        let bodies_ref = &*bodies;
-        let pw: Vec<EnergyIncrements> = {
-            let fp = SharedMut(force.as_mut_ptr());
-            let tp = SharedMut(torque.as_mut_ptr());
-            let sp = SharedMut(wall_slots.as_mut_ptr());
-            let (fp, tp, sp) = (&fp, &tp, &sp);
-            wall_list
-                .par_chunks(WALL_CHUNK)
-                .map_init(
-                    || {
-                        (
-                            Vec::<WallContact>::with_capacity(16),
-                            Vec::<WallSlot>::with_capacity(16),
-                        )
-                    },
-                    |(contacts, fresh), list| {
-                        let mut inc = EnergyIncrements::default();
-                        for &i in list {
-                            let i = i as usize;
-                            // SAFETY: the list holds every particle at most once and `i < n`
-                            // (the three arrays have `n` entries), so the chunks of the list
-                            // touch disjoint entries.
-                            let (f, t, slots) =
-                                unsafe { (&mut *fp.0.add(i), &mut *tp.0.add(i), &mut *sp.0.add(i)) };
-                            wall_contacts_of(
-                                i,
-                                p,
-                                interactions,
-                                bodies_ref,
-                                &body_step,
-                                dt,
-                                slots,
-                                contacts,
-                                fresh,
-                                f,
-                                t,
-                                &mut inc,
-                            );
-                        }
-                        inc
-                    },
-                )
-                .collect()
-        };
-
         std::mem::swap(&mut self.particles.force, &mut force);
         std::mem::swap(&mut self.particles.torque, &mut torque);
         self.scratch_force = force;
         self.scratch_torque = torque;
 
-        self.tock(t_particles, |p| &mut p.particle_forces_s);
+        if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
+            pr.pair_forces_s += t.elapsed().as_secs_f64();
+        }
         let t_loads = self.tick();
         // 3. Loads on rigid bodies, summed in particle order (deterministic).
         for b in self.bodies.iter_mut() {
@@ -1220,10 +1199,8 @@ impl World {
             inc.dissipated_tangential_pp_j += dtan;
             inc.elastic_j += el;
         }
-        for e in ext_work {
+        for (e, w) in block_out {
             inc.external_work_j += e;
-        }
-        for w in pw {
             inc += w;
         }
         self.tock(t_loads, |p| &mut p.energies_s);
@@ -1333,10 +1310,9 @@ fn refresh_candidate_flags(
 /// sphere sliding from a face onto an edge), evaluates the laws and accumulates force, torque
 /// and energy.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(never)]
 fn wall_contacts_of(
-    i: usize,
-    p: &crate::particles::ParticleSet,
+    (material, xr, kin): (u16, &[f64; 4], &Kin),
     interactions: &crate::interaction::InteractionTable,
     bodies: &[crate::body::RigidBody],
     body_step: &[BodyState],
@@ -1349,19 +1325,20 @@ fn wall_contacts_of(
     inc: &mut EnergyIncrements,
 ) {
     fresh.clear();
-    let x = p.position[i];
-    let r = p.radius[i];
+    let x = Vec3::new(xr[0], xr[1], xr[2]);
+    let r = xr[3];
+    let (mass, v, w) = (kin.m, Vec3::from(kin.v), Vec3::from(kin.w));
     for (bi, body) in bodies.iter().enumerate() {
         let bs = &body_step[bi];
         let xb = bs.to_body(&x);
         for (wi, wall) in body.walls.iter().enumerate() {
-            let (model, el_pair) = interactions.get(p.material[i], wall.material);
+            let (model, el_pair) = interactions.get(material, wall.material);
             let props0 = PairProps {
                 e_eff_pa: el_pair.e_eff_pa,
                 g_eff_pa: el_pair.g_eff_pa,
                 poisson_mean: el_pair.poisson_mean,
                 r_eff_m: r,
-                m_eff_kg: p.mass[i],
+                m_eff_kg: mass,
             };
             let gap = model.max_interaction_gap_m(&props0);
             contacts.clear();
@@ -1407,12 +1384,12 @@ fn wall_contacts_of(
                 };
                 let v_wall = bs.point_velocity(&point);
                 let rb = r - 0.5 * c.overlap_m.max(0.0);
-                let v_p = p.velocity[i] + p.angular_velocity[i].cross(&(-rb * normal));
+                let v_p = v + w.cross(&(-rb * normal));
                 let v_rel = v_p - v_wall;
-                let w_rel = p.angular_velocity[i] - bs.angular_velocity_rad_s;
+                let w_rel = w - bs.angular_velocity_rad_s;
                 let kin = ContactKinematics {
                     overlap_m: c.overlap_m,
-                    overlap_rate_m_s: -normal.dot(&(p.velocity[i] - v_wall)),
+                    overlap_rate_m_s: -normal.dot(&(v - v_wall)),
                     normal,
                     tangential_velocity_m_s: tangential_part(&v_rel, &normal),
                     relative_angular_velocity_rad_s: w_rel,
@@ -1455,8 +1432,8 @@ fn wall_contacts_of(
         let bs = &body_step[s.body as usize];
         let v_wall = bs.point_velocity(&s.point);
         let rb = r;
-        let v_rel = p.velocity[i] + p.angular_velocity[i].cross(&(-rb * s.normal)) - v_wall;
-        let w_rel = p.angular_velocity[i] - bs.angular_velocity_rad_s;
+        let v_rel = v + w.cross(&(-rb * s.normal)) - v_wall;
+        let w_rel = w - bs.angular_velocity_rad_s;
         let f = ContactForce::default();
         inc.wall_work_j +=
             0.5 * (s.state.normal_force_prev + s.state.tangential_force_prev).dot(&v_wall) * dt
