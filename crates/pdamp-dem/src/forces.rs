@@ -1111,6 +1111,18 @@ impl World {
                                 nl.row_start[clo] as usize - q_block,
                                 nl.row_start[chi] as usize - q_block,
                             );
+                            // The wall slots of the chunk's particles lie anywhere on the
+                            // heap: fetched while the pairs are evaluated.
+                            let w_end = w + wall_list_ref[w..].partition_point(|&i| (i as usize) < chi);
+                            for &i in &wall_list_ref[w..w_end] {
+                                let s = &part.slots[i as usize - lo];
+                                if !s.is_empty() {
+                                    let q = s.as_ptr().cast::<u8>();
+                                    for line in 0..std::mem::size_of::<WallSlot>().div_ceil(64) {
+                                        prefetch_at(q.wrapping_add(64 * line));
+                                    }
+                                }
+                            }
                             ctx.chunk_pairs(&rows, chunk, &mut part.pc[qa..qb], &mut acc, scratch);
                             // The chunk's particles have all their pair forces from this block.
                             while let Some(&i) = wall_list_ref.get(w)
