@@ -782,13 +782,14 @@ const BLOCK_PARTICLES: usize = 8192;
 
 /// Cuts the chunks of first partners into blocks for the pair pass: `K` = the largest power of
 /// two not above `n / BLOCK_PARTICLES` (at least 1, at most 16, at most the number of chunks),
-/// contiguous runs of chunks of about equal work (neighbour pairs plus four per contact of the
-/// last evaluation). Depends on the state only, never on the thread count. Writes the first
+/// contiguous runs of chunks of about equal work (neighbour pairs, plus four per contact of the
+/// last evaluation and ten per particle of the wall list `walls`). Depends on the state only, never on the thread count. Writes the first
 /// chunk of every block (and the end) to `block_start`, the block of every chunk to
 /// `chunk_block`; returns `K`.
 fn force_blocks(
     nl: &crate::neighbor::NeighborList,
     chunks: &[PpChunk],
+    walls: &[u32],
     n: usize,
     block_start: &mut Vec<usize>,
     chunk_block: &mut Vec<u32>,
@@ -804,16 +805,22 @@ fn force_blocks(
     chunk_block.clear();
     chunk_block.resize(nchunks, 0);
     if k > 1 {
-        let work = |c: usize| -> u64 {
+        // (`w` walks the sorted wall list along the chunks)
+        let work = |c: usize, w: &mut usize| -> u64 {
             let (lo, hi) = (c * PP_CHUNK, ((c + 1) * PP_CHUNK).min(n));
             let pairs = u64::from(nl.row_start[hi] - nl.row_start[lo]);
             let ch = &chunks[c];
-            pairs + 4 * (ch.slab.len() - ch.free.len()) as u64 + 1
+            let w0 = *w;
+            while *w < walls.len() && (walls[*w] as usize) < hi {
+                *w += 1;
+            }
+            pairs + 4 * (ch.slab.len() - ch.free.len()) as u64 + 10 * (*w - w0) as u64 + 1
         };
-        let total: u64 = (0..nchunks).map(work).sum();
-        let mut run = 0u64;
+        let mut w = 0;
+        let total: u64 = (0..nchunks).map(|c| work(c, &mut w)).sum();
+        let (mut run, mut w) = (0u64, 0);
         for c in 0..nchunks {
-            run += work(c);
+            run += work(c, &mut w);
             let b = block_start.len();
             // Cut after this chunk once the run reaches the block's share, leaving at least one
             // chunk for each later block.
@@ -830,13 +837,10 @@ fn force_blocks(
     }
     block_start.push(nchunks);
     for b in 0..block_start.len() - 1 {
-        for c in block_start[b]..block_start[b + 1] {
-            chunk_block[c] = b as u32;
-        }
+        chunk_block[block_start[b]..block_start[b + 1]].fill(b as u32);
     }
     block_start.len() - 1
 }
-
 
 /// Velocity, mass and angular velocity of one particle, packed into one cache line for the
 /// contact laws of the pair loop (scratch, refreshed every evaluation).
@@ -850,6 +854,17 @@ pub(crate) struct Kin {
 }
 
 impl Kin {
+    /// Packs velocity `v`, mass `m` and angular velocity `w`.
+    #[inline]
+    pub(crate) fn new(v: &Vec3, m: f64, w: &Vec3) -> Self {
+        Kin {
+            v: [v.x, v.y, v.z],
+            m,
+            w: [w.x, w.y, w.z],
+            _pad: 0.0,
+        }
+    }
+
     /// The packed state of particle `i`.
     #[inline]
     fn of(p: &crate::particles::ParticleSet, i: usize) -> Self {
@@ -924,6 +939,7 @@ impl World {
             wall_skip,
             scratch_xr: xr,
             scratch_kin: kin,
+            packed,
             ..
         } = self;
         let p = &*p;
@@ -931,14 +947,12 @@ impl World {
         let nl = &*neighbors;
         let n = p.len();
 
-        // 1. Particle–particle contacts, in parallel over chunks of particles (rows of the half
-        //    neighbour list). A pair without a contact that does not touch costs one
-        //    squared-distance test on positions and radii; a contact keeps its slot in the
+        // 1. Particle–particle contacts, in parallel over blocks of chunks of particles (rows
+        //    of the half neighbour list). A pair without a contact that does not touch costs
+        //    one squared-distance test on positions and radii; a contact keeps its slot in the
         //    chunk's slab (history updated in place); a contact that ended closes its work
-        //    integral and frees its slot. The first partner's force and torque are summed here;
-        //    the second partner's share goes to the chunk's output list (`pair_out`, written
-        //    sequentially), which a counting sort by second partner then indexes for the gather
-        //    (fixed order, the first partner ascending: thread-count independent).
+        //    integral and frees its slot. Both partners' forces and torques are summed in the
+        //    block's own particles, in pair-loop order (see `BlockAcc` and `force_blocks`).
         let nchunks = n.div_ceil(PP_CHUNK);
         let m = nl.num_pairs();
         if pp_chunks.len() != nchunks || pair_contact.len() != m {
@@ -965,30 +979,26 @@ impl World {
         // partner in a later block goes to that block's list and is added after the pass, the
         // earlier blocks first. Blocks are cut by the work of the chunks (pairs and contacts),
         // never by the thread count: results do not depend on it.
-        let nblocks = force_blocks(
-            nl,
-            pp_chunks,
-            n,
-            block_start,
-            chunk_block,
-        );
-        cross_out.resize_with(nblocks * nblocks, Vec::new);
         let reach = nl.extra_range_m;
         // Positions and radii packed together: one load per partner in the pair loop.
         // Velocities, masses and spins packed likewise: one cache line per contact partner.
+        // (Already packed by the drift of a velocity-Verlet step.)
+        let packed = std::mem::take(packed) && xr.len() == n && kin.len() == n;
         xr.resize(n, [0.0; 4]);
         kin.resize(n, Kin::default());
-        xr.par_chunks_mut(CHUNK)
-            .zip(kin.par_chunks_mut(CHUNK))
-            .enumerate()
-            .for_each(|(c, (out, kout))| {
-                for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
-                    let i = c * CHUNK + k;
-                    let x = p.position[i];
-                    *v = [x.x, x.y, x.z, p.radius[i]];
-                    *kv = Kin::of(p, i);
-                }
-            });
+        if !packed {
+            xr.par_chunks_mut(CHUNK)
+                .zip(kin.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, (out, kout))| {
+                    for (k, (v, kv)) in out.iter_mut().zip(kout.iter_mut()).enumerate() {
+                        let i = c * CHUNK + k;
+                        let x = p.position[i];
+                        *v = [x.x, x.y, x.z, p.radius[i]];
+                        *kv = Kin::of(p, i);
+                    }
+                });
+        }
         let xr = &*xr;
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
@@ -998,8 +1008,6 @@ impl World {
         let mut torque = std::mem::take(&mut self.scratch_torque);
         force.resize(n, Vec3::zeros());
         torque.resize(n, Vec3::zeros());
-        let block_start = &*block_start;
-        let chunk_block = &*chunk_block;
         // Walls: the particles that may touch one (a sorted list), handled by the block task
         // right after the pairs of their chunk, while their data is in cache.
         let body_step: Vec<BodyState> = bodies.iter().map(|b| b.step_state(dt)).collect();
@@ -1017,6 +1025,10 @@ impl World {
             wall_slots,
             wall_list,
         );
+        let nblocks = force_blocks(nl, pp_chunks, wall_list, n, block_start, chunk_block);
+        cross_out.resize_with(nblocks * nblocks, Vec::new);
+        let block_start = &*block_start;
+        let chunk_block = &*chunk_block;
         let bodies_ref = &*bodies;
         let wall_list_ref = &*wall_list;
         let block_out: Vec<(f64, EnergyIncrements)> = {
@@ -1067,7 +1079,11 @@ impl World {
                     let (lo, hi) = ((c0 * PP_CHUNK).min(n), (c1 * PP_CHUNK).min(n));
                     // Gravity and external loads first.
                     let mut ext = 0.0;
-                    for (k, (f, t)) in part.force.iter_mut().zip(part.torque.iter_mut()).enumerate()
+                    for (k, (f, t)) in part
+                        .force
+                        .iter_mut()
+                        .zip(part.torque.iter_mut())
+                        .enumerate()
                     {
                         let i = lo + k;
                         *f = g * p.mass[i] + p.external_force[i];
@@ -1113,7 +1129,8 @@ impl World {
                             );
                             // The wall slots of the chunk's particles lie anywhere on the
                             // heap: fetched while the pairs are evaluated.
-                            let w_end = w + wall_list_ref[w..].partition_point(|&i| (i as usize) < chi);
+                            let w_end =
+                                w + wall_list_ref[w..].partition_point(|&i| (i as usize) < chi);
                             for &i in &wall_list_ref[w..w_end] {
                                 let s = &part.slots[i as usize - lo];
                                 if !s.is_empty() {
@@ -1263,9 +1280,7 @@ fn refresh_wall_candidates(
     *ref_builds = nl.builds;
     refresh_candidate_flags(p, interactions, nl, bodies, body_step, candidate, enabled);
     list.clear();
-    list.extend(
-        (0..n as u32).filter(|&i| candidate[i as usize] || !slots[i as usize].is_empty()),
-    );
+    list.extend((0..n as u32).filter(|&i| candidate[i as usize] || !slots[i as usize].is_empty()));
 }
 
 /// The candidate flags of [`refresh_wall_candidates`].

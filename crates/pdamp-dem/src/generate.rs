@@ -1581,7 +1581,11 @@ mod morton_tests {
         };
         assert!(span(|p| p.x) * span(|p| p.y) <= LAYER_TILE_CELLS);
         assert_eq!(span(|p| p.z), 1, "a tile's first layer comes first");
-        let bad = vec![Vec3::new(f64::NAN, 0.0, 0.0), Vec3::zeros(), Vec3::new(1.0, 0.0, 0.0)];
+        let bad = vec![
+            Vec3::new(f64::NAN, 0.0, 0.0),
+            Vec3::zeros(),
+            Vec3::new(1.0, 0.0, 0.0),
+        ];
         assert_eq!(*layer_order(&bad, 1.0).last().unwrap(), 0);
     }
 

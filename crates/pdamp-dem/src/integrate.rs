@@ -2,9 +2,9 @@
 //! step-size controller of Meyer & Seifried [D Sect. 2.5, Eq. 2.95–2.106, Tab. 2.2/2.3].
 
 use crate::energy::EnergyIncrements;
-use crate::forces::{PpContact, WallSlot};
+use crate::forces::{Kin, PpContact, WallSlot};
 use crate::math::Vec3;
-use crate::world::World;
+use crate::world::{ENERGY_BLOCK, World};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -51,6 +51,9 @@ pub enum Integrator {
 }
 
 /// Gear corrector coefficients for order p = 5 [D Tab. 2.2].
+/// Particles per task of the drift pass.
+const PASS_CHUNK: usize = 1024;
+
 const GEAR5: [f64; 5] = [19.0 / 90.0, 3.0 / 4.0, 1.0, 1.0 / 2.0, 1.0 / 12.0];
 
 /// Time derivatives kept by the Gear scheme for every particle: translation (x, ẋ, ẍ, x⃛, x⁗) and
@@ -72,37 +75,92 @@ impl World {
     pub(crate) fn step_velocity_verlet(&mut self) -> EnergyIncrements {
         let dt = self.dt_s;
         let t = self.tick();
-        let p = &mut self.particles;
         let half = 0.5 * dt;
-        p.position
-            .par_iter_mut()
-            .zip(p.velocity.par_iter_mut())
-            .zip(p.angular_velocity.par_iter_mut())
-            .zip(p.force.par_iter())
-            .zip(p.torque.par_iter())
-            .zip(p.mass.par_iter().zip(p.inv_inertia.par_iter()))
-            .for_each(|(((((x, v), w), f), t), (m, ii))| {
-                *v += f * (half / m);
-                *w += t * (half * ii);
-                *x += *v * dt;
-            });
+        let n = self.particles.len();
+        // Half kick and drift; the new positions and velocities are also packed for the pair
+        // loop of the force evaluation (one pass over the particles less).
+        self.scratch_xr.resize(n, [0.0; 4]);
+        self.scratch_kin.resize(n, Kin::default());
+        {
+            let crate::particles::ParticleSet {
+                position,
+                velocity,
+                angular_velocity,
+                force,
+                torque,
+                radius,
+                mass,
+                inv_inertia,
+                ..
+            } = &mut self.particles;
+            let (force, torque, radius, mass, inv_inertia) =
+                (&*force, &*torque, &*radius, &*mass, &*inv_inertia);
+            position
+                .par_chunks_mut(PASS_CHUNK)
+                .zip(velocity.par_chunks_mut(PASS_CHUNK))
+                .zip(angular_velocity.par_chunks_mut(PASS_CHUNK))
+                .zip(self.scratch_xr.par_chunks_mut(PASS_CHUNK))
+                .zip(self.scratch_kin.par_chunks_mut(PASS_CHUNK))
+                .enumerate()
+                .for_each(|(c, ((((xs, vs), ws), xrs), ks))| {
+                    for (k, (((x, v), w), (xr, kin))) in xs
+                        .iter_mut()
+                        .zip(vs.iter_mut())
+                        .zip(ws.iter_mut())
+                        .zip(xrs.iter_mut().zip(ks.iter_mut()))
+                        .enumerate()
+                    {
+                        let i = c * PASS_CHUNK + k;
+                        let m = mass[i];
+                        *v += force[i] * (half / m);
+                        *w += torque[i] * (half * inv_inertia[i]);
+                        *x += *v * dt;
+                        *xr = [x.x, x.y, x.z, radius[i]];
+                        *kin = Kin::new(v, m, w);
+                    }
+                });
+        }
+        self.packed = true;
         self.advance_bodies(dt);
         self.tock(t, |p| &mut p.integrate_s);
         self.update_neighbors();
         let inc = self.evaluate_forces(dt);
         self.counters.force_evaluations += 1;
         let t = self.tick();
+        // Second half kick, with the kinetic and potential energy of the new state summed in
+        // the blocks of `refresh_state_energies` (the same numbers, one pass less).
+        let g = self.gravity_m_s2;
         let p = &mut self.particles;
+        let sums = &mut self.scratch_energy;
+        sums.clear();
+        sums.resize(n.div_ceil(ENERGY_BLOCK), [0.0; 2]);
+        let (force, torque, mass, inv_inertia, position) =
+            (&p.force, &p.torque, &p.mass, &p.inv_inertia, &p.position);
         p.velocity
-            .par_iter_mut()
-            .zip(p.angular_velocity.par_iter_mut())
-            .zip(p.force.par_iter())
-            .zip(p.torque.par_iter())
-            .zip(p.mass.par_iter().zip(p.inv_inertia.par_iter()))
-            .for_each(|((((v, w), f), t), (m, ii))| {
-                *v += f * (half / m);
-                *w += t * (half * ii);
+            .par_chunks_mut(ENERGY_BLOCK)
+            .zip(p.angular_velocity.par_chunks_mut(ENERGY_BLOCK))
+            .zip(sums.par_iter_mut())
+            .enumerate()
+            .for_each(|(b, ((vs, ws), e))| {
+                let (mut kin, mut pot) = (0.0, 0.0);
+                for (k, (v, w)) in vs.iter_mut().zip(ws.iter_mut()).enumerate() {
+                    let i = b * ENERGY_BLOCK + k;
+                    *v += force[i] * (half / mass[i]);
+                    *w += torque[i] * (half * inv_inertia[i]);
+                    kin +=
+                        0.5 * mass[i] * v.norm_squared() + 0.5 * w.norm_squared() / inv_inertia[i];
+                    pot += mass[i] * g.dot(&position[i]);
+                }
+                *e = [kin, pot];
             });
+        let (mut kin, mut pot) = (0.0, 0.0);
+        for e in sums.iter() {
+            kin += e[0];
+            pot += e[1];
+        }
+        self.ledger.kinetic_j = kin;
+        self.ledger.potential_j = -pot;
+        self.energies_fresh = true;
         self.tock(t, |p| &mut p.integrate_s);
         inc
     }

@@ -106,7 +106,17 @@ pub struct World {
     pub(crate) scratch_torque: Vec<Vec3>,
     pub(crate) gear: Option<GearState>,
     pub(crate) initialized: bool,
+    /// `scratch_xr`/`scratch_kin` hold the current state (packed by the drift of a
+    /// velocity-Verlet step; consumed by the next force evaluation).
+    pub(crate) packed: bool,
+    /// The ledger's kinetic and potential energy are those of the current state (computed by
+    /// the second half-kick of a velocity-Verlet step).
+    pub(crate) energies_fresh: bool,
 }
+
+/// Particles per block of the kinetic and potential energy sums (fixed, so that the sums do not
+/// depend on the thread count).
+pub(crate) const ENERGY_BLOCK: usize = 2048;
 
 impl World {
     /// A world with the given materials; every material pair uses `default_model` until
@@ -145,6 +155,8 @@ impl World {
             scratch_torque: Vec::new(),
             gear: None,
             initialized: false,
+            packed: false,
+            energies_fresh: false,
         }
     }
 
@@ -381,7 +393,7 @@ impl World {
     pub(crate) fn refresh_state_energies(&mut self) {
         // In parallel over blocks of particles, the blocks added in order (the result does not
         // depend on the thread count).
-        const BLOCK: usize = 2048;
+        const BLOCK: usize = ENERGY_BLOCK;
         let p = &self.particles;
         let g = self.gravity_m_s2;
         let sums = &mut self.scratch_energy;
@@ -417,7 +429,9 @@ impl World {
         };
         let t = self.tick();
         self.ledger.add(&inc);
-        self.refresh_state_energies();
+        if !std::mem::take(&mut self.energies_fresh) {
+            self.refresh_state_energies();
+        }
         self.tock(t, |p| &mut p.energies_s);
         self.counters.steps += 1;
     }

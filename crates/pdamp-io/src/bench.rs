@@ -62,7 +62,10 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Strin
     {
         Some(Ok(state)) => state,
         Some(Err(e)) => {
-            eprintln!("settled bed {}: {e}; settling again", cache.unwrap().display());
+            eprintln!(
+                "settled bed {}: {e}; settling again",
+                cache.unwrap().display()
+            );
             None
         }
         None => None,
