@@ -1167,6 +1167,10 @@ impl World {
                 })
                 .collect()
         };
+        let t_particles = self.profile.map(|_| std::time::Instant::now());
+        if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
+            pr.pair_forces_s += t.elapsed().as_secs_f64();
+        }
         // Shares of second partners from earlier blocks, the earliest first.
         {
             let mut parts: Vec<(&mut [Vec3], &mut [Vec3])> = Vec::with_capacity(nblocks);
@@ -1204,9 +1208,7 @@ impl World {
         self.scratch_force = force;
         self.scratch_torque = torque;
 
-        if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
-            pr.pair_forces_s += t.elapsed().as_secs_f64();
-        }
+        self.tock(t_particles, |p| &mut p.particle_forces_s);
         let t_loads = self.tick();
         // 3. Loads on rigid bodies, summed in particle order (deterministic).
         for b in self.bodies.iter_mut() {

@@ -34,9 +34,10 @@ pub struct PhaseTimes {
     pub integrate_s: f64,
     /// Neighbour-list displacement check and rebuilds.
     pub neighbors_s: f64,
-    /// Particle–particle contact laws.
+    /// The block pass of the force evaluation: packing, gravity and external loads, the
+    /// particle–particle and particle–wall contact laws.
     pub pair_forces_s: f64,
-    /// Per-particle force sums, wall contacts, gravity.
+    /// Shares of second partners from other blocks of the pair pass.
     pub particle_forces_s: f64,
     /// Energy ledger update (kinetic, potential) and body loads.
     pub energies_s: f64,
