@@ -781,7 +781,8 @@ impl BlockAcc<'_> {
 const BLOCK_PARTICLES: usize = 8192;
 
 /// Cuts the chunks of first partners into blocks for the pair pass: `K` = the largest power of
-/// two not above `n / BLOCK_PARTICLES` (at least 1, at most 16, at most the number of chunks),
+/// two not above `n / BLOCK_PARTICLES`, or up to 4 blocks of at least `BLOCK_PARTICLES / 4`
+/// particles for small beds (at least 1, at most 16, at most the number of chunks),
 /// contiguous runs of chunks of about equal work (neighbour pairs, plus four per contact of the
 /// last evaluation and ten per particle of the wall list `walls`). Depends on the state only, never on the thread count. Writes the first
 /// chunk of every block (and the end) to `block_start`, the block of every chunk to
@@ -796,7 +797,12 @@ fn force_blocks(
 ) -> usize {
     let nchunks = n.div_ceil(PP_CHUNK);
     let mut k = 1usize;
-    while k * 2 <= (n / BLOCK_PARTICLES).min(16) {
+    // (small beds: up to four blocks of at least a quarter of BLOCK_PARTICLES, so that two to
+    // four threads still share one simulation)
+    let target = (n / BLOCK_PARTICLES)
+        .max((4 * n / BLOCK_PARTICLES).min(4))
+        .min(16);
+    while k * 2 <= target {
         k *= 2;
     }
     let k = k.min(nchunks.max(1));
