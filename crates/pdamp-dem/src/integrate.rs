@@ -4,7 +4,7 @@
 use crate::energy::EnergyIncrements;
 use crate::forces::{Kin, PpContact, WallSlot};
 use crate::math::Vec3;
-use crate::world::{ENERGY_BLOCK, World};
+use crate::world::{ENERGY_BLOCK, World, particle_energy};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -147,19 +147,13 @@ impl World {
                     let i = b * ENERGY_BLOCK + k;
                     *v += force[i] * (half / mass[i]);
                     *w += torque[i] * (half * inv_inertia[i]);
-                    kin +=
-                        0.5 * mass[i] * v.norm_squared() + 0.5 * w.norm_squared() / inv_inertia[i];
-                    pot += mass[i] * g.dot(&position[i]);
+                    let (k, u) = particle_energy(mass[i], inv_inertia[i], v, w, &position[i], &g);
+                    kin += k;
+                    pot += u;
                 }
                 *e = [kin, pot];
             });
-        let (mut kin, mut pot) = (0.0, 0.0);
-        for e in sums.iter() {
-            kin += e[0];
-            pot += e[1];
-        }
-        self.ledger.kinetic_j = kin;
-        self.ledger.potential_j = -pot;
+        self.ledger_energies_from_blocks();
         self.energies_fresh = true;
         self.tock(t, |p| &mut p.integrate_s);
         inc

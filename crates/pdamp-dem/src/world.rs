@@ -115,6 +115,22 @@ pub struct World {
     pub(crate) energies_fresh: bool,
 }
 
+/// Kinetic energy (translation + rotation) and `m g·x` of one particle, J.
+#[inline]
+pub(crate) fn particle_energy(
+    m: f64,
+    inv_inertia: f64,
+    v: &Vec3,
+    w: &Vec3,
+    x: &Vec3,
+    g: &Vec3,
+) -> (f64, f64) {
+    (
+        0.5 * m * v.norm_squared() + 0.5 * w.norm_squared() / inv_inertia,
+        m * g.dot(x),
+    )
+}
+
 /// Particles per block of the kinetic and potential energy sums (fixed, so that the sums do not
 /// depend on the thread count).
 pub(crate) const ENERGY_BLOCK: usize = 2048;
@@ -404,14 +420,27 @@ impl World {
             let r = b * BLOCK..((b + 1) * BLOCK).min(p.len());
             let (mut kin, mut pot) = (0.0, 0.0);
             for i in r {
-                kin += 0.5 * p.mass[i] * p.velocity[i].norm_squared()
-                    + 0.5 * p.angular_velocity[i].norm_squared() / p.inv_inertia[i];
-                pot += p.mass[i] * g.dot(&p.position[i]);
+                let (k, u) = particle_energy(
+                    p.mass[i],
+                    p.inv_inertia[i],
+                    &p.velocity[i],
+                    &p.angular_velocity[i],
+                    &p.position[i],
+                    &g,
+                );
+                kin += k;
+                pot += u;
             }
             *e = [kin, pot];
         });
+        self.ledger_energies_from_blocks();
+    }
+
+    /// Kinetic and potential energy of the ledger: the per-block sums of `scratch_energy`,
+    /// added in block order.
+    pub(crate) fn ledger_energies_from_blocks(&mut self) {
         let (mut kin, mut pot) = (0.0, 0.0);
-        for e in sums.iter() {
+        for e in self.scratch_energy.iter() {
             kin += e[0];
             pot += e[1];
         }
