@@ -302,6 +302,10 @@ impl World {
 /// How many pairs ahead the pair loop prefetches partner data.
 const PREFETCH_AHEAD: usize = 8;
 
+/// Hertz–Mindlin contacts gathered before a block evaluation (a multiple of [`LANES`]; the
+/// gathered lanes stay in the L1 cache until the kernel and the hand-out read them).
+const BATCH_FLUSH: usize = 2 * LANES;
+
 /// Hints the processor to load the cache line of `x` (no effect on other targets).
 #[inline(always)]
 fn prefetch<T>(x: &T) {
@@ -694,6 +698,9 @@ impl PairContext<'_> {
                     &slab[s as usize].state,
                     s,
                 );
+                if batch.len == BATCH_FLUSH {
+                    batch.flush(self.kernel, dt, slab, acc, &mut sum);
+                }
                 continue;
             }
             let touching = interacts(p, interactions, reach, i, j, dist);
