@@ -938,6 +938,7 @@ impl World {
             interactions,
             neighbors,
             cross_out,
+            block_loads,
             block_start,
             chunk_block,
             wall_list,
@@ -1040,6 +1041,7 @@ impl World {
         );
         let nblocks = force_blocks(nl, pp_chunks, wall_list, n, block_start, chunk_block);
         cross_out.resize_with(nblocks * nblocks, Vec::new);
+        block_loads.resize_with(nblocks, Vec::new);
         let block_start = &*block_start;
         let chunk_block = &*chunk_block;
         let bodies_ref = &*bodies;
@@ -1054,6 +1056,7 @@ impl World {
                 torque: &'a mut [Vec3],
                 slots: &'a mut [Vec<WallSlot>],
                 cross: &'a mut [Vec<SecondOutput>],
+                loads: &'a mut Vec<(Vec3, Vec3)>,
             }
             let mut parts: Vec<BlockParts> = Vec::with_capacity(nblocks);
             let (mut rest_k, mut rest_c, mut rest_f, mut rest_t, mut rest_s, mut rest_x) = (
@@ -1064,7 +1067,7 @@ impl World {
                 &mut wall_slots[..],
                 &mut cross_out[..],
             );
-            for b in 0..nblocks {
+            for (b, loads) in block_loads.iter_mut().enumerate().take(nblocks) {
                 let (c0, c1) = (block_start[b], block_start[b + 1]);
                 let (lo, hi) = ((c0 * PP_CHUNK).min(n), (c1 * PP_CHUNK).min(n));
                 let pairs = (nl.row_start[hi] - nl.row_start[lo]) as usize;
@@ -1081,6 +1084,7 @@ impl World {
                     torque: t,
                     slots: w,
                     cross: x,
+                    loads,
                 });
                 (rest_k, rest_c, rest_f, rest_t, rest_s, rest_x) = (kr, cr, fr, tr, wr, xr_);
             }
@@ -1104,6 +1108,8 @@ impl World {
                         ext += p.external_force[i].dot(&p.velocity[i]) * dt;
                     }
                     part.cross.iter_mut().for_each(Vec::clear);
+                    part.loads.clear();
+                    part.loads.resize(bodies_ref.len(), (Vec3::zeros(), Vec3::zeros()));
                     let mut acc = BlockAcc {
                         lo,
                         hi,
@@ -1172,6 +1178,14 @@ impl World {
                                     &mut acc.torque[a],
                                     &mut walls,
                                 );
+                                // Loads on the bodies, in particle order.
+                                for s in &part.slots[a] {
+                                    let b = &bodies_ref[s.body as usize];
+                                    let l = &mut part.loads[s.body as usize];
+                                    l.0 -= s.force;
+                                    l.1 += (s.point - b.state.position_m).cross(&(-s.force))
+                                        - s.rolling_torque;
+                                }
                                 w += 1;
                             }
                         }
@@ -1214,8 +1228,6 @@ impl World {
                     }
                 });
         }
-        let pp: Vec<(f64, f64, f64)> = pp_chunks.iter().map(|c| c.sums).collect();
-
         std::mem::swap(&mut self.particles.force, &mut force);
         std::mem::swap(&mut self.particles.torque, &mut torque);
         self.scratch_force = force;
@@ -1223,22 +1235,18 @@ impl World {
 
         self.tock(t_particles, |p| &mut p.particle_forces_s);
         let t_loads = self.tick();
-        // 3. Loads on rigid bodies, summed in particle order (deterministic).
-        for b in self.bodies.iter_mut() {
+        // 3. Loads on rigid bodies: the blocks' sums (each in particle order), in block order.
+        for (k, b) in self.bodies.iter_mut().enumerate() {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
-        }
-        for &i in &self.wall_list {
-            for s in &self.wall_slots[i as usize] {
-                let b = &mut self.bodies[s.body as usize];
-                b.contact_force_n -= s.force;
-                b.contact_torque_nm +=
-                    (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
+            for l in &self.block_loads[..nblocks] {
+                b.contact_force_n += l[k].0;
+                b.contact_torque_nm += l[k].1;
             }
         }
 
         let mut inc = EnergyIncrements::default();
-        for (dn, dtan, el) in pp {
+        for &(dn, dtan, el) in self.pp_chunks.iter().map(|c| &c.sums) {
             inc.dissipated_normal_pp_j += dn;
             inc.dissipated_tangential_pp_j += dtan;
             inc.elastic_j += el;

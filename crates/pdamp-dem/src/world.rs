@@ -73,6 +73,9 @@ pub struct World {
     /// (see `force_blocks`): list `b × K + b'` holds those of block `b` for block `b'`, in
     /// pair-loop order.
     pub(crate) cross_out: Vec<Vec<crate::forces::SecondOutput>>,
+    /// Contact force and torque on every rigid body from the wall contacts of each block of
+    /// the pair pass (`K` lists of one entry per body), added in block order.
+    pub(crate) block_loads: Vec<Vec<(Vec3, Vec3)>>,
     /// First chunk of every block of the pair pass, and the end (`K + 1` entries).
     pub(crate) block_start: Vec<usize>,
     /// Block of every chunk of first partners.
@@ -154,6 +157,7 @@ impl World {
             profile: None,
             neighbors: NeighborList::new(0.0),
             cross_out: Vec::new(),
+            block_loads: Vec::new(),
             block_start: Vec::new(),
             chunk_block: Vec::new(),
             wall_list: Vec::new(),
