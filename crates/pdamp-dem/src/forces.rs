@@ -418,10 +418,11 @@ struct PairContext<'a> {
     kernel: crate::hm_block::Kernel,
 }
 
-/// Hertz–Mindlin contacts collected for evaluation in blocks (see [`crate::hm_block`]): all
-/// contacts of a chunk are gathered first, then evaluated block by block, then handed out, so
-/// that the kernel reads lanes written long before (no stalled store-to-load forwarding) and the
-/// gather loop keeps many independent loads in flight. Scratch of a chunk; grows, never shrinks.
+/// Hertz–Mindlin contacts collected for evaluation in blocks (see [`crate::hm_block`]):
+/// [`BATCH_FLUSH`] contacts are gathered first, then evaluated block by block, then handed out,
+/// so that the kernel reads lanes written a while before (no stalled store-to-load forwarding),
+/// the gather loop keeps many independent loads in flight, and the lanes stay in the L1 cache.
+/// Scratch of a chunk; grows, never shrinks.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct HmBatch {
     inp: Vec<HmInput>,
