@@ -690,6 +690,7 @@ impl PairContext<'_> {
                 } else {
                     slot
                 };
+                acc.prefetch_second(j);
                 batch.push(
                     hm,
                     (i, j),
@@ -765,6 +766,16 @@ impl BlockAcc<'_> {
         let a = i - self.lo;
         self.force[a] += force;
         self.torque[a] += torque;
+    }
+
+    /// Starts loading the force and torque sums of the second partner `j` (added to by a later
+    /// flush of the batch; they are mostly not in L1).
+    #[inline(always)]
+    fn prefetch_second(&self, j: usize) {
+        if j < self.hi {
+            prefetch(&self.force[j - self.lo]);
+            prefetch(&self.torque[j - self.lo]);
+        }
     }
 
     /// Adds the share of the second partner `j`: the opposite force, and its torque.
