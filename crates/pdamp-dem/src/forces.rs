@@ -674,11 +674,10 @@ impl PairContext<'_> {
             let ([xi0, xi1, xi2, ri0], [xj0, xj1, xj2, rj]) = (xr[i], xr[j]);
             let d = Vec3::new(xi0 - xj0, xi1 - xj1, xi2 - xj2);
             let dist2 = d.norm_squared();
-            let dist = dist2.sqrt();
             let cut = ri0 + rj;
             if reach <= 0.0
                 && dist2 < cut * cut
-                && dist > 0.0
+                && dist2 > 0.0
                 && let Some(hm) = self
                     .uniform
                     .or_else(|| interactions.hm_fast(p.material[i], p.material[j]))
@@ -705,6 +704,7 @@ impl PairContext<'_> {
                 }
                 continue;
             }
+            let dist = dist2.sqrt();
             let touching = interacts(p, interactions, reach, i, j, dist);
             if !touching && slot == NO_CONTACT {
                 continue;
@@ -1121,7 +1121,8 @@ impl World {
                     }
                     part.cross.iter_mut().for_each(Vec::clear);
                     part.loads.clear();
-                    part.loads.resize(bodies_ref.len(), (Vec3::zeros(), Vec3::zeros()));
+                    part.loads
+                        .resize(bodies_ref.len(), (Vec3::zeros(), Vec3::zeros()));
                     let mut acc = BlockAcc {
                         lo,
                         hi,
