@@ -187,6 +187,13 @@ mod tests {
     use std::sync::Arc;
 
     fn shaken_box(n_side: usize) -> World {
+        shaken_box_sized(n_side, Vec3::new(0.01, 0.01, 0.02))
+    }
+
+    /// A lattice of `n_side`³ steel spheres (r = 1 mm, spacing 2.2 mm, random velocities) in a
+    /// box of half-extents `half` shaken vertically, the lattice starting one radius from the
+    /// walls at the low corner.
+    fn shaken_box_sized(n_side: usize, half: Vec3) -> World {
         let steel = Material::new("steel", 7850.0, 2.1e11, 0.3);
         let model = ContactModel {
             normal: NormalLaw::HertzMindlin {
@@ -214,7 +221,7 @@ mod tests {
         body.walls.push(Wall {
             geometry: Geometry::BoxInside(BoxInside {
                 center_m: Vec3::zeros(),
-                half_extents_m: Vec3::new(0.01, 0.01, 0.02),
+                half_extents_m: half,
             }),
             material: 0,
             name: "box".into(),
@@ -225,9 +232,9 @@ mod tests {
             for j in 0..n_side {
                 for k in 0..n_side {
                     let x = Vec3::new(
-                        -0.008 + 2.2 * r * i as f64 + 1e-5 * k as f64,
-                        -0.008 + 2.2 * r * j as f64,
-                        -0.018 + 2.2 * r * k as f64,
+                        -half.x + 2.0 * r + 2.2 * r * i as f64 + 1e-5 * k as f64,
+                        -half.y + 2.0 * r + 2.2 * r * j as f64,
+                        -half.z + 2.0 * r + 2.2 * r * k as f64,
                     );
                     let id = w.add_particle(x, r, 0);
                     let s = id as f64;
@@ -261,6 +268,42 @@ mod tests {
         assert_eq!(a.particles.angular_velocity, b.particles.angular_velocity);
         assert_eq!(a.ledger, b.ledger);
         assert_eq!(a.bodies[0].contact_force_n, b.bodies[0].contact_force_n);
+    }
+
+    /// The loads of the bed on the box, summed per block of the pair pass and the blocks added
+    /// in order, close the momentum balance of the particles: over a run of velocity Verlet the
+    /// change of their momentum equals gravity's impulse minus the impulse of the box loads
+    /// (trapezoidal rule, which is what velocity Verlet integrates), to round-off. 4 096
+    /// spheres, so that the pair pass has several blocks; a block whose loads were lost or
+    /// counted twice would miss by a share of the wall impulse.
+    #[test]
+    fn body_loads_close_the_momentum_balance() {
+        let mut w = shaken_box_sized(16, Vec3::new(0.0185, 0.0185, 0.02));
+        let momentum = |w: &World| {
+            (0..w.particles.len()).fold(Vec3::zeros(), |a, i| {
+                a + w.particles.velocity[i] * w.particles.mass[i]
+            })
+        };
+        w.step();
+        assert!(w.block_start.len() - 1 >= 2, "{:?}", w.block_start);
+        let m_total: f64 = w.particles.mass.iter().sum();
+        let (p0, dt, steps) = (momentum(&w), w.dt_s, 8000);
+        let (mut f_prev, mut impulse) = (w.bodies[0].contact_force_n, Vec3::zeros());
+        for _ in 0..steps {
+            w.step();
+            let f = w.bodies[0].contact_force_n;
+            impulse += (f_prev + f) * (0.5 * dt);
+            f_prev = f;
+        }
+        let gravity_impulse = w.gravity_m_s2 * (m_total * dt * steps as f64);
+        let dp = momentum(&w) - p0;
+        let miss = (dp - (gravity_impulse - impulse)).norm();
+        // the walls matter: their impulse is larger than gravity's
+        assert!(impulse.norm() > gravity_impulse.norm(), "{impulse:?}");
+        assert!(
+            miss <= 1e-9 * impulse.norm(),
+            "momentum change {dp:?}, gravity {gravity_impulse:?}, box {impulse:?}, miss {miss:e}"
+        );
     }
 
     /// Restoring a snapshot after `first` steps and running `second` more equals running
