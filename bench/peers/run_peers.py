@@ -155,15 +155,20 @@ def main():
         case = os.path.join(d, "liggghts")
         print(f"N = {n}: settling (once) and writing the LIGGGHTS case ...", file=sys.stderr)
         run_pdamp(exe, n, args.steps, max(int(t) for t in args.threads.split(",")), settled, case)
-        for t in [int(x) for x in args.threads.split(",")]:
-            best_p, best_l = None, None
-            for _ in range(args.repeat):
+        # All thread counts within every repeat, so that each configuration sees the machine
+        # in the same states (its speed drifts over minutes on a shared VM); best time kept.
+        threads = [int(x) for x in args.threads.split(",")]
+        best = {t: [None, None] for t in threads}
+        for _ in range(args.repeat):
+            for t in threads:
                 p = run_pdamp(exe, n, args.steps, t, settled)
                 l = run_liggghts(case, t)
-                if best_p is None or p["wall_time_s"] < best_p["wall_time_s"]:
-                    best_p = p
-                if best_l is None or l["wall_time_s"] < best_l["wall_time_s"]:
-                    best_l = l
+                if best[t][0] is None or p["wall_time_s"] < best[t][0]["wall_time_s"]:
+                    best[t][0] = p
+                if best[t][1] is None or l["wall_time_s"] < best[t][1]["wall_time_s"]:
+                    best[t][1] = l
+        for t in threads:
+            best_p, best_l = best[t]
             ratio = best_p["particle_steps_per_s"] / best_l["particle_steps_per_s"]
             diff = best_p["dissipated_power_w"] / best_l["dissipated_power_w"] - 1.0
             row = {"particles": n, "threads": t, "steps": args.steps, "pdamp": best_p,

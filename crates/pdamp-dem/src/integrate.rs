@@ -81,6 +81,14 @@ impl World {
         // loop of the force evaluation (one pass over the particles less).
         self.scratch_xr.resize(n, [0.0; 4]);
         self.scratch_kin.resize(n, Kin::default());
+        // The largest squared displacement since the last neighbour build is taken in the same
+        // pass, per chunk: the list is sure to be valid while twice the largest displacement
+        // stays below the skin (see `World::update_neighbors_given`).
+        let reference = &self.neighbors.reference_position;
+        let check = reference.len() == n && self.neighbors.builds > 0;
+        let tops = &mut self.scratch_top;
+        tops.clear();
+        tops.resize(n.div_ceil(PASS_CHUNK), 0.0);
         {
             let crate::particles::ParticleSet {
                 position,
@@ -101,8 +109,10 @@ impl World {
                 .zip(angular_velocity.par_chunks_mut(PASS_CHUNK))
                 .zip(self.scratch_xr.par_chunks_mut(PASS_CHUNK))
                 .zip(self.scratch_kin.par_chunks_mut(PASS_CHUNK))
+                .zip(tops.par_iter_mut())
                 .enumerate()
-                .for_each(|(c, ((((xs, vs), ws), xrs), ks))| {
+                .for_each(|(c, (((((xs, vs), ws), xrs), ks), top))| {
+                    let mut t = 0.0f64;
                     for (k, (((x, v), w), (xr, kin))) in xs
                         .iter_mut()
                         .zip(vs.iter_mut())
@@ -117,13 +127,19 @@ impl World {
                         *x += *v * dt;
                         *xr = [x.x, x.y, x.z, radius[i]];
                         *kin = Kin::new(v, m, w);
+                        if check {
+                            let d2 = (*x - reference[i]).norm_squared();
+                            t = if d2 > t { d2 } else { t };
+                        }
                     }
+                    *top = t;
                 });
         }
+        let top = self.scratch_top.iter().fold(0.0f64, |a, &b| a.max(b));
         self.packed = true;
         self.advance_bodies(dt);
         self.tock(t, |p| &mut p.integrate_s);
-        self.update_neighbors();
+        self.update_neighbors_given(check.then_some(top));
         let inc = self.evaluate_forces(dt);
         self.counters.force_evaluations += 1;
         let t = self.tick();

@@ -4,9 +4,8 @@
 //! the new list.
 //!
 //! The list is a half list in compressed rows: for particle `i`, the partners `j > i` in
-//! ascending order. A transposed index lets every particle gather the forces of the pairs in
-//! which it is the second partner, so forces are summed in a fixed order (deterministic for any
-//! thread count).
+//! ascending order (the pair pass sums both partners' forces in a fixed order, see
+//! `forces::force_blocks`).
 
 use crate::math::Vec3;
 use rayon::prelude::*;
@@ -24,14 +23,21 @@ pub struct NeighborList {
     pub first: Vec<u32>,
     /// Second partner `j > i` of each pair.
     pub second: Vec<u32>,
-    /// For every particle `j`: range into `col_pairs` of the pairs where it is second.
-    pub col_start: Vec<u32>,
-    /// Pair indices grouped by second partner.
-    pub col_pairs: Vec<u32>,
     /// Positions at the last build, m.
     pub reference_position: Vec<Vec3>,
     /// Number of builds so far.
     pub builds: u64,
+}
+
+/// The two largest of four values, largest first: merges the top two of two sets (exact, in any
+/// order of merging).
+#[inline]
+pub fn top_two(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    if a[0] >= b[0] {
+        [a[0], a[1].max(b[0])]
+    } else {
+        [b[0], b[1].max(a[0])]
+    }
 }
 
 impl NeighborList {
@@ -54,31 +60,19 @@ impl NeighborList {
         if self.reference_position.len() != position.len() || self.builds == 0 {
             return true;
         }
-        let (a, b) = position
+        let top = position
             .par_iter()
             .zip(self.reference_position.par_iter())
             .map(|(x, x0)| (x - x0).norm_squared())
-            .fold(
-                || (0.0f64, 0.0f64),
-                |(a, b), d| {
-                    if d > a {
-                        (d, a)
-                    } else if d > b {
-                        (a, d)
-                    } else {
-                        (a, b)
-                    }
-                },
-            )
-            .reduce(
-                || (0.0, 0.0),
-                |(a1, b1), (a2, b2)| {
-                    let mut v = [a1, b1, a2, b2];
-                    v.sort_by(|x, y| y.total_cmp(x));
-                    (v[0], v[1])
-                },
-            );
-        a.sqrt() + b.sqrt() >= self.skin_m
+            .fold(|| [0.0f64; 2], |top, d| top_two(top, [d, 0.0]))
+            .reduce(|| [0.0; 2], top_two);
+        self.exceeds_skin(top)
+    }
+
+    /// True if the two largest displacements since the last build, given squared as
+    /// `top = [d1², d2²]` (see [`top_two`]), sum to at least the skin [D Eq. 2.11].
+    pub fn exceeds_skin(&self, top: [f64; 2]) -> bool {
+        top[0].sqrt() + top[1].sqrt() >= self.skin_m
     }
 
     /// Rebuilds the list with a cell grid. (Contact history is not stored here: the world keeps
@@ -133,24 +127,6 @@ impl NeighborList {
                 self.row_start.push(self.second.len() as u32);
                 i += 1;
             }
-        }
-
-        let m = self.second.len();
-        // Transposed index (counting sort by second partner, stable in pair order).
-        self.col_start.clear();
-        self.col_start.resize(n + 1, 0);
-        for &j in &self.second {
-            self.col_start[j as usize + 1] += 1;
-        }
-        for k in 0..n {
-            self.col_start[k + 1] += self.col_start[k];
-        }
-        self.col_pairs.clear();
-        self.col_pairs.resize(m, 0);
-        let mut fill = self.col_start.clone();
-        for (p, &j) in self.second.iter().enumerate() {
-            self.col_pairs[fill[j as usize] as usize] = p as u32;
-            fill[j as usize] += 1;
         }
 
         self.reference_position.clear();
@@ -260,6 +236,24 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
+    /// Merging top-two pairs in any grouping gives the two largest values.
+    #[test]
+    fn top_two_merges_exactly() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        for _ in 0..200 {
+            let v: Vec<f64> = (0..rng.random_range(1..40))
+                .map(|_| rng.random::<f64>())
+                .collect();
+            let mut sorted = v.clone();
+            sorted.sort_by(|a, b| b.total_cmp(a));
+            let want = [sorted[0], sorted.get(1).copied().unwrap_or(0.0)];
+            let cut = rng.random_range(0..=v.len());
+            let part = |s: &[f64]| s.iter().fold([0.0; 2], |t, &d| top_two(t, [d, 0.0]));
+            assert_eq!(top_two(part(&v[..cut]), part(&v[cut..])), want);
+            assert_eq!(top_two(part(&v[cut..]), part(&v[..cut])), want);
+        }
+    }
+
     #[test]
     fn grid_build_terminates_on_non_finite_positions() {
         let pos = vec![
@@ -306,14 +300,5 @@ mod tests {
             .zip(list.second.iter().cloned())
             .collect();
         assert_eq!(got, brute);
-        // Transposed index covers every pair once.
-        let mut seen = vec![0; list.num_pairs()];
-        for j in 0..n {
-            for &p in &list.col_pairs[list.col_start[j] as usize..list.col_start[j + 1] as usize] {
-                assert_eq!(list.second[p as usize] as usize, j);
-                seen[p as usize] += 1;
-            }
-        }
-        assert!(seen.iter().all(|&c| c == 1));
     }
 }

@@ -276,6 +276,43 @@ mod tests {
     /// (trapezoidal rule, which is what velocity Verlet integrates), to round-off. 4 096
     /// spheres, so that the pair pass has several blocks; a block whose loads were lost or
     /// counted twice would miss by a share of the wall impulse.
+    /// The drift's shortcut (no second look while twice the largest displacement stays below
+    /// the skin) rebuilds the neighbour list exactly when the two largest displacements reach
+    /// the skin [D Eq. 2.11], including the cases where only the shortcut's bound is exceeded.
+    #[test]
+    fn drift_shortcut_keeps_the_exact_rebuild_criterion() {
+        let mut w = shaken_box(4);
+        w.initialize();
+        let skin = w.neighbors.skin_m;
+        assert!(skin > 0.0);
+        // (a, b): the two displacements as fractions of the skin.
+        for &(a, b) in &[
+            (0.3, 0.3),
+            (0.55, 0.1),
+            (0.49, 0.49),
+            (0.6, 0.45),
+            (0.2, 0.9),
+            (0.0, 0.0),
+        ] {
+            let x0 = w.neighbors.reference_position.clone();
+            w.particles.position.clone_from(&x0);
+            w.particles.position[3].x += a * skin;
+            w.particles.position[17].y -= b * skin;
+            let max_d2 = w
+                .particles
+                .position
+                .iter()
+                .zip(&x0)
+                .map(|(x, r)| (x - r).norm_squared())
+                .fold(0.0, f64::max);
+            let exact = w.neighbors.needs_rebuild(&w.particles.position);
+            assert_eq!(exact, a + b >= 1.0, "({a}, {b})");
+            let before = w.neighbors.builds;
+            w.update_neighbors_given(Some(max_d2));
+            assert_eq!(w.neighbors.builds > before, exact, "({a}, {b})");
+        }
+    }
+
     #[test]
     fn body_loads_close_the_momentum_balance() {
         let mut w = shaken_box_sized(16, Vec3::new(0.0185, 0.0185, 0.02));

@@ -105,6 +105,9 @@ pub struct World {
     pub(crate) scratch_energy: Vec<[f64; 2]>,
     /// Positions and radii packed per particle for the pair loop (scratch).
     pub(crate) scratch_xr: Vec<[f64; 4]>,
+    /// Largest squared displacement since the last neighbour build, per chunk of the drift
+    /// (scratch).
+    pub(crate) scratch_top: Vec<f64>,
     /// Velocities, masses and spins packed per particle for the pair loop (scratch).
     pub(crate) scratch_kin: Vec<crate::forces::Kin>,
     pub(crate) scratch_torque: Vec<Vec3>,
@@ -172,6 +175,7 @@ impl World {
             scratch_force: Vec::new(),
             scratch_energy: Vec::new(),
             scratch_xr: Vec::new(),
+            scratch_top: Vec::new(),
             scratch_kin: Vec::new(),
             scratch_torque: Vec::new(),
             gear: None,
@@ -390,24 +394,33 @@ impl World {
 
     /// Rebuilds the neighbour list when the displacement criterion asks for it.
     pub(crate) fn update_neighbors(&mut self) {
+        self.update_neighbors_given(None);
+    }
+
+    /// [`World::update_neighbors`], knowing the largest squared displacement since the last
+    /// build (`max_d2`, m²): while twice the largest displacement stays below the skin, the
+    /// two largest cannot reach it [D Eq. 2.11] and the particles need not be visited again;
+    /// otherwise the exact criterion decides.
+    pub(crate) fn update_neighbors_given(&mut self, max_d2: Option<f64>) {
         let t = self.tick();
-        self.update_neighbors_untimed();
+        let surely_valid = max_d2.is_some_and(|d2| 2.0 * d2.sqrt() < self.neighbors.skin_m);
+        if !surely_valid && self.neighbors.needs_rebuild(&self.particles.position) {
+            self.rebuild_neighbors();
+        }
         self.tock(t, |p| &mut p.neighbors_s);
     }
 
-    fn update_neighbors_untimed(&mut self) {
-        if self.neighbors.needs_rebuild(&self.particles.position) {
-            // Contacts are attached to the pairs of the list: take them off, rebuild, put them
-            // back onto the new pairs (in (i, j) order, which also compacts the slabs).
-            let mut contacts = std::mem::take(&mut self.remap_scratch);
-            contacts.clear();
-            self.collect_pp_contacts(&mut contacts);
-            self.neighbors
-                .rebuild(&self.particles.position, &self.particles.radius);
-            self.set_pp_contacts(&contacts);
-            self.remap_scratch = contacts;
-            self.counters.neighbor_builds += 1;
-        }
+    fn rebuild_neighbors(&mut self) {
+        // Contacts are attached to the pairs of the list: take them off, rebuild, put them
+        // back onto the new pairs (in (i, j) order, which also compacts the slabs).
+        let mut contacts = std::mem::take(&mut self.remap_scratch);
+        contacts.clear();
+        self.collect_pp_contacts(&mut contacts);
+        self.neighbors
+            .rebuild(&self.particles.position, &self.particles.radius);
+        self.set_pp_contacts(&contacts);
+        self.remap_scratch = contacts;
+        self.counters.neighbor_builds += 1;
     }
 
     /// Recomputes kinetic and potential energy in the ledger from the state.

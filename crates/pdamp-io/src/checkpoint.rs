@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 
 /// Format version of the checkpoint file; bumped when the layout changes.
-pub const CHECKPOINT_FORMAT: u32 = 1;
+pub const CHECKPOINT_FORMAT: u32 = 2;
 
 static STOP: AtomicBool = AtomicBool::new(false);
 static STOPPABLE: AtomicBool = AtomicBool::new(false);
@@ -178,17 +178,24 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
     if digest(data).as_bytes() != sum {
         return Err("damaged (digest mismatch)".into());
     }
-    let f: InFile<T> = bincode::DefaultOptions::new()
+    let options = bincode::DefaultOptions::new()
         .with_fixint_encoding()
-        .with_limit(data.len() as u64)
+        .with_limit(data.len() as u64);
+    // The header first: a file of another format (another body layout) is named as such
+    // instead of failing somewhere in its body.
+    let header: CheckpointHeader = options
+        .allow_trailing_bytes()
         .deserialize(&data[MAGIC.len()..])
         .map_err(|e| format!("unreadable ({e})"))?;
-    if f.header.format != CHECKPOINT_FORMAT {
+    if header.format != CHECKPOINT_FORMAT {
         return Err(format!(
             "format {} written by pdamp {}, this pdamp reads format {CHECKPOINT_FORMAT}",
-            f.header.format, f.header.pdamp_version
+            header.format, header.pdamp_version
         ));
     }
+    let f: InFile<T> = options
+        .deserialize(&data[MAGIC.len()..])
+        .map_err(|e| format!("unreadable ({e})"))?;
     if f.header.kind != kind {
         return Err(format!(
             "written by a '{}' run, not '{kind}'",
@@ -270,6 +277,18 @@ mod tests {
         std::fs::write(&p, b"garbage").unwrap();
         let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
         assert!(e.contains("not a pdamp checkpoint"), "{e}");
+        // A file of an older format whose body no longer parses is named by its format.
+        let mut old = CheckpointHeader::new("run", "abc");
+        old.format = CHECKPOINT_FORMAT - 1;
+        save(&p, &old, &(7u8,)).unwrap();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        assert!(
+            e.contains(&format!(
+                "format {} written by pdamp",
+                CHECKPOINT_FORMAT - 1
+            )),
+            "{e}"
+        );
         assert!(
             load::<u8>(&dir.join("none.bin"), "run", "abc")
                 .unwrap()
