@@ -63,6 +63,31 @@ pub(crate) struct SecondOutput {
     second: u32,
 }
 
+/// The forces and torques that second partners receive from earlier blocks of the pair pass:
+/// the lists `cross_out` of the last evaluation (list `a × C + c`: those of block `a` for chunk
+/// `c` of first partners), see `force_blocks`.
+pub(crate) struct SecondShares<'a> {
+    pub(crate) lists: &'a [Vec<SecondOutput>],
+    /// Block of every chunk.
+    pub(crate) chunk_block: &'a [u32],
+}
+
+impl SecondShares<'_> {
+    /// Adds the shares of chunk `c` (particles `c × PP_CHUNK ..`) to its `force` and `torque`:
+    /// those of the earliest block first, each list in pair-loop order.
+    #[inline]
+    pub(crate) fn add_to_chunk(&self, c: usize, force: &mut [Vec3], torque: &mut [Vec3]) {
+        let (lo, nchunks) = (c * PP_CHUNK, self.chunk_block.len());
+        for a in 0..self.chunk_block[c] as usize {
+            for o in &self.lists[a * nchunks + c] {
+                let k = o.second as usize - lo;
+                force[k] -= o.force;
+                torque[k] += o.torque;
+            }
+        }
+    }
+}
+
 /// Work bookkeeping of one contact evaluation; returns (dissipated normal, dissipated tangential).
 #[inline]
 #[allow(clippy::too_many_arguments)]
@@ -753,10 +778,8 @@ pub(crate) struct BlockAcc<'a> {
     hi: usize,
     force: &'a mut [Vec3],
     torque: &'a mut [Vec3],
-    /// Outgoing lists of this block, by target block.
+    /// Outgoing lists of this block, by target chunk.
     cross: &'a mut [Vec<SecondOutput>],
-    /// Block of every chunk of first partners.
-    chunk_block: &'a [u32],
 }
 
 impl BlockAcc<'_> {
@@ -786,8 +809,7 @@ impl BlockAcc<'_> {
             self.force[a] -= force;
             self.torque[a] += torque;
         } else {
-            let b = self.chunk_block[j / PP_CHUNK] as usize;
-            self.cross[b].push(SecondOutput {
+            self.cross[j / PP_CHUNK].push(SecondOutput {
                 force,
                 torque,
                 second: j as u32,
@@ -945,6 +967,14 @@ impl World {
     /// state (0 for the initial evaluation): it integrates history variables and contact work.
     /// Returns the energy increments of this evaluation.
     pub(crate) fn evaluate_forces(&mut self, dt: f64) -> EnergyIncrements {
+        self.evaluate_forces_with(dt, false)
+    }
+
+    /// [`World::evaluate_forces`]; with `defer_shares`, the forces and torques that second
+    /// partners receive from earlier blocks of the pair pass are left for the caller to add,
+    /// chunk by chunk, with [`SecondShares`] (before anything reads the forces): the second
+    /// half-kick of velocity Verlet does, one parallel loop less.
+    pub(crate) fn evaluate_forces_with(&mut self, dt: f64, defer_shares: bool) -> EnergyIncrements {
         let t_pairs = self.tick();
         let World {
             particles: p,
@@ -1053,7 +1083,7 @@ impl World {
             wall_list,
         );
         let nblocks = force_blocks(nl, pp_chunks, wall_list, n, block_start, chunk_block);
-        cross_out.resize_with(nblocks * nblocks, Vec::new);
+        cross_out.resize_with(nblocks * nchunks, Vec::new);
         block_loads.resize_with(nblocks, Vec::new);
         let block_start = &*block_start;
         let chunk_block = &*chunk_block;
@@ -1089,7 +1119,7 @@ impl World {
                 let (f, fr) = rest_f.split_at_mut(hi - lo);
                 let (t, tr) = rest_t.split_at_mut(hi - lo);
                 let (w, wr) = rest_s.split_at_mut(hi - lo);
-                let (x, xr_) = rest_x.split_at_mut(nblocks);
+                let (x, xr_) = rest_x.split_at_mut(nchunks);
                 parts.push(BlockParts {
                     chunks: k,
                     pc: c,
@@ -1130,7 +1160,6 @@ impl World {
                         force: part.force,
                         torque: part.torque,
                         cross: part.cross,
-                        chunk_block,
                     };
                     let ctx = PairContext {
                         p,
@@ -1212,35 +1241,18 @@ impl World {
         if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
             pr.pair_forces_s += t.elapsed().as_secs_f64();
         }
-        // Shares of second partners from earlier blocks, the earliest first.
-        {
-            let mut parts: Vec<(&mut [Vec3], &mut [Vec3])> = Vec::with_capacity(nblocks);
-            let (mut rest_f, mut rest_t) = (&mut force[..], &mut torque[..]);
-            for b in 0..nblocks {
-                let (lo, hi) = (
-                    (block_start[b] * PP_CHUNK).min(n),
-                    (block_start[b + 1] * PP_CHUNK).min(n),
-                );
-                let (f, fr) = rest_f.split_at_mut(hi - lo);
-                let (t, tr) = rest_t.split_at_mut(hi - lo);
-                parts.push((f, t));
-                (rest_f, rest_t) = (fr, tr);
-            }
-            let cross_out = &*cross_out;
-            parts
-                .into_par_iter()
+        // Shares of second partners from earlier blocks, the earliest first (or, with
+        // `defer_shares`, by the caller, see [`SecondShares`]).
+        if !defer_shares {
+            let shares = SecondShares {
+                lists: cross_out,
+                chunk_block,
+            };
+            force
+                .par_chunks_mut(PP_CHUNK)
+                .zip(torque.par_chunks_mut(PP_CHUNK))
                 .enumerate()
-                .skip(1)
-                .for_each(|(b, (f, t))| {
-                    let lo = (block_start[b] * PP_CHUNK).min(n);
-                    for a in 0..b {
-                        for o in &cross_out[a * nblocks + b] {
-                            let k = o.second as usize - lo;
-                            f[k] -= o.force;
-                            t[k] += o.torque;
-                        }
-                    }
-                });
+                .for_each(|(c, (f, t))| shares.add_to_chunk(c, f, t));
         }
         std::mem::swap(&mut self.particles.force, &mut force);
         std::mem::swap(&mut self.particles.torque, &mut torque);
@@ -1552,7 +1564,6 @@ mod tests {
             force: &mut rf,
             torque: &mut rt,
             cross: &mut [],
-            chunk_block: &[0],
         };
         batch.flush(kernel, dt, &mut slab, &mut acc, &mut sums);
         *st = slab[0].state;

@@ -2,7 +2,7 @@
 //! step-size controller of Meyer & Seifried [D Sect. 2.5, Eq. 2.95–2.106, Tab. 2.2/2.3].
 
 use crate::energy::EnergyIncrements;
-use crate::forces::{Kin, PpContact, WallSlot};
+use crate::forces::{Kin, PpContact, SecondShares, WallSlot};
 use crate::math::Vec3;
 use crate::world::{ENERGY_BLOCK, World, particle_energy};
 use rayon::prelude::*;
@@ -53,6 +53,9 @@ pub enum Integrator {
 /// Gear corrector coefficients for order p = 5 [D Tab. 2.2].
 /// Particles per task of the drift pass.
 const PASS_CHUNK: usize = 1024;
+
+/// Energy blocks per task of the second half-kick, at least.
+const KICK_TASK_CHUNKS: usize = 8;
 
 const GEAR5: [f64; 5] = [19.0 / 90.0, 3.0 / 4.0, 1.0, 1.0 / 2.0, 1.0 / 12.0];
 
@@ -140,29 +143,43 @@ impl World {
         self.advance_bodies(dt);
         self.tock(t, |p| &mut p.integrate_s);
         self.update_neighbors_given(check.then_some(top));
-        let inc = self.evaluate_forces(dt);
+        let inc = self.evaluate_forces_with(dt, true);
         self.counters.force_evaluations += 1;
         let t = self.tick();
-        // Second half kick, with the kinetic and potential energy of the new state summed in
-        // the blocks of `refresh_state_energies` (the same numbers, one pass less).
+        // Second half kick, chunk by chunk after the chunk's shares from earlier blocks of the
+        // pair pass (left out by the force evaluation: one parallel loop less), with the
+        // kinetic and potential energy of the new state summed in the blocks of
+        // `refresh_state_energies` (the same numbers, one pass less again).
         let g = self.gravity_m_s2;
         let p = &mut self.particles;
         let sums = &mut self.scratch_energy;
         sums.clear();
         sums.resize(n.div_ceil(ENERGY_BLOCK), [0.0; 2]);
-        let (force, torque, mass, inv_inertia, position) =
-            (&p.force, &p.torque, &p.mass, &p.inv_inertia, &p.position);
+        let shares = SecondShares {
+            lists: &self.cross_out,
+            chunk_block: &self.chunk_block,
+        };
+        let (mass, inv_inertia, position) = (&p.mass, &p.inv_inertia, &p.position);
         p.velocity
             .par_chunks_mut(ENERGY_BLOCK)
             .zip(p.angular_velocity.par_chunks_mut(ENERGY_BLOCK))
+            .zip(p.force.par_chunks_mut(ENERGY_BLOCK))
+            .zip(p.torque.par_chunks_mut(ENERGY_BLOCK))
             .zip(sums.par_iter_mut())
             .enumerate()
-            .for_each(|(b, ((vs, ws), e))| {
+            .with_min_len(KICK_TASK_CHUNKS)
+            .for_each(|(b, ((((vs, ws), fs), ts), e))| {
+                shares.add_to_chunk(b, fs, ts);
                 let (mut kin, mut pot) = (0.0, 0.0);
-                for (k, (v, w)) in vs.iter_mut().zip(ws.iter_mut()).enumerate() {
+                for (k, ((v, w), (f, t))) in vs
+                    .iter_mut()
+                    .zip(ws.iter_mut())
+                    .zip(fs.iter().zip(ts.iter()))
+                    .enumerate()
+                {
                     let i = b * ENERGY_BLOCK + k;
-                    *v += force[i] * (half / mass[i]);
-                    *w += torque[i] * (half * inv_inertia[i]);
+                    *v += *f * (half / mass[i]);
+                    *w += *t * (half * inv_inertia[i]);
                     let (k, u) = particle_energy(mass[i], inv_inertia[i], v, w, &position[i], &g);
                     kin += k;
                     pot += u;

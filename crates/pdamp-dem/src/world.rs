@@ -70,8 +70,8 @@ pub struct World {
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
     /// Outputs of the contacts whose second partner lies in a later block of the pair pass
-    /// (see `force_blocks`): list `b × K + b'` holds those of block `b` for block `b'`, in
-    /// pair-loop order.
+    /// (see `force_blocks`): list `b × C + c` holds those of block `b` for chunk `c` (of `C`
+    /// chunks of first partners), in pair-loop order.
     pub(crate) cross_out: Vec<Vec<crate::forces::SecondOutput>>,
     /// Contact force and torque on every rigid body from the wall contacts of each block of
     /// the pair pass (`K` lists of one entry per body), added in block order.
@@ -139,7 +139,7 @@ pub(crate) fn particle_energy(
 
 /// Particles per block of the kinetic and potential energy sums (fixed, so that the sums do not
 /// depend on the thread count).
-pub(crate) const ENERGY_BLOCK: usize = 2048;
+pub(crate) const ENERGY_BLOCK: usize = crate::forces::PP_CHUNK;
 
 impl World {
     /// A world with the given materials; every material pair uses `default_model` until
