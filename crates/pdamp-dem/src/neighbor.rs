@@ -32,7 +32,7 @@ pub struct NeighborList {
 /// The two largest of four values, largest first: merges the top two of two sets (exact, in any
 /// order of merging).
 #[inline]
-pub fn top_two(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+fn top_two(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     if a[0] >= b[0] {
         [a[0], a[1].max(b[0])]
     } else {
@@ -66,12 +66,6 @@ impl NeighborList {
             .map(|(x, x0)| (x - x0).norm_squared())
             .fold(|| [0.0f64; 2], |top, d| top_two(top, [d, 0.0]))
             .reduce(|| [0.0; 2], top_two);
-        self.exceeds_skin(top)
-    }
-
-    /// True if the two largest displacements since the last build, given squared as
-    /// `top = [d1², d2²]` (see [`top_two`]), sum to at least the skin [D Eq. 2.11].
-    pub fn exceeds_skin(&self, top: [f64; 2]) -> bool {
         top[0].sqrt() + top[1].sqrt() >= self.skin_m
     }
 
