@@ -1,7 +1,7 @@
 //! The simulation world: particles, materials, contact models, rigid bodies with walls, and the
 //! time loop state. `World::step` advances by one time step with the chosen integrator.
 
-use crate::body::RigidBody;
+use crate::body::{BodyState, RigidBody};
 use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
 use crate::forces::{PpChunk, WallSlot};
@@ -92,6 +92,8 @@ pub struct World {
     /// Body poses and neighbour-list build count when the candidates were computed.
     pub(crate) wall_ref: Vec<(Vec3, crate::math::Rotation, usize)>,
     pub(crate) wall_ref_builds: u64,
+    /// Refreshes of the wall candidates since the world was built (diagnostic, not saved).
+    pub(crate) wall_refreshes: u64,
     /// Use the wall candidates (switched off only by tests comparing both paths).
     pub(crate) wall_skip: bool,
     /// Scratch of the contact remap at neighbour-list rebuilds.
@@ -108,6 +110,10 @@ pub struct World {
     /// Largest squared displacement since the last neighbour build, per chunk of the drift
     /// (scratch).
     pub(crate) scratch_top: Vec<f64>,
+    /// Scratch: the bodies' states over the step being evaluated.
+    pub(crate) scratch_body_step: Vec<BodyState>,
+    /// Scratch: external work and wall energies of every block of the pair pass.
+    pub(crate) scratch_block_out: Vec<(f64, EnergyIncrements)>,
     /// Velocities, masses and spins packed per particle for the pair loop (scratch).
     pub(crate) scratch_kin: Vec<crate::forces::Kin>,
     pub(crate) scratch_torque: Vec<Vec3>,
@@ -169,6 +175,7 @@ impl World {
             wall_candidate: Vec::new(),
             wall_ref: Vec::new(),
             wall_ref_builds: 0,
+            wall_refreshes: 0,
             wall_skip: true,
             pp_chunks: Vec::new(),
             wall_slots: Vec::new(),
@@ -176,6 +183,8 @@ impl World {
             scratch_energy: Vec::new(),
             scratch_xr: Vec::new(),
             scratch_top: Vec::new(),
+            scratch_body_step: Vec::new(),
+            scratch_block_out: Vec::new(),
             scratch_kin: Vec::new(),
             scratch_torque: Vec::new(),
             gear: None,
@@ -218,6 +227,12 @@ impl World {
     /// Number of touching particle–wall contacts.
     pub fn num_pw_contacts(&self) -> usize {
         self.wall_slots.iter().map(|s| s.len()).sum()
+    }
+
+    /// Refreshes of the particles' wall candidates since the world was built (at neighbour-list
+    /// rebuilds and when a body has moved by one skin; not kept in checkpoints).
+    pub fn wall_candidate_refreshes(&self) -> u64 {
+        self.wall_refreshes
     }
 
     /// Number of wall contacts of particle `i` at the last evaluation.
