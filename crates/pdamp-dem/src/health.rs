@@ -67,6 +67,7 @@ impl World {
     /// [`MAX_RELATIVE_OVERLAP`] of the radius, energy balance within [`MAX_CLOSURE_ERROR`].
     /// O(N + contacts); meant to be called every few hundred steps.
     pub fn check_health(&self) -> Result<(), HealthError> {
+        debug_assert!(!self.step_pending(), "state read with a half kick pending");
         let p = &self.particles;
         let err = |i: Option<usize>, message: String| HealthError {
             time_s: self.time_s,

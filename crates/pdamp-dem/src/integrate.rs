@@ -50,13 +50,14 @@ pub enum Integrator {
     Gear(GearParams),
 }
 
-/// Gear corrector coefficients for order p = 5 [D Tab. 2.2].
-/// Particles per task of the drift pass.
+/// Particles per task of the drift pass (a whole number of energy blocks).
 const PASS_CHUNK: usize = 1024;
+const _: () = assert!(PASS_CHUNK.is_multiple_of(ENERGY_BLOCK));
 
 /// Energy blocks per task of the second half-kick, at least.
 const KICK_TASK_CHUNKS: usize = 8;
 
+/// Gear corrector coefficients for order p = 5 [D Tab. 2.2].
 const GEAR5: [f64; 5] = [19.0 / 90.0, 3.0 / 4.0, 1.0, 1.0 / 2.0, 1.0 / 12.0];
 
 /// Time derivatives kept by the Gear scheme for every particle: translation (x, ẋ, ẍ, x⃛, x⁗) and
@@ -75,11 +76,16 @@ pub struct GearState {
 }
 
 impl World {
-    pub(crate) fn step_velocity_verlet(&mut self) -> EnergyIncrements {
+    /// One velocity-Verlet step: half kick and drift, forces at the new positions, second half
+    /// kick. With `defer_kick` the second half kick is left pending (see
+    /// [`World::step_deferred`]); a pending half kick of the previous step is done here, in the
+    /// same pass as this step's half kick and drift, with the same arithmetic (same bits).
+    pub(crate) fn step_velocity_verlet(&mut self, defer_kick: bool) -> EnergyIncrements {
         let dt = self.dt_s;
         let t = self.tick();
         let half = 0.5 * dt;
         let n = self.particles.len();
+        let pending = self.pending_half_kick_s.take();
         // Half kick and drift; the new positions and velocities are also packed for the pair
         // loop of the force evaluation (one pass over the particles less).
         self.scratch_xr.resize(n, [0.0; 4]);
@@ -92,7 +98,84 @@ impl World {
         let tops = &mut self.scratch_top;
         tops.clear();
         tops.resize(n.div_ceil(PASS_CHUNK), 0.0);
-        {
+        if let Some(half_prev) = pending {
+            // The pending second half kick of the last step first, particle by particle: the
+            // shares of its second partners, the kick, the kinetic and potential energy of the
+            // state it completes (in the blocks of `refresh_state_energies`), then this step's
+            // half kick and drift.
+            let g = self.gravity_m_s2;
+            let sums = &mut self.scratch_energy;
+            sums.clear();
+            sums.resize(n.div_ceil(ENERGY_BLOCK), [0.0; 2]);
+            let shares = SecondShares {
+                lists: &self.cross_out,
+                chunk_block: &self.chunk_block,
+            };
+            let crate::particles::ParticleSet {
+                position,
+                velocity,
+                angular_velocity,
+                force,
+                torque,
+                radius,
+                mass,
+                inv_inertia,
+                ..
+            } = &mut self.particles;
+            let (radius, mass, inv_inertia) = (&*radius, &*mass, &*inv_inertia);
+            const BLOCKS: usize = PASS_CHUNK / ENERGY_BLOCK;
+            position
+                .par_chunks_mut(PASS_CHUNK)
+                .zip(velocity.par_chunks_mut(PASS_CHUNK))
+                .zip(angular_velocity.par_chunks_mut(PASS_CHUNK))
+                .zip(force.par_chunks_mut(PASS_CHUNK))
+                .zip(torque.par_chunks_mut(PASS_CHUNK))
+                .zip(self.scratch_xr.par_chunks_mut(PASS_CHUNK))
+                .zip(self.scratch_kin.par_chunks_mut(PASS_CHUNK))
+                .zip(sums.par_chunks_mut(BLOCKS))
+                .zip(tops.par_iter_mut())
+                .enumerate()
+                .for_each(
+                    |(c, ((((((((xs, vs), ws), fs), ts), xrs), ks), es), top))| {
+                        let mut t = 0.0f64;
+                        for (s, e) in es.iter_mut().enumerate() {
+                            let b = c * BLOCKS + s;
+                            let r = s * ENERGY_BLOCK..((s + 1) * ENERGY_BLOCK).min(xs.len());
+                            let (fs, ts) = (&mut fs[r.clone()], &mut ts[r.clone()]);
+                            shares.add_to_chunk(b, fs, ts);
+                            let (mut kin, mut pot) = (0.0, 0.0);
+                            for (k, ((((x, v), w), (f, tq)), (xr, kn))) in xs[r.clone()]
+                                .iter_mut()
+                                .zip(vs[r.clone()].iter_mut())
+                                .zip(ws[r.clone()].iter_mut())
+                                .zip(fs.iter().zip(ts.iter()))
+                                .zip(xrs[r.clone()].iter_mut().zip(ks[r.clone()].iter_mut()))
+                                .enumerate()
+                            {
+                                let i = b * ENERGY_BLOCK + k;
+                                let (m, jinv) = (mass[i], inv_inertia[i]);
+                                *v += *f * (half_prev / m);
+                                *w += *tq * (half_prev * jinv);
+                                let (ek, ep) = particle_energy(m, jinv, v, w, x, &g);
+                                kin += ek;
+                                pot += ep;
+                                *v += *f * (half / m);
+                                *w += *tq * (half * jinv);
+                                *x += *v * dt;
+                                *xr = [x.x, x.y, x.z, radius[i]];
+                                *kn = Kin::new(v, m, w);
+                                if check {
+                                    let d2 = (*x - reference[i]).norm_squared();
+                                    t = if d2 > t { d2 } else { t };
+                                }
+                            }
+                            *e = [kin, pot];
+                        }
+                        *top = t;
+                    },
+                );
+            self.ledger_energies_from_blocks();
+        } else {
             let crate::particles::ParticleSet {
                 position,
                 velocity,
@@ -145,11 +228,23 @@ impl World {
         self.update_neighbors_given(check.then_some(top));
         let inc = self.evaluate_forces_with(dt, true);
         self.counters.force_evaluations += 1;
-        let t = self.tick();
-        // Second half kick, chunk by chunk after the chunk's shares from earlier blocks of the
-        // pair pass (left out by the force evaluation: one parallel loop less), with the
-        // kinetic and potential energy of the new state summed in the blocks of
-        // `refresh_state_energies` (the same numbers, one pass less again).
+        if defer_kick {
+            self.pending_half_kick_s = Some(half);
+        } else {
+            let t = self.tick();
+            self.second_half_kick(half);
+            self.tock(t, |p| &mut p.integrate_s);
+        }
+        inc
+    }
+
+    /// The second half kick of a velocity-Verlet step (`half` = half its time step), chunk by
+    /// chunk after the chunk's shares from earlier blocks of the pair pass (left out by the
+    /// force evaluation: one parallel loop less), with the kinetic and potential energy of the
+    /// new state summed in the blocks of `refresh_state_energies` (the same numbers, one pass
+    /// less again) and put into the ledger.
+    pub(crate) fn second_half_kick(&mut self, half: f64) {
+        let n = self.particles.len();
         let g = self.gravity_m_s2;
         let p = &mut self.particles;
         let sums = &mut self.scratch_energy;
@@ -187,9 +282,6 @@ impl World {
                 *e = [kin, pot];
             });
         self.ledger_energies_from_blocks();
-        self.energies_fresh = true;
-        self.tock(t, |p| &mut p.integrate_s);
-        inc
     }
 
     /// Moves prescribed bodies to `time + dt` and advances the clock.

@@ -59,6 +59,7 @@ impl WorldState {
 impl World {
     /// Copies the time-dependent state (does not change the world).
     pub fn save_state(&self) -> WorldState {
+        debug_assert!(!self.step_pending(), "state read with a half kick pending");
         let p = &self.particles;
         WorldState {
             radius: p.radius.clone(),

@@ -122,9 +122,9 @@ pub struct World {
     /// `scratch_xr`/`scratch_kin` hold the current state (packed by the drift of a
     /// velocity-Verlet step; consumed by the next force evaluation).
     pub(crate) packed: bool,
-    /// The ledger's kinetic and potential energy are those of the current state (computed by
-    /// the second half-kick of a velocity-Verlet step).
-    pub(crate) energies_fresh: bool,
+    /// Half the time step of the last velocity-Verlet step while its second half kick is
+    /// pending (see [`World::step_deferred`]), s.
+    pub(crate) pending_half_kick_s: Option<f64>,
 }
 
 /// Kinetic energy (translation + rotation) and `m g·x` of one particle, J.
@@ -190,7 +190,7 @@ impl World {
             gear: None,
             initialized: false,
             packed: false,
-            energies_fresh: false,
+            pending_half_kick_s: None,
         }
     }
 
@@ -352,6 +352,7 @@ impl World {
 
     /// Prepares neighbour lists and evaluates the initial forces (called by the first step).
     pub fn initialize(&mut self) {
+        self.complete_step();
         let n = self.particles.len();
         if self.neighbors.skin_m <= 0.0 {
             self.neighbors.skin_m = self.default_skin();
@@ -482,20 +483,56 @@ impl World {
 
     /// Advances by one time step (or one accepted step under Gear step control).
     pub fn step(&mut self) {
+        self.step_deferred();
+        self.complete_step();
+    }
+
+    /// Like [`World::step`], but under velocity Verlet the second half kick of the step is left
+    /// pending and done by the next step, in the same pass over the particles as that step's
+    /// first half kick and drift (one pass over velocities, forces, masses and positions less
+    /// per step; the arithmetic and so the results are the same to the bit).
+    ///
+    /// Until [`World::complete_step`] (or [`World::step`]) is called, only the positions, the
+    /// clock, the bodies (poses and contact loads), the counters and the ledger's work and
+    /// dissipation terms are current: particle velocities and spins are half a step behind,
+    /// particle forces lack shares of the pair pass, and the ledger's kinetic and potential
+    /// energy are those of the previous step. Nothing that reads particle state may run
+    /// between deferred steps (observers of [`World::run_until_or_break_deferred`] included).
+    pub fn step_deferred(&mut self) {
         if !self.initialized {
             self.initialize();
         }
         let inc: EnergyIncrements = match self.integrator.clone() {
-            Integrator::VelocityVerlet => self.step_velocity_verlet(),
-            Integrator::Gear(params) => self.step_gear(&params),
+            Integrator::VelocityVerlet => self.step_velocity_verlet(true),
+            Integrator::Gear(params) => {
+                self.complete_step();
+                self.step_gear(&params)
+            }
         };
         let t = self.tick();
         self.ledger.add(&inc);
-        if !std::mem::take(&mut self.energies_fresh) {
+        if matches!(self.integrator, Integrator::Gear(_)) {
             self.refresh_state_energies();
         }
         self.tock(t, |p| &mut p.energies_s);
         self.counters.steps += 1;
+    }
+
+    /// Does the second half kick left pending by [`World::step_deferred`], if any: afterwards
+    /// velocities, spins, forces and the ledger's kinetic and potential energy are those of
+    /// the current time.
+    pub fn complete_step(&mut self) {
+        if let Some(half) = self.pending_half_kick_s.take() {
+            let t = self.tick();
+            self.second_half_kick(half);
+            self.tock(t, |p| &mut p.integrate_s);
+        }
+    }
+
+    /// True while a half kick is pending (between [`World::step_deferred`] and
+    /// [`World::complete_step`]).
+    pub fn step_pending(&self) -> bool {
+        self.pending_half_kick_s.is_some()
     }
 
     /// Steps until `time_s` reaches `t_end_s` (the last step is shortened to land on it).
@@ -513,23 +550,53 @@ impl World {
         t_end_s: f64,
         mut observer: impl FnMut(&World) -> std::ops::ControlFlow<()>,
     ) -> bool {
-        while self.time_s < t_end_s - 1e-12 * t_end_s.abs().max(1e-300) {
+        self.run_until_impl(t_end_s, |w| observer(w), false)
+    }
+
+    /// Like [`World::run_until_or_break`], with the steps taken by [`World::step_deferred`]
+    /// (faster under velocity Verlet, the same results). After a step `observer` may read the
+    /// clock, the bodies, the counters and the ledger's work and dissipation terms; before it
+    /// reads anything else (particles, the ledger's kinetic and potential energy, a health
+    /// check, a snapshot, a checkpoint) it calls [`World::complete_step`]. The state is complete
+    /// again when this returns.
+    pub fn run_until_or_break_deferred(
+        &mut self,
+        t_end_s: f64,
+        observer: impl FnMut(&mut World) -> std::ops::ControlFlow<()>,
+    ) -> bool {
+        self.run_until_impl(t_end_s, observer, true)
+    }
+
+    fn run_until_impl(
+        &mut self,
+        t_end_s: f64,
+        mut observer: impl FnMut(&mut World) -> std::ops::ControlFlow<()>,
+        deferred: bool,
+    ) -> bool {
+        let tol = 1e-12 * t_end_s.abs().max(1e-300);
+        let mut reached = true;
+        while self.time_s < t_end_s - tol {
             let dt_nominal = self.dt_s;
             let remaining = t_end_s - self.time_s;
-            if remaining < dt_nominal {
+            let short = remaining < dt_nominal;
+            if short {
                 self.dt_s = remaining;
-                self.step();
-                if matches!(self.integrator, Integrator::VelocityVerlet) {
-                    self.dt_s = dt_nominal;
-                }
+            }
+            if deferred {
+                self.step_deferred();
             } else {
                 self.step();
             }
+            if short && matches!(self.integrator, Integrator::VelocityVerlet) {
+                self.dt_s = dt_nominal;
+            }
             if observer(self).is_break() {
-                return self.time_s >= t_end_s - 1e-12 * t_end_s.abs().max(1e-300);
+                reached = self.time_s >= t_end_s - tol;
+                break;
             }
         }
-        true
+        self.complete_step();
+        reached
     }
 
     /// Sets the clock back to zero and re-initialises (forces, body poses, ledger) while keeping

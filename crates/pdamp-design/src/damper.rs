@@ -96,10 +96,22 @@ pub struct PointResult {
 pub trait PointObserver {
     /// Called after every step with the world, the cycle index (from 0) and the phase Ωt mod 2π.
     fn on_step(&mut self, world: &World, cycle: u32, phase_rad: f64, damper: &Damper);
+
+    /// Whether `on_step` reads particle state (velocities, forces, the ledger's kinetic and
+    /// potential energy). When false, the point runs with deferred half kicks
+    /// ([`World::step_deferred`]: same results, one pass over the particles less per step) and
+    /// `on_step` may read only the clock, the bodies and the counters.
+    fn reads_particles(&self) -> bool {
+        true
+    }
 }
 
 impl PointObserver for () {
     fn on_step(&mut self, _: &World, _: u32, _: f64, _: &Damper) {}
+
+    fn reads_particles(&self) -> bool {
+        false
+    }
 }
 
 /// Complex amplitude $\hat x$ with $x(t) \approx \mathrm{Re}(\hat x e^{i\Omega t})$ of a sampled
@@ -284,7 +296,13 @@ impl Damper {
             }
             let evaluating = cycle >= self.transient_cycles;
             let mut health = None;
-            w.run_until_or_break(t_end, |w| {
+            // An observer that reads particles gets every step complete (then this is
+            // `World::step`); otherwise the half kicks are deferred (same results).
+            let deferred = !observer.reads_particles();
+            w.run_until_or_break_deferred(t_end, |w| {
+                if !deferred {
+                    w.complete_step();
+                }
                 if evaluating {
                     sample(w, &mut times, &mut force, &mut velocity);
                 }
@@ -293,10 +311,12 @@ impl Damper {
                 if w.counters
                     .steps
                     .is_multiple_of(pdamp_io::run::HEALTH_CHECK_STEPS)
-                    && let Err(e) = w.check_health()
                 {
-                    health = Some(e);
-                    return std::ops::ControlFlow::Break(());
+                    w.complete_step();
+                    if let Err(e) = w.check_health() {
+                        health = Some(e);
+                        return std::ops::ControlFlow::Break(());
+                    }
                 }
                 if pdamp_io::checkpoint::stop_requested() {
                     return std::ops::ControlFlow::Break(());

@@ -170,6 +170,10 @@ impl<P: FnMut(&str, f64)> crate::damper::PointObserver for ProgressObserver<'_, 
             (self.progress)("running", pct as f64 / 1000.0);
         }
     }
+
+    fn reads_particles(&self) -> bool {
+        self.inner.reads_particles()
+    }
 }
 
 /// Writes the phase-averaged velocity fields: one row per phase and occupied cell.

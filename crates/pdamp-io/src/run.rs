@@ -605,14 +605,18 @@ pub fn run_scenario(
     let t_end = scenario.simulation.duration_s;
     let mut err: Option<String> = None;
     let mut stopped = false;
-    world.run_until_or_break(t_end, |w| {
-        if w.counters.steps.is_multiple_of(HEALTH_CHECK_STEPS)
-            && let Err(e) = w.check_health()
-        {
-            health = Some(e);
-            return ControlFlow::Break(());
+    // Half kicks deferred (`World::step_deferred`: same results, one pass over the particles
+    // less per step); the state is completed wherever it is read.
+    world.run_until_or_break_deferred(t_end, |w| {
+        if w.counters.steps.is_multiple_of(HEALTH_CHECK_STEPS) {
+            w.complete_step();
+            if let Err(e) = w.check_health() {
+                health = Some(e);
+                return ControlFlow::Break(());
+            }
         }
         if w.time_s >= next_e - 1e-12 {
+            w.complete_step();
             if let Err(e) = csv.write_row(&ledger_row(w)) {
                 err = Some(format!("output: {e}"));
                 return ControlFlow::Break(());
@@ -623,6 +627,7 @@ pub fn run_scenario(
         if let Some(s) = series.as_mut()
             && w.time_s >= next_v - 1e-12
         {
+            w.complete_step();
             match write_snapshot(w, &vtk_dir, snap) {
                 Ok(f) => {
                     if let Err(e) = s.add(w.time_s, f.to_string_lossy()) {
@@ -640,6 +645,7 @@ pub fn run_scenario(
         }
         let stop = ck::stop_requested();
         if stop || timer.due() {
+            w.complete_step();
             let r = csv.sync().map_err(csvio).and_then(|bytes| {
                 let c = RunCheckpoint {
                     phase: RunPhase::Running,

@@ -1,0 +1,140 @@
+//! Deferred half kicks (`World::step_deferred`, `World::run_until_or_break_deferred`) give the
+//! same state as plain steps, to the bit: the fused pass does the same arithmetic in the same
+//! order, only in one pass over the particles instead of two.
+
+mod common;
+use common::*;
+use pdamp_dem::{HarmonicTranslation, Integrator, Motion, World};
+use std::ops::ControlFlow;
+use std::sync::Arc;
+
+fn shaken(threads_seed: u64) -> World {
+    let mut w = box_world(
+        800,
+        1e-3,
+        0.025,
+        0.04,
+        hertz_mindlin(0.6, 0.4),
+        2e-6,
+        false,
+        threads_seed,
+    );
+    w.integrator = Integrator::VelocityVerlet;
+    w.bodies[0].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
+        direction: [1.0, 0.0, 0.3],
+        amplitude_m: 2e-3,
+        frequency_hz: 60.0,
+        phase_rad: 0.0,
+    }));
+    w.initialize();
+    w
+}
+
+fn assert_same(a: &World, b: &World, what: &str) {
+    let (p, q) = (&a.particles, &b.particles);
+    assert_eq!(a.time_s.to_bits(), b.time_s.to_bits(), "{what}: time");
+    for i in 0..p.len() {
+        for k in 0..3 {
+            assert_eq!(
+                p.position[i][k].to_bits(),
+                q.position[i][k].to_bits(),
+                "{what}: x[{i}]"
+            );
+            assert_eq!(
+                p.velocity[i][k].to_bits(),
+                q.velocity[i][k].to_bits(),
+                "{what}: v[{i}]"
+            );
+            assert_eq!(
+                p.angular_velocity[i][k].to_bits(),
+                q.angular_velocity[i][k].to_bits(),
+                "{what}: ω[{i}]"
+            );
+            assert_eq!(
+                p.force[i][k].to_bits(),
+                q.force[i][k].to_bits(),
+                "{what}: F[{i}]"
+            );
+            assert_eq!(
+                p.torque[i][k].to_bits(),
+                q.torque[i][k].to_bits(),
+                "{what}: T[{i}]"
+            );
+        }
+    }
+    let (l, m) = (&a.ledger, &b.ledger);
+    for (x, y, name) in [
+        (l.kinetic_j, m.kinetic_j, "kinetic"),
+        (l.potential_j, m.potential_j, "potential"),
+        (l.elastic_j, m.elastic_j, "elastic"),
+        (l.wall_work_j, m.wall_work_j, "wall work"),
+        (l.dissipated_j(), m.dissipated_j(), "dissipated"),
+    ] {
+        assert_eq!(x.to_bits(), y.to_bits(), "{what}: ledger {name} {x} vs {y}");
+    }
+}
+
+/// 1 500 plain steps against 1 500 deferred ones (completed at the end), and a run to a time
+/// that is not a whole number of steps (the last step shortened) against the deferred run
+/// that stops every 97 steps to read the state: same bits on one and two threads.
+#[test]
+fn deferred_half_kicks_give_the_same_bits() {
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut a = shaken(3);
+            let mut b = a.clone();
+            for _ in 0..1500 {
+                a.step();
+                b.step_deferred();
+                assert!(b.step_pending());
+                // Positions, clock and body loads are current between deferred steps.
+                assert_eq!(a.time_s.to_bits(), b.time_s.to_bits());
+                assert_eq!(
+                    a.particles.position[17][0].to_bits(),
+                    b.particles.position[17][0].to_bits()
+                );
+                assert_eq!(
+                    a.bodies[0].contact_force_n[0].to_bits(),
+                    b.bodies[0].contact_force_n[0].to_bits()
+                );
+            }
+            b.complete_step();
+            assert!(!b.step_pending());
+            assert_same(&a, &b, "after 1 500 steps");
+            assert!(a.counters.neighbor_builds > 2, "the list was rebuilt");
+
+            let t_end = a.time_s + 1234.5 * a.dt_s;
+            a.run_until(t_end, |_| {});
+            let mut reads = 0;
+            let reached = b.run_until_or_break_deferred(t_end, |w| {
+                if w.counters.steps.is_multiple_of(97) {
+                    w.complete_step();
+                    reads += 1;
+                    assert!(w.check_health().is_ok());
+                }
+                ControlFlow::Continue(())
+            });
+            assert!(reached && reads > 10);
+            assert!(!b.step_pending());
+            assert_same(&a, &b, "after run_until");
+        });
+    }
+}
+
+/// Under Gear's step control nothing is deferred: `step_deferred` is `step`.
+#[test]
+fn gear_steps_are_never_deferred() {
+    let mut a = shaken(5);
+    a.integrator = Integrator::Gear(Default::default());
+    let mut b = a.clone();
+    for _ in 0..50 {
+        a.step();
+        b.step_deferred();
+        assert!(!b.step_pending());
+    }
+    assert_same(&a, &b, "Gear");
+}
