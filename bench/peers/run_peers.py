@@ -59,6 +59,26 @@ def parallel_capacity(n=6_000_000):
     return 2.0 * t1 / t2
 
 
+def cpu_times():
+    """Aggregate CPU time counters of /proc/stat (jiffies): (steal, total); None off Linux."""
+    try:
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:]]
+    except (OSError, ValueError):
+        return None
+    return v[7] if len(v) > 7 else 0, sum(v[:8])
+
+
+def steal_fraction(before, after):
+    """Share of the machine's CPU time taken by the hypervisor for other guests between two
+    `cpu_times()` readings (steal time): on a shared VM a run with steal time measures the
+    neighbours as much as the code, and a thread that is descheduled stalls the other at
+    every synchronisation (2 threads can then run slower than 1)."""
+    if before is None or after is None or after[1] <= before[1]:
+        return float("nan")
+    return (after[0] - before[0]) / (after[1] - before[1])
+
+
 def pdamp_binary():
     if os.environ.get("PDAMP_BIN"):
         return os.environ["PDAMP_BIN"]
@@ -71,8 +91,11 @@ def run_pdamp(exe, n, steps, threads, settled, export=None):
            str(steps), "--settled", settled, "--peer"]
     if export:
         cmd += ["--export-liggghts", export]
+    c0 = cpu_times()
     out = sh(cmd).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    r = json.loads(out.strip().splitlines()[-1])
+    r["steal_fraction"] = steal_fraction(c0, cpu_times())
+    return r
 
 
 def run_liggghts(case_dir, ranks):
@@ -80,10 +103,12 @@ def run_liggghts(case_dir, ranks):
     if ranks == 1:
         mpi = ["mpirun", "--allow-run-as-root", "-np", "1"]
     t0 = time.time()
+    c0 = cpu_times()
     log = subprocess.run(mpi + ["liggghts", "-in", "in.shaken_box"], cwd=case_dir, text=True,
                          capture_output=True)
     if log.returncode != 0:
         raise RuntimeError(f"LIGGGHTS failed in {case_dir}:\n{log.stdout[-3000:]}\n{log.stderr[-3000:]}")
+    steal = steal_fraction(c0, cpu_times())
     text = log.stdout
     m = re.search(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", text)
     loop_s, steps, atoms = float(m.group(1)), int(m.group(3)), int(m.group(4))
@@ -131,6 +156,7 @@ def run_liggghts(case_dir, ranks):
         "dissipated_power_w": (work - d_kin - d_pot) / duration,
         "atoms_left": int(last[1]),
         "elapsed_s": time.time() - t0,
+        "steal_fraction": steal,
     }
 
 
@@ -159,10 +185,18 @@ def main():
         # in the same states (its speed drifts over minutes on a shared VM); best time kept.
         threads = [int(x) for x in args.threads.split(",")]
         best = {t: [None, None] for t in threads}
+        runs = {t: [] for t in threads}
         for _ in range(args.repeat):
             for t in threads:
                 p = run_pdamp(exe, n, args.steps, t, settled)
                 l = run_liggghts(case, t)
+                runs[t].append({"pdamp_particle_steps_per_s": p["particle_steps_per_s"],
+                                "pdamp_steal_fraction": p["steal_fraction"],
+                                "liggghts_particle_steps_per_s": l["particle_steps_per_s"],
+                                "liggghts_steal_fraction": l["steal_fraction"]})
+                print(f"  N={n} threads={t}: pdamp {p['particle_steps_per_s']:.3e} (steal "
+                      f"{100 * p['steal_fraction']:.0f} %), LIGGGHTS {l['particle_steps_per_s']:.3e} "
+                      f"(steal {100 * l['steal_fraction']:.0f} %)", file=sys.stderr, flush=True)
                 if best[t][0] is None or p["wall_time_s"] < best[t][0]["wall_time_s"]:
                     best[t][0] = p
                 if best[t][1] is None or l["wall_time_s"] < best[t][1]["wall_time_s"]:
@@ -172,13 +206,15 @@ def main():
             ratio = best_p["particle_steps_per_s"] / best_l["particle_steps_per_s"]
             diff = best_p["dissipated_power_w"] / best_l["dissipated_power_w"] - 1.0
             row = {"particles": n, "threads": t, "steps": args.steps, "pdamp": best_p,
-                   "liggghts": best_l, "speed_ratio": ratio, "dissipated_power_difference": diff,
+                   "liggghts": best_l, "runs": runs[t], "speed_ratio": ratio, "dissipated_power_difference": diff,
                    "same_physics": abs(diff) <= 0.10}
             results.append(row)
             print(f"N={n:6d} threads={t}: pdamp {best_p['particle_steps_per_s']:.3e} p-steps/s, "
                   f"LIGGGHTS {best_l['particle_steps_per_s']:.3e} p-steps/s, ratio {ratio:.2f}; "
                   f"P_diss pdamp {best_p['dissipated_power_w']:.4g} W, LIGGGHTS "
-                  f"{best_l['dissipated_power_w']:.4g} W ({100 * diff:+.1f} %)", flush=True)
+                  f"{best_l['dissipated_power_w']:.4g} W ({100 * diff:+.1f} %); steal time "
+                  f"{100 * best_p['steal_fraction']:.0f} % / {100 * best_l['steal_fraction']:.0f} %",
+                  flush=True)
     # Thread scaling.
     for n in sorted({r["particles"] for r in results}):
         rs = {r["threads"]: r for r in results if r["particles"] == n}
@@ -186,6 +222,11 @@ def main():
             sp = rs[2]["pdamp"]["particle_steps_per_s"] / rs[1]["pdamp"]["particle_steps_per_s"]
             sl = rs[2]["liggghts"]["particle_steps_per_s"] / rs[1]["liggghts"]["particle_steps_per_s"]
             print(f"N={n:6d}: speed-up 1 -> 2 threads: pdamp {sp:.2f}, LIGGGHTS {sl:.2f}")
+    steals = [r[k]["steal_fraction"] for r in results for k in ("pdamp", "liggghts")]
+    if any(x > 0.05 for x in steals if x == x):
+        print("warning: the hypervisor took more than 5 % of the CPU time (steal) during some "
+              "runs: their times and the thread speed-ups measure the neighbours too",
+              file=sys.stderr)
     out = os.path.join(args.work, "results.json")
     with open(out, "w") as f:
         json.dump({"load_average": os.getloadavg(), "machine_parallel_capacity": capacity,
