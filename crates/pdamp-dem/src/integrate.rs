@@ -75,6 +75,35 @@ pub struct GearState {
     pub last_corrections: u32,
 }
 
+/// Half kick of one particle: $v \mathrel{+}= F\,h/m$, $\omega \mathrel{+}= T\,h/J$ (`h` = half the
+/// step).
+#[inline(always)]
+fn half_kick(v: &mut Vec3, w: &mut Vec3, f: &Vec3, t: &Vec3, m: f64, inv_inertia: f64, h: f64) {
+    *v += *f * (h / m);
+    *w += *t * (h * inv_inertia);
+}
+
+/// Drift of one particle by `dt`, packed for the pair loop (`[x, y, z, r]`, [`Kin`]); returns
+/// its squared displacement from `reference` (0 without one).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn drift_and_pack(
+    x: &mut Vec3,
+    v: &Vec3,
+    w: &Vec3,
+    m: f64,
+    radius: f64,
+    dt: f64,
+    xr: &mut [f64; 4],
+    kin: &mut Kin,
+    reference: Option<&Vec3>,
+) -> f64 {
+    *x += *v * dt;
+    *xr = [x.x, x.y, x.z, radius];
+    *kin = Kin::new(v, m, w);
+    reference.map_or(0.0, |r| (*x - *r).norm_squared())
+}
+
 impl World {
     /// One velocity-Verlet step: half kick and drift, forces at the new positions, second half
     /// kick. With `defer_kick` the second half kick is left pending (see
@@ -154,20 +183,23 @@ impl World {
                             {
                                 let i = b * ENERGY_BLOCK + k;
                                 let (m, jinv) = (mass[i], inv_inertia[i]);
-                                *v += *f * (half_prev / m);
-                                *w += *tq * (half_prev * jinv);
+                                half_kick(v, w, f, tq, m, jinv, half_prev);
                                 let (ek, ep) = particle_energy(m, jinv, v, w, x, &g);
                                 kin += ek;
                                 pot += ep;
-                                *v += *f * (half / m);
-                                *w += *tq * (half * jinv);
-                                *x += *v * dt;
-                                *xr = [x.x, x.y, x.z, radius[i]];
-                                *kn = Kin::new(v, m, w);
-                                if check {
-                                    let d2 = (*x - reference[i]).norm_squared();
-                                    t = if d2 > t { d2 } else { t };
-                                }
+                                half_kick(v, w, f, tq, m, jinv, half);
+                                let d2 = drift_and_pack(
+                                    x,
+                                    v,
+                                    w,
+                                    m,
+                                    radius[i],
+                                    dt,
+                                    xr,
+                                    kn,
+                                    check.then(|| &reference[i]),
+                                );
+                                t = if d2 > t { d2 } else { t };
                             }
                             *e = [kin, pot];
                         }
@@ -208,15 +240,19 @@ impl World {
                     {
                         let i = c * PASS_CHUNK + k;
                         let m = mass[i];
-                        *v += force[i] * (half / m);
-                        *w += torque[i] * (half * inv_inertia[i]);
-                        *x += *v * dt;
-                        *xr = [x.x, x.y, x.z, radius[i]];
-                        *kin = Kin::new(v, m, w);
-                        if check {
-                            let d2 = (*x - reference[i]).norm_squared();
-                            t = if d2 > t { d2 } else { t };
-                        }
+                        half_kick(v, w, &force[i], &torque[i], m, inv_inertia[i], half);
+                        let d2 = drift_and_pack(
+                            x,
+                            v,
+                            w,
+                            m,
+                            radius[i],
+                            dt,
+                            xr,
+                            kin,
+                            check.then(|| &reference[i]),
+                        );
+                        t = if d2 > t { d2 } else { t };
                     }
                     *top = t;
                 });
@@ -273,8 +309,7 @@ impl World {
                     .enumerate()
                 {
                     let i = b * ENERGY_BLOCK + k;
-                    *v += *f * (half / mass[i]);
-                    *w += *t * (half * inv_inertia[i]);
+                    half_kick(v, w, f, t, mass[i], inv_inertia[i], half);
                     let (k, u) = particle_energy(mass[i], inv_inertia[i], v, w, &position[i], &g);
                     kin += k;
                     pot += u;

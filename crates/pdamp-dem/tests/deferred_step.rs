@@ -4,11 +4,10 @@
 
 mod common;
 use common::*;
-use pdamp_dem::{HarmonicTranslation, Integrator, Motion, World};
+use pdamp_dem::{Integrator, World};
 use std::ops::ControlFlow;
-use std::sync::Arc;
 
-fn shaken(threads_seed: u64) -> World {
+fn shaken(seed: u64) -> World {
     let mut w = box_world(
         800,
         1e-3,
@@ -17,16 +16,9 @@ fn shaken(threads_seed: u64) -> World {
         hertz_mindlin(0.6, 0.4),
         2e-6,
         false,
-        threads_seed,
+        seed,
     );
-    w.integrator = Integrator::VelocityVerlet;
-    w.bodies[0].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
-        direction: [1.0, 0.0, 0.3],
-        amplitude_m: 2e-3,
-        frequency_hz: 60.0,
-        phase_rad: 0.0,
-    }));
-    w.initialize();
+    shake(&mut w, [1.0, 0.0, 0.3], 2e-3, 60.0);
     w
 }
 

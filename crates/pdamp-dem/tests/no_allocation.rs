@@ -5,9 +5,9 @@
 
 mod common;
 use common::*;
-use pdamp_dem::{HarmonicTranslation, Integrator, Motion};
+
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::Arc;
+
 use std::sync::atomic::{AtomicU64, Ordering};
 
 struct Counting;
@@ -48,14 +48,7 @@ fn velocity_verlet_steps_do_not_allocate() {
             .unwrap();
         pool.install(|| {
             let mut w = box_world(1500, 1e-3, 0.03, 0.04, hertz_mindlin(0.6, 0.4), 2e-6, false, 7);
-            w.integrator = Integrator::VelocityVerlet;
-            w.bodies[0].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
-                direction: [0.0, 0.0, 1.0],
-                amplitude_m: 2e-3,
-                frequency_hz: 50.0,
-                phase_rad: 0.0,
-            }));
-            w.initialize();
+            shake(&mut w, [0.0, 0.0, 1.0], 2e-3, 50.0);
             for _ in 0..2000 {
                 w.step();
             }

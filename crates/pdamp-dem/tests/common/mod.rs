@@ -7,6 +7,19 @@ use pdamp_dem::walls::{BoxInside, Geometry, TriMesh};
 use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
 use rand::{RngExt, SeedableRng};
 
+/// Shakes the box (body 0) of `w` harmonically along `direction` (velocity Verlet) and
+/// initialises the world.
+pub fn shake(w: &mut World, direction: [f64; 3], amplitude_m: f64, frequency_hz: f64) {
+    w.integrator = pdamp_dem::Integrator::VelocityVerlet;
+    w.bodies[0].motion = Motion::Prescribed(std::sync::Arc::new(pdamp_dem::HarmonicTranslation {
+        direction,
+        amplitude_m,
+        frequency_hz,
+        phase_rad: 0.0,
+    }));
+    w.initialize();
+}
+
 /// Soft steel-like material used in the bulk tests.
 pub fn soft_steel() -> Material {
     Material::new("steel", 7800.0, 2e9, 0.3)
