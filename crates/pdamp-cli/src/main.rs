@@ -56,6 +56,19 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Prepare the bed of a scenario (drop-down and settling) and save it: DIR/bed.pdbed (exact
+    /// continuation, `placement = { method = "file", path = "DIR/bed.pdbed" }`), bed.csv,
+    /// bed.data (LAMMPS/LIGGGHTS read_data), bed.vtp and summary.json with its statistics.
+    Settle {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Packing index k of an ensemble (seed = simulation.seed + 1 000 003 k).
+        #[arg(long, default_value_t = 0)]
+        packing: usize,
+    },
     /// Load, validate and build a scenario without running it; prints what would run as JSON
     /// (particles, masses, shortest contact time, time-step ratio, damper grid).
     Check {
@@ -147,6 +160,10 @@ struct PointArgs {
     /// Intensity Γ = A/g (damper scenarios).
     #[arg(long)]
     intensity: Option<f64>,
+    /// Independently prepared beds (an ensemble: mean, spread and 95 % confidence interval);
+    /// overrides `[damper] packings`.
+    #[arg(long)]
+    packings: Option<usize>,
 }
 
 impl PointArgs {
@@ -155,6 +172,7 @@ impl PointArgs {
             || self.amplitude_m.is_some()
             || self.acceleration_m_s2.is_some()
             || self.intensity.is_some()
+            || self.packings.is_some()
     }
 
     /// Puts the point into the scenario's `[damper]` and validates it again.
@@ -164,11 +182,14 @@ impl PointArgs {
         }
         let Some(d) = sc.damper.as_mut() else {
             bail!(
-                "--frequency-hz/--amplitude-m/--acceleration-m-s2/--intensity need a scenario with a [damper] section"
+                "--frequency-hz/--amplitude-m/--acceleration-m-s2/--intensity/--packings need a scenario with a [damper] section"
             );
         };
         if let Some(f) = self.frequency_hz {
             d.frequency_hz = Some(f);
+        }
+        if let Some(k) = self.packings {
+            d.packings = k;
         }
         if self.amplitude_m.is_some()
             || self.acceleration_m_s2.is_some()
@@ -272,6 +293,11 @@ fn dispatch(command: Command) -> Result<()> {
         ),
         Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
         Command::Check { scenario } => cmd_check(&scenario),
+        Command::Settle {
+            scenario,
+            out,
+            packing,
+        } => cmd_settle(&scenario, &out, packing),
         Command::Example {
             particles,
             duration_s,
@@ -491,6 +517,52 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+fn cmd_settle(scenario: &std::path::Path, out: &std::path::Path, packing: usize) -> Result<()> {
+    let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
+    let sc = pdamp_io::prepare::scenario_for_packing(&sc, packing);
+    let base = scenario
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default();
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let s = pdamp_io::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| {
+        bar.set_message(phase.to_string());
+        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
+    })
+    .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
+    println!("{}", serde_json::to_string_pretty(&s)?);
+    Ok(())
+}
+
+/// Warnings about a scenario that runs but is unlikely to be what the user wants.
+fn scenario_warnings(sc: &pdamp_io::scenario::Scenario) -> Vec<String> {
+    let mut w = Vec::new();
+    if sc.damper.is_some() {
+        for g in sc.crystal_groups() {
+            w.push(format!(
+                "particles[{g}].placement.method: a damper bed that starts as a crystal (grid/tight) has another packing \
+                 fraction and clearance than a poured bed and moves as a block; the dissertation's beds are drop-downs: \
+                 use method = \"drop_down\" (with [settle]) for results to compare with it"
+            ));
+        }
+        if sc.damper.as_ref().is_some_and(|d| d.packings == 1) {
+            w.push(
+                "damper.packings = 1: one bed is one sample of a chaotic system; set packings >= 3 (or --packings) \
+                 for a mean with a 95 % confidence interval"
+                    .into(),
+            );
+        }
+    }
+    w
+}
+
 fn cmd_check(scenario: &std::path::Path) -> Result<()> {
     let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     let p = &world.particles;
@@ -511,7 +583,11 @@ fn cmd_check(scenario: &std::path::Path) -> Result<()> {
         "time_step_s": sc.simulation.time_step_s,
         "shortest_contact_time_s": tc,
         "time_step_over_contact_time": sc.simulation.time_step_s / tc,
+        "warnings": scenario_warnings(&sc),
     });
+    for w in scenario_warnings(&sc) {
+        eprintln!("warning: {w}");
+    }
     if let Some(d) = &sc.damper {
         report["damper"] = serde_json::json!({
             "container_body": d.container_body,

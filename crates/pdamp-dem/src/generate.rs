@@ -565,7 +565,7 @@ impl Region {
     }
 
     /// Uniform random centre for a sphere of radius `r` inside the region; `None` if it cannot fit.
-    fn sample_center<R: Rng + ?Sized>(&self, r: f64, rng: &mut R) -> Option<Vec3> {
+    pub(crate) fn sample_center<R: Rng + ?Sized>(&self, r: f64, rng: &mut R) -> Option<Vec3> {
         match self {
             Region::Box { min_m, max_m } => {
                 let mut x = Vec3::zeros();
@@ -820,7 +820,7 @@ pub struct Layering {
 }
 
 /// Uniform cell grid over a box with linked lists of particle indices (O(1) overlap checks).
-struct CellGrid {
+pub(crate) struct CellGrid {
     lo: Vec3,
     cell: f64,
     dims: [usize; 3],
@@ -828,10 +828,10 @@ struct CellGrid {
     next: Vec<u32>,
 }
 
-const EMPTY: u32 = u32::MAX;
+pub(crate) const EMPTY: u32 = u32::MAX;
 
 impl CellGrid {
-    fn new(lo: Vec3, hi: Vec3, min_cell: f64, n: usize) -> Self {
+    pub(crate) fn new(lo: Vec3, hi: Vec3, min_cell: f64, n: usize) -> Self {
         let ext = hi - lo;
         // Keep the cell count bounded (≤ ~4M cells) for huge regions with tiny particles.
         let cell = min_cell.max((ext.product() / 4.0e6).cbrt());
@@ -864,7 +864,7 @@ impl CellGrid {
     }
 
     /// Adds particle `id` (ids must be added in order 0, 1, 2, …).
-    fn insert(&mut self, id: u32, x: &Vec3) {
+    pub(crate) fn insert(&mut self, id: u32, x: &Vec3) {
         let k = self.index(self.coord(x));
         debug_assert_eq!(self.next.len(), id as usize);
         self.next.push(self.head[k]);
@@ -872,7 +872,7 @@ impl CellGrid {
     }
 
     /// Whether a sphere (x, r) overlaps any stored particle; valid while r + r_j ≤ cell size.
-    fn overlaps(&self, x: &Vec3, r: f64, pos: &[Vec3], radii: &[f64]) -> bool {
+    pub(crate) fn overlaps(&self, x: &Vec3, r: f64, pos: &[Vec3], radii: &[f64]) -> bool {
         let c = self.coord(x);
         let range = |i: usize| c[i].saturating_sub(1)..=(c[i] + 1).min(self.dims[i] - 1);
         for iz in range(2) {
@@ -891,6 +891,37 @@ impl CellGrid {
             }
         }
         false
+    }
+}
+
+impl CellGrid {
+    /// Calls `f(j)` for every stored particle in the cells around `x` (the 27 cells).
+    pub(crate) fn for_each_near(&self, x: &Vec3, mut f: impl FnMut(usize)) {
+        let c = self.coord(x);
+        let range = |i: usize| c[i].saturating_sub(1)..=(c[i] + 1).min(self.dims[i] - 1);
+        for iz in range(2) {
+            for iy in range(1) {
+                for ix in range(0) {
+                    let mut j = self.head[self.index([ix, iy, iz])];
+                    while j != EMPTY {
+                        f(j as usize);
+                        j = self.next[j as usize];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether the point `x` lies inside any stored particle (valid for points within one cell
+    /// of the stored centres' box).
+    pub(crate) fn contains_point(&self, x: &Vec3, pos: &[Vec3], radii: &[f64]) -> bool {
+        let mut inside = false;
+        self.for_each_near(x, |j| {
+            if !inside && (pos[j] - x).norm_squared() < radii[j] * radii[j] {
+                inside = true;
+            }
+        });
+        inside
     }
 }
 
@@ -914,6 +945,27 @@ pub fn random_insertion(
     seed: u64,
     max_attempts_per_particle: usize,
     layering: Option<&Layering>,
+) -> Result<Vec<Vec3>, String> {
+    random_insertion_clear_of(
+        region,
+        radii,
+        seed,
+        max_attempts_per_particle,
+        layering,
+        &|_, _| false,
+    )
+}
+
+/// [`random_insertion`] that also rejects every trial centre for which `blocked(x, r)` is true —
+/// e.g. a sphere that would start inside or across a wall or an inner structure of the
+/// container ([`crate::World::wall_overlap`]). A rejected trial counts as an attempt.
+pub fn random_insertion_clear_of(
+    region: &Region,
+    radii: &[f64],
+    seed: u64,
+    max_attempts_per_particle: usize,
+    layering: Option<&Layering>,
+    blocked: &dyn Fn(&Vec3, f64) -> bool,
 ) -> Result<Vec<Vec3>, String> {
     region.validate()?;
     let r_max = check_radii(radii)?;
@@ -992,7 +1044,7 @@ pub fn random_insertion(
                 if !region.contains_sphere(&p, r) {
                     continue;
                 }
-                if !grid.overlaps(&p, r, &pos, &ins_radii) {
+                if !grid.overlaps(&p, r, &pos, &ins_radii) && !blocked(&p, r) {
                     found = Some(p);
                     break;
                 }

@@ -7,8 +7,11 @@
 //! closes. References: [D] = the dissertation on the particle-damper design toolchain (chapter 2),
 //! [P] = the DEM–FEM powder-damper paper (section 2.1). No file I/O lives here.
 
+pub mod bed;
+pub mod bed_statistics;
 pub mod body;
 pub mod contact;
+pub mod drop_down;
 pub mod energy;
 mod forces;
 pub mod generate;
@@ -24,6 +27,7 @@ pub mod state;
 pub mod walls;
 pub mod world;
 
+pub use bed::Bed;
 pub use body::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, Wall};
 pub use contact::{ContactModel, FrictionLaw, NormalLaw};
 pub use energy::EnergyLedger;

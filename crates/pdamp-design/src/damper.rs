@@ -136,7 +136,8 @@ pub fn harmonic_amplitude(t_s: &[f64], x: &[f64], frequency_hz: f64) -> (f64, f6
 }
 
 impl Damper {
-    /// Builds the world of a damper scenario and settles it (drop-down) as the scenario says.
+    /// Builds the world of a damper scenario and prepares its bed (drop-down, settling) as the
+    /// scenario says ([`pdamp_io::prepare::prepare_bed`]); `progress` gets the fraction done.
     pub fn from_scenario(
         scenario: &Scenario,
         base_dir: &Path,
@@ -146,38 +147,14 @@ impl Damper {
             .damper
             .as_ref()
             .ok_or("scenario has no [damper] section")?;
-        let mut world = scenario.build_world(base_dir)?;
-        let container = world
+        let container = scenario
             .bodies
             .iter()
             .position(|b| b.name == spec.container_body)
             .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
+        let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))?;
+        let mut world = prepared.world;
         world.bodies[container].motion = Motion::Fixed;
-        let main_gravity = world.gravity_m_s2;
-        let settling_time_s = match &scenario.settle {
-            Some(s) => {
-                let t = pdamp_io::run::settle_with(&mut world, s, &mut progress);
-                // Filled under another gravity: turn the container and let the bed come to
-                // rest again before any excitation (a steady state needs a bed at rest).
-                let turned = s
-                    .gravity_m_s2
-                    .is_some_and(|g| Vec3::from(g) != main_gravity);
-                t + if turned {
-                    pdamp_io::run::settle_after_turn(
-                        &mut world,
-                        s.turn_max_duration_s.unwrap_or(s.max_duration_s),
-                        s.kinetic_energy_per_particle_j,
-                        &mut progress,
-                    )
-                } else {
-                    0.0
-                }
-            }
-            None => {
-                world.initialize();
-                0.0
-            }
-        };
         let bed_mass_kg = world.particles.mass.iter().sum();
         Ok(Self {
             container,
@@ -187,10 +164,15 @@ impl Damper {
             cycles: spec.cycles,
             transient_cycles: spec.transient_cycles,
             time_step_s: scenario.simulation.time_step_s,
-            settling_time_s,
+            settling_time_s: prepared.settling_time_s,
             settled: world,
             convergence: spec.convergence.clone(),
         })
+    }
+
+    /// Statistics of the settled bed, with the clearance along the excitation direction.
+    pub fn bed_statistics(&self) -> pdamp_dem::bed_statistics::BedStatistics {
+        pdamp_dem::bed_statistics::bed_statistics(&self.settled, Some(self.direction))
     }
 
     /// A damper from an already prepared world (tests, programmatic use). The world's clock is

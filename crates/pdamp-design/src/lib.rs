@@ -4,6 +4,7 @@
 
 pub mod convergence;
 pub mod damper;
+pub mod ensemble;
 pub mod event_driven;
 pub mod fields;
 pub mod motion;

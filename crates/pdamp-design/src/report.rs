@@ -2,8 +2,10 @@
 //! trajectories, VTK animation of the last cycle and plots.
 
 use crate::damper::{Damper, PointResult};
+use crate::ensemble::EnsembleStat;
 use crate::fields::{FieldGrid, FieldsOutcome, run_fields};
 use crate::motion::MotionRecorder;
+use pdamp_dem::bed_statistics::BedStatistics;
 use pdamp_io::scenario::Scenario;
 use serde::Serialize;
 use std::path::Path;
@@ -51,8 +53,158 @@ pub struct DamperRunSummary {
     pub cycles_evaluated: u32,
     /// Whether `[damper] convergence` was met (`null`: no criterion given).
     pub converged: Option<bool>,
+    /// Statistics of the settled bed of packing 0 (packing fraction, coordination number,
+    /// clearance h along the excitation).
+    pub bed: BedStatistics,
+    /// Independently prepared beds the point ran on (`[damper] packings`). With more than one,
+    /// the top-level Ẽ, η, η̄ and m̄_bed/m_bed are the ensemble means and `ensemble` holds their
+    /// spread and 95 % confidence intervals; `point`, `bed` and the motion outputs are packing 0's.
+    pub packings: usize,
+    /// Ensemble statistics (with more than one packing).
+    pub ensemble: Option<EnsembleSummary>,
     /// Everything else of the point (ledger cross-check, dissipation shares, timing).
     pub point: PointResult,
+}
+
+/// One member of an ensemble.
+#[derive(Debug, Clone, Serialize)]
+pub struct PackingResult {
+    /// Packing index k.
+    pub packing: usize,
+    /// Seed of its bed.
+    pub seed: u64,
+    /// Dissipated energy per cycle Ẽ, J.
+    pub dissipated_energy_per_cycle_j: f64,
+    /// Loss factor η.
+    pub loss_factor: f64,
+    /// Effective loss factor η̄.
+    pub effective_loss_factor: f64,
+    /// Effective mass ratio m̄_bed/m_bed.
+    pub effective_mass_ratio: f64,
+    /// Energy balance residual relative to the wall work.
+    pub energy_closure_relative: f64,
+    /// Packing fraction of the settled bed.
+    pub packing_fraction: f64,
+    /// Clearance h along the excitation, m.
+    pub clearance_m: f64,
+    /// Error of a failed member (its values are NaN and left out of the statistics).
+    pub error: Option<String>,
+}
+
+/// Mean, spread and 95 % confidence interval over the packings of a point.
+#[derive(Debug, Clone, Serialize)]
+pub struct EnsembleSummary {
+    /// Dissipated energy per cycle Ẽ, J.
+    pub dissipated_energy_per_cycle_j: EnsembleStat,
+    /// Loss factor η.
+    pub loss_factor: EnsembleStat,
+    /// Effective loss factor η̄.
+    pub effective_loss_factor: EnsembleStat,
+    /// Effective mass ratio m̄_bed/m_bed.
+    pub effective_mass_ratio: EnsembleStat,
+    /// Packing fraction of the beds.
+    pub packing_fraction: EnsembleStat,
+    /// Clearance h of the beds, m.
+    pub clearance_m: EnsembleStat,
+    /// Every member.
+    pub members: Vec<PackingResult>,
+}
+
+impl EnsembleSummary {
+    /// Statistics over `members` (failed ones left out).
+    pub fn of(members: Vec<PackingResult>) -> Self {
+        let st = |f: fn(&PackingResult) -> f64| {
+            EnsembleStat::of(&members.iter().map(f).collect::<Vec<_>>())
+        };
+        Self {
+            dissipated_energy_per_cycle_j: st(|m| m.dissipated_energy_per_cycle_j),
+            loss_factor: st(|m| m.loss_factor),
+            effective_loss_factor: st(|m| m.effective_loss_factor),
+            effective_mass_ratio: st(|m| m.effective_mass_ratio),
+            packing_fraction: st(|m| m.packing_fraction),
+            clearance_m: st(|m| m.clearance_m),
+            members,
+        }
+    }
+}
+
+/// Member `k` of an ensemble from its point and bed.
+fn packing_result(
+    k: usize,
+    seed: u64,
+    r: Result<(PointResult, BedStatistics), String>,
+) -> PackingResult {
+    match r {
+        Ok((p, b)) => PackingResult {
+            packing: k,
+            seed,
+            dissipated_energy_per_cycle_j: p.dissipated_energy_per_cycle_j,
+            loss_factor: p.loss_factor,
+            effective_loss_factor: p.effective_loss_factor,
+            effective_mass_ratio: p.effective_mass_ratio,
+            energy_closure_relative: p.energy_closure_relative,
+            packing_fraction: b.packing_fraction,
+            clearance_m: b.clearance_m.unwrap_or(f64::NAN),
+            error: None,
+        },
+        Err(e) => PackingResult {
+            packing: k,
+            seed,
+            dissipated_energy_per_cycle_j: f64::NAN,
+            loss_factor: f64::NAN,
+            effective_loss_factor: f64::NAN,
+            effective_mass_ratio: f64::NAN,
+            energy_closure_relative: f64::NAN,
+            packing_fraction: f64::NAN,
+            clearance_m: f64::NAN,
+            error: Some(e),
+        },
+    }
+}
+
+/// Runs the point (f, X) of `sc` on packings `1..packings` (packing 0 is the caller's), in
+/// parallel, each on its own freshly prepared bed; writes `out/packings/packing_KKK.json`.
+pub fn run_other_packings(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    frequency_hz: f64,
+    amplitude_m: f64,
+    packings: usize,
+    on_done: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<PackingResult>, String> {
+    use rayon::prelude::*;
+    if packings <= 1 {
+        return Ok(Vec::new());
+    }
+    let dir = out.join("packings");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("output: {e}"))?;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let members: Vec<Result<PackingResult, String>> = (1..packings)
+        .into_par_iter()
+        .map(|k| {
+            let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
+            let r = Damper::from_scenario(&sk, base_dir, |_| {}).and_then(|d| {
+                let p = d.run_point(frequency_hz, amplitude_m, &mut ())?;
+                Ok((p, d.bed_statistics()))
+            });
+            if let Err(e) = &r
+                && (e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED))
+            {
+                return Err(e.clone());
+            }
+            let m = packing_result(k, sk.simulation.seed, r);
+            let json = serde_json::to_string_pretty(&m).map_err(|e| e.to_string())?;
+            pdamp_io::atomic::write_atomic(
+                dir.join(format!("packing_{k:03}.json")),
+                json.as_bytes(),
+            )
+            .map_err(|e| format!("output: {e}"))?;
+            on_done(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+            Ok(m)
+        })
+        .collect();
+    members.into_iter().collect()
 }
 
 /// Runs the single excitation point of a damper scenario and writes `summary.json`,
@@ -123,6 +275,31 @@ pub fn run_damper_scenario(
     }
     crate::plots::velocity_field_plots(&rec, out)?;
     crate::plots::trajectory_plot(&rec, out)?;
+    let bed = damper.bed_statistics();
+    let packings = spec.packings;
+    let ensemble = if packings > 1 {
+        progress("packings", 0.0);
+        let mut members = vec![packing_result(
+            0,
+            sc.simulation.seed,
+            Ok((p.clone(), bed.clone())),
+        )];
+        members.extend(run_other_packings(
+            sc,
+            base_dir,
+            out,
+            f,
+            x,
+            packings,
+            &|_| {},
+        )?);
+        Some(EnsembleSummary::of(members))
+    } else {
+        None
+    };
+    let mean_or = |v: f64, pick: fn(&EnsembleSummary) -> &EnsembleStat| {
+        ensemble.as_ref().map_or(v, |e| pick(e).mean)
+    };
     let summary = DamperRunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: sc.title.clone(),
@@ -140,12 +317,17 @@ pub fn run_damper_scenario(
         amplitude_m: x,
         acceleration_m_s2: p.acceleration_m_s2,
         intensity: p.intensity,
-        dissipated_energy_per_cycle_j: p.dissipated_energy_per_cycle_j,
-        loss_factor: p.loss_factor,
-        effective_loss_factor: p.effective_loss_factor,
-        effective_mass_ratio: p.effective_mass_ratio,
+        dissipated_energy_per_cycle_j: mean_or(p.dissipated_energy_per_cycle_j, |e| {
+            &e.dissipated_energy_per_cycle_j
+        }),
+        loss_factor: mean_or(p.loss_factor, |e| &e.loss_factor),
+        effective_loss_factor: mean_or(p.effective_loss_factor, |e| &e.effective_loss_factor),
+        effective_mass_ratio: mean_or(p.effective_mass_ratio, |e| &e.effective_mass_ratio),
         cycles_evaluated: p.cycles_evaluated,
         converged: p.converged,
+        bed,
+        packings,
+        ensemble,
         point: p,
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;

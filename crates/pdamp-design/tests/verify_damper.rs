@@ -158,6 +158,7 @@ fn complex_power_matches_ledger_on_shaken_box() {
         transient_cycles: 3,
         convergence: None,
         motion_output: Default::default(),
+        packings: 1,
     });
     let damper = Damper::from_scenario(&sc, std::path::Path::new("."), |_| {}).expect("damper");
     let p = damper.run_point(20.0, 2e-3, &mut ()).expect("point");

@@ -75,13 +75,14 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
             filling: None,
             size: SizeDistribution::Monodisperse { radius_m: 1e-3 },
             placement: PlacementSpec {
-                method: PlacementMethod::Tight,
-                region: Region::Box {
-                    min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
-                    max_m: Vec3::new(0.5 * side, 0.5 * side, h),
-                },
                 gap_m: 2e-5,
-                layer_height_m: None,
+                ..PlacementSpec::new(
+                    PlacementMethod::Tight,
+                    Region::Box {
+                        min_m: Vec3::new(-0.5 * side, -0.5 * side, 0.0),
+                        max_m: Vec3::new(0.5 * side, 0.5 * side, h),
+                    },
+                )
             },
             initial_velocity_m_s: [0.0; 3],
         }],

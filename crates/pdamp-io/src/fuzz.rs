@@ -53,16 +53,51 @@ pub fn checkpoint(bytes: &[u8]) {
     }
 }
 
+/// LAMMPS / LIGGGHTS data files ([`crate::bed_formats::read_lammps_data`]); a bed that reads
+/// is written back ([`crate::bed_formats::write_lammps_data`]) and must read back identical (a
+/// difference panics, so the harnesses report it).
+pub fn lammps_data(bytes: &[u8]) {
+    use crate::bed_formats::{read_lammps_data, write_lammps_data};
+    let text = String::from_utf8_lossy(bytes);
+    if let Ok(bed) = read_lammps_data(&text, &[]) {
+        let densities = vec![1000.0; bed.materials.len()];
+        let out = write_lammps_data(&bed, &densities, ([-1.0; 3], [1.0; 3]));
+        let again = read_lammps_data(&out, &bed.materials);
+        assert_eq!(
+            again.as_ref(),
+            Ok(&bed),
+            "LAMMPS data round trip changed the bed"
+        );
+    }
+}
+
+/// Bed CSV ([`crate::bed_formats::read_bed_csv`]); a bed that reads is written back
+/// ([`crate::bed_formats::write_bed_csv`]) and must read back identical (a difference panics).
+pub fn bed_csv(bytes: &[u8]) {
+    use crate::bed_formats::{read_bed_csv, write_bed_csv};
+    let text = String::from_utf8_lossy(bytes);
+    if let Ok(bed) = read_bed_csv(&text, "default") {
+        let again = read_bed_csv(&write_bed_csv(&bed), "default");
+        assert_eq!(
+            again.as_ref(),
+            Ok(&bed),
+            "bed CSV round trip changed the bed"
+        );
+    }
+}
+
 /// A named fuzz entry point.
 pub type Target = (&'static str, fn(&[u8]));
 
 /// All readers by name (for the harnesses).
-pub const TARGETS: [Target; 5] = [
+pub const TARGETS: [Target; 7] = [
     ("stl", stl),
     ("scenario", scenario),
     ("csv", csv),
     ("restitution_table", restitution_table),
     ("checkpoint", checkpoint),
+    ("lammps_data", lammps_data),
+    ("bed_csv", bed_csv),
 ];
 
 /// Deterministic xorshift64* generator for the mutation fuzzer.

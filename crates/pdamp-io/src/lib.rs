@@ -4,11 +4,14 @@
 //! Every output file is written atomically (write to a temporary file, then rename).
 
 pub mod atomic;
+pub mod bed;
+pub mod bed_formats;
 pub mod bench;
 pub mod checkpoint;
 pub mod csv;
 pub mod examples;
 pub mod fuzz;
+pub mod prepare;
 pub mod provenance;
 pub mod restitution;
 pub mod run;

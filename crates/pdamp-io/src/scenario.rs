@@ -5,7 +5,7 @@
 
 use pdamp_dem::contact::ContactModel;
 use pdamp_dem::generate::{
-    Layering, Region, SizeDistribution, grid_packing, random_insertion, tight_packing,
+    Layering, Region, SizeDistribution, grid_packing, random_insertion_clear_of, tight_packing,
 };
 use pdamp_dem::walls::{BoxInside, CylinderInside, CylinderOutside, Geometry, Plane};
 use pdamp_dem::{
@@ -197,7 +197,19 @@ pub struct DamperSpec {
     /// Motion-mode output of `pdamp run` (velocity fields, trajectories, VTK frames).
     #[serde(default)]
     pub motion_output: MotionOutputSpec,
+    /// Independently prepared beds per point (an ensemble; packing k uses the seed
+    /// `simulation.seed + 1 000 003 k`): results are reported as the mean with the standard
+    /// deviation and the 95 % confidence interval over the packings.
+    #[serde(default = "default_packings")]
+    pub packings: usize,
 }
+
+fn default_packings() -> usize {
+    1
+}
+
+/// Most packings of an ensemble.
+pub const MAX_PACKINGS: usize = 1000;
 
 fn default_cycles() -> u32 {
     20
@@ -716,28 +728,114 @@ impl ParticleGroupSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlacementSpec {
-    /// `grid` (simple cubic), `tight` (hexagonal close packing) or `random`.
+    /// `drop_down` (random insertion clear of every wall, falling in rounds under gravity: the
+    /// dissertation's beds), `random` (random insertion clear of every wall, no fall), `grid`
+    /// (simple cubic crystal), `tight` (hexagonal close-packed crystal) or `file` (a saved or
+    /// imported bed).
     pub method: PlacementMethod,
-    /// Region to fill.
-    pub region: Region,
+    /// Region to fill (all methods but `file`), m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<Region>,
     /// Gap between neighbouring spheres (lattices), m.
     #[serde(default)]
     pub gap_m: f64,
     /// For `random`: height of insertion layers (layer by layer), m.
     #[serde(default)]
     pub layer_height_m: Option<f64>,
+    /// For `file`: the bed file, relative to the scenario file: a native bed of `pdamp settle`
+    /// (`*.pdbed`, exact continuation), a LAMMPS/LIGGGHTS data file of `write_data`
+    /// (`*.data`, `*.lmp`; SI units, `atom_style sphere` or `granular`) or a CSV file
+    /// (`*.csv`: `x_m,y_m,z_m,radius_m[,vx_m_s,…]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathBuf>,
+    /// For `file`: the format when the extension does not tell (`native`, `lammps`, `csv`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub format: Option<BedFormat>,
+    /// For `file` with a LAMMPS data file: material name of atom type 1, 2, … (default: every
+    /// atom gets the group's material).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub type_materials: Vec<String>,
+    /// For `drop_down`: most insertion rounds (default 200).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_rounds: Option<usize>,
+    /// For `drop_down`: longest fall of a round, s (default 0.5 s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_round_duration_s: Option<f64>,
+    /// For `drop_down`: a round's fall ends when the kinetic energy per particle is below this,
+    /// J (default: 1 % of m g r of the mean particle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub round_kinetic_energy_per_particle_j: Option<f64>,
+}
+
+impl PlacementSpec {
+    /// `method` in `region` with every other key at its default.
+    pub fn new(method: PlacementMethod, region: Region) -> Self {
+        Self {
+            method,
+            region: Some(region),
+            gap_m: 0.0,
+            layer_height_m: None,
+            path: None,
+            format: None,
+            type_materials: Vec::new(),
+            max_rounds: None,
+            max_round_duration_s: None,
+            round_kinetic_energy_per_particle_j: None,
+        }
+    }
 }
 
 /// Placement method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlacementMethod {
-    /// Simple cubic lattice.
+    /// Simple cubic lattice (a crystal).
     Grid,
-    /// Hexagonal close packing.
+    /// Hexagonal close packing (a crystal).
     Tight,
-    /// Random without overlap.
+    /// Random without overlap, clear of every wall; no fall.
     Random,
+    /// Random insertion clear of every wall, falling in rounds under gravity
+    /// ([`pdamp_dem::drop_down`], D Sect. 2.1, Fig. 2.2c/d).
+    DropDown,
+    /// A saved or imported bed ([`PlacementSpec::path`]).
+    File,
+}
+
+/// Format of a bed file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BedFormat {
+    /// pdamp's own bed file (`pdamp settle`), with the state for an exact continuation.
+    Native,
+    /// LAMMPS/LIGGGHTS data file (`write_data`).
+    Lammps,
+    /// Plain CSV.
+    Csv,
+}
+
+impl BedFormat {
+    /// The format `format` says, or the one of the path's extension.
+    pub fn of(path: &Path, format: Option<BedFormat>) -> Result<BedFormat, String> {
+        if let Some(f) = format {
+            return Ok(f);
+        }
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("pdbed") => Ok(BedFormat::Native),
+            Some("data" | "lmp" | "lammps") => Ok(BedFormat::Lammps),
+            Some("csv") => Ok(BedFormat::Csv),
+            _ => Err(format!(
+                "cannot tell the bed format of '{}' from its extension; name it *.pdbed, \
+                 *.data or *.csv, or set placement.format = \"native\" | \"lammps\" | \"csv\"",
+                path.display()
+            )),
+        }
+    }
 }
 
 /// Settling (drop-down) before the main run: the bodies stay at their reference pose.
@@ -786,14 +884,18 @@ impl Scenario {
 
     /// Reads and validates a scenario file and builds its world (paths relative to the file):
     /// all checks run before any output is written, and every error names the file, the key
-    /// with its line and column, and the fix.
+    /// with its line and column, and the fix. `drop_down` groups are checked for fit but not
+    /// dropped ([`Preparation::Check`]): their particles sit at placeholder positions far from
+    /// the container (right for counts, masses and the time-step check, not for a run).
     pub fn load_and_build(path: &Path) -> Result<(Self, World), ScenarioError> {
         let s = Self::load(path)?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
-        let world = s.build_world(&base).map_err(|m| {
-            let text = std::fs::read_to_string(path).ok();
-            ScenarioError::invalid(path, text.as_deref(), m)
-        })?;
+        let world = s
+            .build_world_with(&base, Preparation::Check, &mut |_, _| {})
+            .map_err(|m| {
+                let text = std::fs::read_to_string(path).ok();
+                ScenarioError::invalid(path, text.as_deref(), m)
+            })?;
         Ok((s, world))
     }
 
@@ -819,6 +921,104 @@ impl Scenario {
     /// Serialises to TOML.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Checks the placement of group `g` (keys as `particles[g].placement.…`).
+    fn validate_placement(&self, g: usize, pl: &PlacementSpec) -> Result<(), String> {
+        let key = format!("particles[{g}].placement");
+        let is_file = pl.method == PlacementMethod::File;
+        match (&pl.region, is_file) {
+            (Some(r), false) => r.validate().map_err(|e| format!("{key}.region.{e}"))?,
+            (None, false) => {
+                return Err(format!(
+                    "{key}.region: missing; give the volume to fill, e.g. region = {{ type = \"box\", min_m = [..], max_m = [..] }}"
+                ));
+            }
+            (Some(_), true) => {
+                return Err(format!(
+                    "{key}.region: a bed from a file has its own positions; remove region"
+                ));
+            }
+            (None, true) => {}
+        }
+        if is_file && pl.path.is_none() {
+            return Err(format!(
+                "{key}.path: missing; method = \"file\" needs the bed file (from `pdamp settle`, LAMMPS write_data or CSV)"
+            ));
+        }
+        if !is_file && (pl.path.is_some() || pl.format.is_some() || !pl.type_materials.is_empty()) {
+            return Err(format!(
+                "{key}.path: path, format and type_materials belong to method = \"file\""
+            ));
+        }
+        if is_file && self.particles.len() > 1 {
+            return Err(format!(
+                "{key}.method: a bed file holds the whole bed; it must be the only [[particles]] group"
+            ));
+        }
+        for m in &pl.type_materials {
+            self.material_index(m, &format!("{key}.type_materials"))?;
+        }
+        let is_drop = pl.method == PlacementMethod::DropDown;
+        if !is_drop
+            && (pl.max_rounds.is_some()
+                || pl.max_round_duration_s.is_some()
+                || pl.round_kinetic_energy_per_particle_j.is_some())
+        {
+            return Err(format!(
+                "{key}.max_rounds: max_rounds, max_round_duration_s and round_kinetic_energy_per_particle_j belong to method = \"drop_down\""
+            ));
+        }
+        if pl.max_rounds == Some(0) {
+            return Err(format!("{key}.max_rounds must be >= 1"));
+        }
+        if let Some(t) = pl.max_round_duration_s
+            && !(t.is_finite() && t > 0.0 && t <= 1e3)
+        {
+            return Err(format!(
+                "{key}.max_round_duration_s must be in (0, 1000] s, got {t}"
+            ));
+        }
+        if let Some(e) = pl.round_kinetic_energy_per_particle_j
+            && !(e.is_finite() && e >= 0.0)
+        {
+            return Err(format!(
+                "{key}.round_kinetic_energy_per_particle_j must be finite and >= 0 (J), got {e}"
+            ));
+        }
+        if is_drop && self.fill_gravity().norm() == 0.0 {
+            return Err(format!(
+                "{key}.method: drop_down lets the particles fall, but gravity is zero; set simulation.gravity_m_s2 or settle.gravity_m_s2, or use method = \"random\""
+            ));
+        }
+        Ok(())
+    }
+
+    /// Gravity while the bed is made: `settle.gravity_m_s2` when given, else the run's, m/s².
+    pub fn fill_gravity(&self) -> Vec3 {
+        Vec3::from(
+            self.settle
+                .as_ref()
+                .and_then(|s| s.gravity_m_s2)
+                .unwrap_or(self.simulation.gravity_m_s2),
+        )
+    }
+
+    /// Whether any group starts from a crystal (`grid` or `tight`): such a bed has another
+    /// packing fraction and clearance than the dissertation's drop-down beds and moves as a
+    /// block (a warning for damper scenarios).
+    pub fn crystal_groups(&self) -> Vec<usize> {
+        self.particles
+            .iter()
+            .enumerate()
+            .filter(|(_, g)| {
+                matches!(
+                    g.placement.method,
+                    PlacementMethod::Grid | PlacementMethod::Tight
+                )
+            })
+            .map(|(i, _)| i)
+            .collect()
     }
 
     fn material_index(&self, name: &str, key: &str) -> Result<u16, String> {
@@ -993,6 +1193,12 @@ impl Scenario {
                     known.join(", ")
                 ));
             }
+            if !(1..=MAX_PACKINGS).contains(&d.packings) {
+                return Err(format!(
+                    "damper.packings must be in 1..={MAX_PACKINGS} (independently prepared beds), got {}",
+                    d.packings
+                ));
+            }
             if !(d.container_mass_kg.is_finite() && d.container_mass_kg >= 0.0) {
                 return Err(format!(
                     "damper.container_mass_kg must be >= 0 (kg), got {}",
@@ -1163,10 +1369,7 @@ impl Scenario {
             grp.size
                 .validate()
                 .map_err(|e| format!("particles[{g}].size.{e}"))?;
-            grp.placement
-                .region
-                .validate()
-                .map_err(|e| format!("particles[{g}].placement.region.{e}"))?;
+            self.validate_placement(g, &grp.placement)?;
             if !(grp.placement.gap_m.is_finite() && grp.placement.gap_m >= 0.0) {
                 return Err(format!(
                     "particles[{g}].placement.gap_m must be >= 0 (metres), got {}",
@@ -1183,8 +1386,35 @@ impl Scenario {
     }
 
     /// Builds the world: bodies, walls (STL paths relative to `base_dir`), particles placed
-    /// and checked for overlaps, and the time step checked against the contact time.
+    /// and checked for overlaps, and the time step checked against the contact time. A
+    /// `drop_down` group is dropped here (its falls are simulated: see
+    /// [`Scenario::build_world_with`] for progress and a quick check without it).
     pub fn build_world(&self, base_dir: &Path) -> Result<World, String> {
+        self.build_world_with(base_dir, Preparation::Full, &mut |_, _| {})
+    }
+
+    /// [`Scenario::build_world`] with `mode`: [`Preparation::Check`] checks a `drop_down` group
+    /// for fit (its particles' volume against the region) without dropping it, so that the
+    /// world lacks those particles; `progress(phase, fraction)` follows the drop-down.
+    pub fn build_world_with(
+        &self,
+        base_dir: &Path,
+        mode: Preparation,
+        progress: &mut dyn FnMut(&str, f64),
+    ) -> Result<World, String> {
+        self.build_world_reporting(base_dir, mode, progress)
+            .map(|(w, _)| w)
+    }
+
+    /// [`Scenario::build_world_with`], also returning what each drop-down did (one report per
+    /// `drop_down` group, in group order).
+    pub fn build_world_reporting(
+        &self,
+        base_dir: &Path,
+        mode: Preparation,
+        progress: &mut dyn FnMut(&str, f64),
+    ) -> Result<(World, Vec<pdamp_dem::drop_down::DropDownReport>), String> {
+        let mut reports = Vec::new();
         let mut model = self.contact.default.clone();
         model.prepare();
         let mut world = World::new(self.materials.clone(), model, self.simulation.time_step_s);
@@ -1257,40 +1487,93 @@ impl Scenario {
         } else {
             Vec3::z()
         };
-        let mut placed: Vec<(Vec3, f64)> = Vec::new();
         let mut group_of: Vec<usize> = Vec::new();
+        let mut settled_bed = false;
+        let mut bed_state = None;
+        let mut placeholders: Vec<(u16, Vec<f64>)> = Vec::new();
         for (g, grp) in self.particles.iter().enumerate() {
             let mat = self.material_index(&grp.material, "particles")?;
             let count = grp
                 .resolved_count()
                 .map_err(|e| format!("particles[{g}].{e}"))?;
+            let pl = &grp.placement;
+            if pl.method == PlacementMethod::File {
+                let path = base_dir.join(pl.path.as_ref().ok_or("placement.path missing")?);
+                let (bed, state) = self.read_bed_for_group(g, &path, pl, &grp.material)?;
+                self.check_bed_against_group(g, &path, &bed, count, grp)?;
+                for i in 0..bed.len() {
+                    let m = self.material_index(
+                        &bed.materials[bed.material[i] as usize],
+                        &format!(
+                            "particles[{g}].placement.path: particle {i} of {}",
+                            path.display()
+                        ),
+                    )?;
+                    let id = world.add_particle(bed.position_m[i], bed.radius_m[i], m);
+                    world.particles.velocity[id] = bed.velocity_m_s[i];
+                    world.particles.angular_velocity[id] = bed.angular_velocity_rad_s[i];
+                    group_of.push(g);
+                }
+                settled_bed = true;
+                bed_state = state;
+                continue;
+            }
             let radii = grp
                 .size
                 .sample_n(count, self.simulation.seed.wrapping_add(g as u64));
-            let pl = &grp.placement;
-            let pos = match pl.method {
-                PlacementMethod::Grid => grid_packing(&pl.region, &radii, pl.gap_m, &up),
-                PlacementMethod::Tight => tight_packing(&pl.region, &radii, pl.gap_m, &up),
-                PlacementMethod::Random => {
-                    let layering = pl.layer_height_m.map(|h| Layering {
-                        up,
-                        layer_height_m: h,
-                    });
-                    random_insertion(
-                        &pl.region,
-                        &radii,
-                        self.simulation.seed.wrapping_add(1000 + g as u64),
-                        1000,
-                        layering.as_ref(),
-                    )
-                }
-            }
-            .map_err(|e| {
+            let region = pl.region.as_ref().ok_or("placement.region missing")?;
+            let seed = self.simulation.seed.wrapping_add(1000 + g as u64);
+            let fix = |e: String| {
                 format!(
                     "particles[{g}].placement.region: {e}; enlarge the region, or lower the \
                      particle count, the radius or placement.gap_m"
                 )
-            })?;
+            };
+            if pl.method == PlacementMethod::DropDown {
+                if mode == Preparation::Check {
+                    self.check_drop_down_fits(g, region, &radii)?;
+                    placeholders.push((mat, radii));
+                    continue;
+                }
+                let dropped =
+                    self.drop_down_group(&world, g, mat, region, &radii, seed, progress)?;
+                reports.push(dropped.report.clone());
+                settled_bed = true;
+                let r_max = radii.iter().cloned().fold(0.0, f64::max);
+                let order = pdamp_dem::generate::layer_order(&dropped.position_m, 2.0 * r_max);
+                for k in order {
+                    let id = world.add_particle(dropped.position_m[k], radii[k], mat);
+                    world.particles.velocity[id] = dropped.velocity_m_s[k];
+                    world.particles.angular_velocity[id] = dropped.angular_velocity_rad_s[k];
+                    group_of.push(g);
+                }
+                continue;
+            }
+            let pos = match pl.method {
+                PlacementMethod::Grid => grid_packing(region, &radii, pl.gap_m, &up),
+                PlacementMethod::Tight => tight_packing(region, &radii, pl.gap_m, &up),
+                _ => {
+                    let layering = pl.layer_height_m.map(|h| Layering {
+                        up,
+                        layer_height_m: h,
+                    });
+                    let scratch = std::cell::RefCell::new(Vec::new());
+                    let blocked = |x: &Vec3, r: f64| {
+                        world
+                            .wall_overlap(x, r, &mut scratch.borrow_mut())
+                            .is_some()
+                    };
+                    random_insertion_clear_of(
+                        region,
+                        &radii,
+                        seed,
+                        1000,
+                        layering.as_ref(),
+                        &blocked,
+                    )
+                }
+            }
+            .map_err(fix)?;
             // Number the group's particles by layers of cells (spatial neighbours close in
             // memory: the DEM's pair loop then finds its partners in cache).
             let r_max = radii.iter().cloned().fold(0.0, f64::max);
@@ -1298,12 +1581,39 @@ impl Scenario {
             for (x, r) in order.iter().map(|&k| (&pos[k], &radii[k])) {
                 let id = world.add_particle(*x, *r, mat);
                 world.particles.velocity[id] = Vec3::from(grp.initial_velocity_m_s);
-                placed.push((*x, *r));
                 group_of.push(g);
             }
         }
-        check_initial_overlaps(&world, &group_of)?;
-        check_inside_walls(&world, &group_of, self)?;
+        // A dropped bed or one from a file is at rest with its contacts: it overlaps its
+        // neighbours and the walls by its contact deformation (a few 1e-4 of the radius,
+        // refused beyond 5 %).
+        let tolerance = if settled_bed { 0.05 } else { 1e-9 };
+        check_initial_overlaps(&world, &group_of, tolerance)?;
+        check_inside_walls(&world, &group_of, self, tolerance)?;
+        // Check mode: the drop-down groups' particles far away in a row (for counts, masses
+        // and the time-step check below), not dropped.
+        let far = world
+            .bodies
+            .iter()
+            .flat_map(|b| b.walls.iter().filter_map(|w| w.geometry.bounding_box()))
+            .fold(1.0f64, |a, (lo, hi)| a.max(lo.amax()).max(hi.amax()));
+        let pitch = 4.0
+            * placeholders
+                .iter()
+                .flat_map(|(_, r)| r.iter())
+                .fold(0.0f64, |a, &b| a.max(b));
+        let mut x = 1e3 * far;
+        for (mat, radii) in placeholders {
+            for r in radii {
+                world.add_particle(Vec3::new(x, 0.0, 0.0), r, mat);
+                x += pitch;
+            }
+        }
+        if let Some(state) = bed_state {
+            // The saved state continues exactly when the bed was made in this container; a bed
+            // from another scenario keeps the positions, velocities and spins set above.
+            let _ = world.restore_state(state);
+        }
         if let Some(skin) = self.simulation.skin_m {
             world.set_skin(skin);
         }
@@ -1325,12 +1635,157 @@ impl Scenario {
                 ));
             }
         }
-        Ok(world)
+        Ok((world, reports))
+    }
+}
+
+/// How much of a bed [`Scenario::build_world_with`] prepares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Preparation {
+    /// Everything, drop-downs included.
+    Full,
+    /// Checks only: `drop_down` groups are checked for fit but not dropped (not in the world).
+    Check,
+}
+
+/// Densest random packing a drop-down can reach (random close packing of equal spheres).
+const RANDOM_CLOSE_PACKING: f64 = 0.64;
+
+impl Scenario {
+    /// Reads the bed file of group `g` in its format; the native format also gives the saved
+    /// state.
+    fn read_bed_for_group(
+        &self,
+        g: usize,
+        path: &Path,
+        pl: &PlacementSpec,
+        material: &str,
+    ) -> Result<(pdamp_dem::Bed, Option<pdamp_dem::WorldState>), String> {
+        let key = format!("particles[{g}].placement.path");
+        let format = BedFormat::of(path, pl.format).map_err(|e| format!("{key}: {e}"))?;
+        let read = || {
+            std::fs::read_to_string(path)
+                .map_err(|e| format!("{key}: cannot read '{}': {e}", path.display()))
+        };
+        let (bed, state) = match format {
+            BedFormat::Native => {
+                let f = crate::bed::load_bed(path).map_err(|e| format!("{key}: {e}"))?;
+                (f.bed, f.state)
+            }
+            BedFormat::Lammps => {
+                let mut bed = crate::bed_formats::read_lammps_data(&read()?, &pl.type_materials)
+                    .map_err(|e| format!("{key}: '{}': {e}", path.display()))?;
+                if pl.type_materials.is_empty() {
+                    bed.materials = vec![material.to_string()];
+                    bed.material.iter_mut().for_each(|m| *m = 0);
+                }
+                (bed, None)
+            }
+            BedFormat::Csv => (
+                crate::bed_formats::read_bed_csv(&read()?, material)
+                    .map_err(|e| format!("{key}: '{}': {e}", path.display()))?,
+                None,
+            ),
+        };
+        bed.validate()
+            .map_err(|e| format!("{key}: '{}': {e}", path.display()))?;
+        Ok((bed, state))
+    }
+
+    /// A bed must have the group's count and radii inside its size distribution.
+    fn check_bed_against_group(
+        &self,
+        g: usize,
+        path: &Path,
+        bed: &pdamp_dem::Bed,
+        count: usize,
+        grp: &ParticleGroupSpec,
+    ) -> Result<(), String> {
+        if bed.len() != count {
+            return Err(format!(
+                "particles[{g}].count: the scenario asks for {count} particles, the bed '{}' has {}; set count = {}",
+                path.display(),
+                bed.len(),
+                bed.len()
+            ));
+        }
+        let (lo, hi) = (grp.size.min_radius_m(), grp.size.max_radius_m());
+        if let Some(i) = bed
+            .radius_m
+            .iter()
+            .position(|&r| r < lo * (1.0 - 1e-9) || r > hi * (1.0 + 1e-9))
+        {
+            return Err(format!(
+                "particles[{g}].size: particle {i} of the bed '{}' has radius {:.6e} m, outside the group's size range [{lo:.6e}, {hi:.6e}] m; make the size match the bed",
+                path.display(),
+                bed.radius_m[i]
+            ));
+        }
+        Ok(())
+    }
+
+    /// A drop-down cannot pack denser than random close packing: refuse a group whose solid
+    /// volume exceeds 0.64 of the region's volume.
+    fn check_drop_down_fits(&self, g: usize, region: &Region, radii: &[f64]) -> Result<(), String> {
+        let solid: f64 = radii
+            .iter()
+            .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+            .sum();
+        let v = region.volume_m3();
+        if solid > RANDOM_CLOSE_PACKING * v {
+            return Err(format!(
+                "particles[{g}].placement.region: the particles' volume {solid:.4e} m³ is {:.2} of the region's {v:.4e} m³, more than a random packing holds ({RANDOM_CLOSE_PACKING}); enlarge the region or lower the count",
+                solid / v
+            ));
+        }
+        Ok(())
+    }
+
+    /// Drops group `g` into `world` under the filling gravity ([`Scenario::fill_gravity`]).
+    #[allow(clippy::too_many_arguments)]
+    fn drop_down_group(
+        &self,
+        world: &World,
+        g: usize,
+        mat: u16,
+        region: &Region,
+        radii: &[f64],
+        seed: u64,
+        progress: &mut dyn FnMut(&str, f64),
+    ) -> Result<pdamp_dem::drop_down::DroppedParticles, String> {
+        self.check_drop_down_fits(g, region, radii)?;
+        let pl = &self.particles[g].placement;
+        let gravity = self.fill_gravity();
+        let rho = world.materials[mat as usize].density_kg_m3;
+        let r_mean = radii.iter().sum::<f64>() / radii.len().max(1) as f64;
+        let m_mean = 4.0 / 3.0 * std::f64::consts::PI * rho * r_mean.powi(3);
+        let spec = pdamp_dem::drop_down::DropDownSpec {
+            region: region.clone(),
+            max_attempts_per_particle: 1000,
+            seed,
+            kinetic_energy_per_particle_j: pl
+                .round_kinetic_energy_per_particle_j
+                .unwrap_or(0.01 * m_mean * gravity.norm() * r_mean),
+            max_round_duration_s: pl.max_round_duration_s.unwrap_or(0.5),
+            max_rounds: pl.max_rounds.unwrap_or(200),
+        };
+        let mut w = world.clone();
+        w.gravity_m_s2 = gravity;
+        let total = radii.len().max(1) as f64;
+        pdamp_dem::drop_down::drop_down(&w, radii, mat, &spec, |_, placed| {
+            progress("drop-down", placed as f64 / total);
+            if crate::checkpoint::stop_requested() {
+                std::ops::ControlFlow::Break(())
+            } else {
+                std::ops::ControlFlow::Continue(())
+            }
+        })
+        .map_err(|e| format!("particles[{g}].placement: {e}"))
     }
 }
 
 /// Fails if two particles overlap by more than 1e-9 of the smaller radius at the start.
-fn check_initial_overlaps(world: &World, group_of: &[usize]) -> Result<(), String> {
+fn check_initial_overlaps(world: &World, group_of: &[usize], tolerance: f64) -> Result<(), String> {
     let p = &world.particles;
     let n = p.len();
     if n < 2 {
@@ -1347,7 +1802,7 @@ fn check_initial_overlaps(world: &World, group_of: &[usize]) -> Result<(), Strin
             }
             let d = (p.position[i] - p.position[j]).norm();
             let ov = p.radius[i] + p.radius[j] - d;
-            if ov > 1e-9 * p.radius[i].min(p.radius[j]) {
+            if ov > tolerance * p.radius[i].min(p.radius[j]) {
                 let (i, j) = (i.min(j), i.max(j));
                 let (gi, gj) = (group_of[i], group_of[j]);
                 let fix = if gi != gj {
@@ -1374,7 +1829,12 @@ fn check_initial_overlaps(world: &World, group_of: &[usize]) -> Result<(), Strin
 
 /// Fails if a particle starts overlapping a wall or outside a closed container (boxes and
 /// cylinders report a particle outside as a deep overlap; open meshes cannot tell).
-fn check_inside_walls(world: &World, group_of: &[usize], sc: &Scenario) -> Result<(), String> {
+fn check_inside_walls(
+    world: &World,
+    group_of: &[usize],
+    sc: &Scenario,
+    tolerance: f64,
+) -> Result<(), String> {
     let p = &world.particles;
     let mut contacts = Vec::new();
     for (bi, b) in world.bodies.iter().enumerate() {
@@ -1385,7 +1845,10 @@ fn check_inside_walls(world: &World, group_of: &[usize], sc: &Scenario) -> Resul
                 let x = pose.to_body(&p.position[i]);
                 w.geometry
                     .sphere_contacts(&x, p.radius[i], 0.0, &mut contacts);
-                if let Some(c) = contacts.iter().find(|c| c.overlap_m > 1e-9 * p.radius[i]) {
+                if let Some(c) = contacts
+                    .iter()
+                    .find(|c| c.overlap_m > tolerance * p.radius[i])
+                {
                     let outside = c.overlap_m > p.radius[i];
                     return Err(format!(
                         "particles[{g}].placement.region: particle {i} at {:?} m {} wall '{}' of body '{}' (bodies[{bi}].walls[{wi}]) by {:.3e} m; \

@@ -194,6 +194,9 @@ struct Derived {
     vert_tris: Vec<u32>,
     bbox: (Vec3, Vec3),
     grid: Grid,
+    /// Every edge is shared by exactly two triangles of opposite orientation (a closed,
+    /// consistently oriented surface).
+    closed: bool,
 }
 
 impl std::fmt::Debug for TriMesh {
@@ -403,6 +406,18 @@ impl TriMesh {
         let (vert_tri_start, vert_tris) = csr(vertices.len(), &vert_tri_pairs);
         let bbox = bbox_of(&vertices);
         let grid = Grid::build(&vertices, &faces, bbox);
+        let closed = (0..edges.len()).all(|e| {
+            let (s0, s1) = (edge_tri_start[e] as usize, edge_tri_start[e + 1] as usize);
+            if s1 - s0 != 2 {
+                return false;
+            }
+            // Opposite orientation: the edge runs a→b in one triangle and b→a in the other.
+            let dir = |(t, l): (u32, u8)| {
+                let f = faces[t as usize];
+                f[l as usize] < f[(l as usize + 1) % 3]
+            };
+            dir(edge_tris[s0]) != dir(edge_tris[s0 + 1])
+        });
         Ok(TriMesh {
             vertices,
             faces,
@@ -417,8 +432,71 @@ impl TriMesh {
                 vert_tris,
                 bbox,
                 grid,
+                closed,
             }),
         })
+    }
+
+    /// Whether the mesh is a closed, consistently oriented surface: every edge is shared by
+    /// exactly two triangles that run along it in opposite directions. Only a closed mesh has an
+    /// inside and an outside ([`TriMesh::winding_number`]).
+    pub fn is_closed(&self) -> bool {
+        self.d.closed
+    }
+
+    /// Generalised winding number of the surface around `x`: the signed solid angle of all
+    /// triangles seen from `x` over 4π (Van Oosterom–Strackee). For a closed mesh it is +1 for a
+    /// point behind every normal (inside a solid whose normals point outwards), −1 inside a
+    /// cavity whose normals point inwards (a container) and 0 outside; for an open mesh it is a
+    /// fraction. Costs O(triangles).
+    pub fn winding_number(&self, x: &Vec3) -> f64 {
+        let mut omega = 0.0;
+        for f in &self.faces {
+            let a = self.vertices[f[0] as usize] - x;
+            let b = self.vertices[f[1] as usize] - x;
+            let c = self.vertices[f[2] as usize] - x;
+            let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+            let num = a.dot(&b.cross(&c));
+            let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
+            omega += 2.0 * num.atan2(den);
+        }
+        // Normals by the right-hand rule point away from a point with positive solid angle
+        // seen counter-clockwise; "behind the normal" counts positive.
+        omega / (4.0 * std::f64::consts::PI)
+    }
+
+    /// Whether `x` lies in the particle region of a **closed** mesh, i.e. on the side the
+    /// normals point to (outside an obstacle, inside a container); always true for an open mesh
+    /// (it has no inside). The mesh's orientation decides which: a closed mesh whose normals
+    /// point outwards (positive enclosed volume) is an obstacle, one whose normals point inwards a
+    /// container.
+    pub fn in_particle_region(&self, x: &Vec3) -> bool {
+        if !self.d.closed {
+            return true;
+        }
+        let w = self.winding_number(x);
+        if self.enclosed_volume_m3() > 0.0 {
+            w < 0.5
+        } else {
+            w < -0.5
+        }
+    }
+
+    /// Signed volume enclosed by the surface (divergence theorem), m³: positive when the normals
+    /// point outwards, negative when they point inwards (a container); meaningful for closed
+    /// meshes only.
+    pub fn enclosed_volume_m3(&self) -> f64 {
+        self.faces
+            .iter()
+            .map(|f| {
+                let (a, b, c) = (
+                    self.vertices[f[0] as usize],
+                    self.vertices[f[1] as usize],
+                    self.vertices[f[2] as usize],
+                );
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum()
     }
 
     /// The closed box `center ± half_extents` as 12 triangles with normals pointing **inward**

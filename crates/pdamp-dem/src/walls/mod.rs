@@ -63,6 +63,35 @@ impl Geometry {
         }
     }
 
+    /// How far a sphere (centre `x` in the body frame, radius `r`) would start inside this wall:
+    /// the largest overlap of its contacts, or `f64::INFINITY` when the centre lies behind a
+    /// closed mesh (inside an obstacle, outside a container) where the one-sided triangles
+    /// report nothing; `None` when the sphere is clear (touching allowed up to `tolerance_m`).
+    /// Used to place particles without overlap with any wall or inner structure.
+    pub fn sphere_overlap(
+        &self,
+        x: &Vec3,
+        r: f64,
+        tolerance_m: f64,
+        scratch: &mut Vec<WallContact>,
+    ) -> Option<f64> {
+        scratch.clear();
+        self.sphere_contacts(x, r, 0.0, scratch);
+        let deepest = scratch
+            .iter()
+            .map(|c| c.overlap_m)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if deepest > tolerance_m {
+            return Some(deepest);
+        }
+        if let Geometry::Mesh(m) = self
+            && !m.in_particle_region(x)
+        {
+            return Some(f64::INFINITY);
+        }
+        None
+    }
+
     /// Axis-aligned bounding box in the body frame, if finite.
     pub fn bounding_box(&self) -> Option<(Vec3, Vec3)> {
         match self {

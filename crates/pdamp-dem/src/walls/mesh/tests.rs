@@ -457,3 +457,40 @@ fn walls_mesh_transform_and_flip() {
     assert!((cs[0].overlap_m - 0.15).abs() < TOL);
     assert!((cs[0].normal - Vec3::z()).norm() < TOL);
 }
+
+/// Winding number and closedness: a container box (inward normals) has w = −1 inside and 0
+/// outside, the same box as an obstacle (outward normals) +1 inside; a box with a face missing
+/// is open and has no inside; the enclosed volume is ∓ the box volume.
+#[test]
+fn winding_number_and_closedness() {
+    let c = Vec3::new(0.1, -0.2, 0.3);
+    let h = Vec3::new(0.5, 0.25, 1.0);
+    let container = TriMesh::box_inside(c, h);
+    assert!(container.is_closed());
+    let vol = 8.0 * h.x * h.y * h.z;
+    assert!((container.enclosed_volume_m3() + vol).abs() < 1e-12);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..200 {
+        let u = Vec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - Vec3::repeat(1.0);
+        let x = c + (h * 1.5).component_mul(&u);
+        let inside = (0..3).all(|k| (x[k] - c[k]).abs() < h[k]);
+        let w = container.winding_number(&x);
+        let expect = if inside { -1.0 } else { 0.0 };
+        assert!((w - expect).abs() < 1e-9, "{x:?}: w = {w}");
+        assert_eq!(container.in_particle_region(&x), inside);
+    }
+    let mut obstacle = container.clone();
+    obstacle.flip_normals();
+    assert!(obstacle.is_closed());
+    assert!((obstacle.enclosed_volume_m3() - vol).abs() < 1e-12);
+    assert!((obstacle.winding_number(&c) - 1.0).abs() < 1e-12);
+    assert!(!obstacle.in_particle_region(&c));
+    assert!(obstacle.in_particle_region(&(c + h * 1.01)));
+    let open = TriMesh::from_indexed(
+        container.vertices().to_vec(),
+        container.faces()[..10].to_vec(),
+    )
+    .unwrap();
+    assert!(!open.is_closed());
+    assert!(open.in_particle_region(&c));
+}

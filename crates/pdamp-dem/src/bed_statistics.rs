@@ -1,0 +1,259 @@
+//! Statistics of a particle bed at rest: packing fraction, coordination number, bed height and
+//! the clearance h it leaves along the excitation [D Eq. 6.1, 7.4, 8.1], measured on the bed
+//! rather than assumed.
+//!
+//! * **Packing fraction** φ = solid volume / volume, by Monte Carlo: uniform points (fixed seed)
+//!   in the bed's bounding box that lie in the container's free space (clear of every wall,
+//!   [`World::wall_overlap`]) below the bed surface; φ is the fraction of them inside a particle.
+//!   `packing_fraction_bulk` takes only points at least 1.5 mean diameters from every wall, the
+//!   floor and the surface (the random-packing value of the bulk, without the wall layering);
+//!   `packing_fraction` takes all free points below the surface (the container's free volume
+//!   up to the bed height, what a designer fills).
+//! * **Bed surface**: the mean, over lateral cells of two mean diameters, of the highest
+//!   particle top in the cell (along −g).
+//! * **Coordination number** Z = 2 C / N with C the touching particle–particle pairs
+//!   (centre distance < r_i + r_j); `rattler_fraction` is the share without any contact.
+//! * **Clearance** along a direction e: the free length of the container on the line through the
+//!   bed's centroid along e, minus the bed's span along e.
+
+use crate::generate::{CellGrid, orthonormal_frame};
+use crate::math::Vec3;
+use crate::world::World;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// Monte Carlo points of [`bed_statistics`] (standard error of φ ≈ 0.5/√n ≈ 1e-3).
+pub const PACKING_SAMPLES: usize = 200_000;
+
+/// Statistics of a bed (see the module docs); SI units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BedStatistics {
+    /// Number of particles.
+    pub particles: usize,
+    /// Mass of the bed, kg.
+    pub bed_mass_kg: f64,
+    /// Solid volume Σ 4/3 π r³, m³.
+    pub solid_volume_m3: f64,
+    /// Mean particle diameter, m.
+    pub mean_diameter_m: f64,
+    /// Packing fraction of the container's free volume below the bed surface.
+    pub packing_fraction: f64,
+    /// Packing fraction of the bulk (≥ 1.5 mean diameters from walls, floor and surface);
+    /// `NaN` when the bed is too shallow or narrow to have a bulk.
+    pub packing_fraction_bulk: f64,
+    /// Free volume of the container below the bed surface, m³.
+    pub free_volume_below_surface_m3: f64,
+    /// Mean number of particle–particle contacts per particle.
+    pub mean_coordination_number: f64,
+    /// Mean number of wall contacts per particle.
+    pub mean_wall_contacts: f64,
+    /// Share of particles without any particle or wall contact.
+    pub rattler_fraction: f64,
+    /// Lowest particle bottom along −g (`up` = −g/|g|), m.
+    pub bed_bottom_m: f64,
+    /// Bed surface height along `up` (module docs), m.
+    pub bed_surface_m: f64,
+    /// Bed height: surface − bottom, m.
+    pub bed_height_m: f64,
+    /// Excitation direction the next three refer to (unit), if one was given.
+    pub direction: Option<[f64; 3]>,
+    /// Span of the bed along the direction [lowest, highest] of x·e ∓ r, m.
+    pub bed_span_along_direction_m: Option<[f64; 2]>,
+    /// Free length of the container through the bed's centroid along the direction, m.
+    pub container_length_along_direction_m: Option<f64>,
+    /// Clearance h = free length − bed span along the direction [D Eq. 8.1], m.
+    pub clearance_m: Option<f64>,
+}
+
+/// Statistics of the bed of `world` (bodies at their current poses, at rest; gravity gives
+/// `up`, or +z without gravity), with the clearance along `direction` when given. Deterministic.
+pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
+    let p = &world.particles;
+    let n = p.len();
+    let g = world.gravity_m_s2;
+    let (e1, e2, up) = orthonormal_frame(&(-g)).unwrap_or((Vec3::x(), Vec3::y(), Vec3::z()));
+    let solid: f64 = p
+        .radius
+        .iter()
+        .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+        .sum();
+    let d_mean = if n > 0 {
+        2.0 * p.radius.iter().sum::<f64>() / n as f64
+    } else {
+        0.0
+    };
+    let mut s = BedStatistics {
+        particles: n,
+        bed_mass_kg: p.mass.iter().sum(),
+        solid_volume_m3: solid,
+        mean_diameter_m: d_mean,
+        packing_fraction: f64::NAN,
+        packing_fraction_bulk: f64::NAN,
+        free_volume_below_surface_m3: f64::NAN,
+        mean_coordination_number: f64::NAN,
+        mean_wall_contacts: f64::NAN,
+        rattler_fraction: f64::NAN,
+        bed_bottom_m: f64::NAN,
+        bed_surface_m: f64::NAN,
+        bed_height_m: f64::NAN,
+        direction: None,
+        bed_span_along_direction_m: None,
+        container_length_along_direction_m: None,
+        clearance_m: None,
+    };
+    if n == 0 {
+        return s;
+    }
+    let r_max = p.max_radius();
+    let (mut lo, mut hi) = (p.position[0], p.position[0]);
+    for x in &p.position {
+        lo = lo.inf(x);
+        hi = hi.sup(x);
+    }
+    let mut grid = CellGrid::new(lo, hi, 2.0 * r_max, n);
+    for (i, x) in p.position.iter().enumerate() {
+        grid.insert(i as u32, x);
+    }
+
+    // Contacts.
+    let mut pp = vec![0u32; n];
+    for i in 0..n {
+        grid.for_each_near(&p.position[i], |j| {
+            if j > i {
+                let rr = p.radius[i] + p.radius[j];
+                if (p.position[i] - p.position[j]).norm_squared() < rr * rr {
+                    pp[i] += 1;
+                    pp[j] += 1;
+                }
+            }
+        });
+    }
+    let mut scratch = Vec::new();
+    let mut wall = vec![0u32; n];
+    for (i, c) in wall.iter_mut().enumerate() {
+        for b in &world.bodies {
+            let xb = b.state.to_body(&p.position[i]);
+            for w in &b.walls {
+                scratch.clear();
+                w.geometry
+                    .sphere_contacts(&xb, p.radius[i], 0.0, &mut scratch);
+                *c += scratch.iter().filter(|k| k.overlap_m > 0.0).count() as u32;
+            }
+        }
+    }
+    s.mean_coordination_number = pp.iter().map(|&k| k as f64).sum::<f64>() / n as f64;
+    s.mean_wall_contacts = wall.iter().map(|&k| k as f64).sum::<f64>() / n as f64;
+    s.rattler_fraction = (0..n).filter(|&i| pp[i] + wall[i] == 0).count() as f64 / n as f64;
+
+    // Bottom and surface along `up`.
+    let along = |x: &Vec3| [x.dot(&e1), x.dot(&e2), x.dot(&up)];
+    let bottom = (0..n)
+        .map(|i| p.position[i].dot(&up) - p.radius[i])
+        .fold(f64::INFINITY, f64::min);
+    let (mut a_lo, mut a_hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for x in &p.position {
+        let a = along(x);
+        for k in 0..2 {
+            a_lo[k] = a_lo[k].min(a[k]);
+            a_hi[k] = a_hi[k].max(a[k]);
+        }
+    }
+    let cell = 2.0 * d_mean;
+    let cells = |k: usize| (((a_hi[k] - a_lo[k]) / cell).floor() as usize + 1).min(4096);
+    let (cx, cy) = (cells(0), cells(1));
+    let mut top = vec![f64::NEG_INFINITY; cx * cy];
+    for i in 0..n {
+        let a = along(&p.position[i]);
+        let ix = (((a[0] - a_lo[0]) / cell) as usize).min(cx - 1);
+        let iy = (((a[1] - a_lo[1]) / cell) as usize).min(cy - 1);
+        let t = &mut top[iy * cx + ix];
+        *t = t.max(a[2] + p.radius[i]);
+    }
+    let filled: Vec<f64> = top.into_iter().filter(|t| t.is_finite()).collect();
+    let surface = filled.iter().sum::<f64>() / filled.len() as f64;
+    s.bed_bottom_m = bottom;
+    s.bed_surface_m = surface;
+    s.bed_height_m = surface - bottom;
+
+    // Packing fraction by Monte Carlo in the bed's bounding box (grown by r_max).
+    let (box_lo, box_hi) = (lo.add_scalar(-r_max), hi.add_scalar(r_max));
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_bed5);
+    let margin = 1.5 * d_mean;
+    let (mut free, mut free_solid, mut bulk, mut bulk_solid) = (0usize, 0usize, 0usize, 0usize);
+    for _ in 0..PACKING_SAMPLES {
+        let u = Vec3::new(rng.random(), rng.random(), rng.random());
+        let x = box_lo + (box_hi - box_lo).component_mul(&u);
+        let h = x.dot(&up);
+        if h > surface || world.wall_overlap(&x, 0.0, &mut scratch).is_some() {
+            continue;
+        }
+        let inside = grid.contains_point(&x, &p.position, &p.radius);
+        free += 1;
+        free_solid += inside as usize;
+        if h >= bottom + margin
+            && h <= surface - margin
+            && world.wall_overlap(&x, margin, &mut scratch).is_none()
+        {
+            bulk += 1;
+            bulk_solid += inside as usize;
+        }
+    }
+    let box_volume = (box_hi - box_lo).product();
+    s.free_volume_below_surface_m3 = box_volume * free as f64 / PACKING_SAMPLES as f64;
+    s.packing_fraction = free_solid as f64 / free.max(1) as f64;
+    if bulk >= 1000 {
+        s.packing_fraction_bulk = bulk_solid as f64 / bulk as f64;
+    }
+
+    // Clearance along the excitation direction.
+    if let Some(d) = direction.filter(|d| d.norm() > 0.0 && d.iter().all(|c| c.is_finite())) {
+        let e = d.normalize();
+        let (mut s_lo, mut s_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut centroid = Vec3::zeros();
+        for i in 0..n {
+            let t = p.position[i].dot(&e);
+            s_lo = s_lo.min(t - p.radius[i]);
+            s_hi = s_hi.max(t + p.radius[i]);
+            centroid += p.position[i];
+        }
+        centroid /= n as f64;
+        let reach = 10.0 * ((hi - lo).norm() + 2.0 * r_max);
+        let free_to = |sign: f64, scratch: &mut Vec<_>| -> f64 {
+            // March in steps of a quarter radius, then bisect the wall crossing.
+            let step = 0.25 * r_max.max(1e-12);
+            let is_free = |t: f64, sc: &mut Vec<_>| {
+                world
+                    .wall_overlap(&(centroid + e * (sign * t)), 0.0, sc)
+                    .is_none()
+            };
+            let mut t = 0.0;
+            while t < reach && is_free(t + step, scratch) {
+                t += step;
+            }
+            if t >= reach {
+                return f64::INFINITY;
+            }
+            let (mut a, mut b) = (t, t + step);
+            for _ in 0..50 {
+                let m = 0.5 * (a + b);
+                if is_free(m, scratch) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            a
+        };
+        let length = if world.wall_overlap(&centroid, 0.0, &mut scratch).is_none() {
+            free_to(1.0, &mut scratch) + free_to(-1.0, &mut scratch)
+        } else {
+            f64::NAN
+        };
+        s.direction = Some([e.x, e.y, e.z]);
+        s.bed_span_along_direction_m = Some([s_lo, s_hi]);
+        s.container_length_along_direction_m = Some(length);
+        s.clearance_m = Some(length - (s_hi - s_lo));
+    }
+    s
+}

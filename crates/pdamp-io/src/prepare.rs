@@ -1,0 +1,200 @@
+//! Bed preparation as a scenario says: build the world (placing or dropping the particles,
+//! [`Scenario::build_world_reporting`]), settle it (`[settle]`, with the "turn" of a container
+//! filled under another gravity, D Sect. 8.1.1) and measure the bed
+//! ([`pdamp_dem::bed_statistics`]). Used by `pdamp settle`, damper points, effective fields and
+//! ensembles, so that every command makes its beds the same way.
+
+use crate::bed::{BedFile, save_bed};
+use crate::scenario::{Preparation, Scenario};
+use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
+use pdamp_dem::drop_down::DropDownReport;
+use pdamp_dem::{Bed, Vec3, World};
+use serde::Serialize;
+use std::path::Path;
+
+/// A settled bed in its world.
+#[derive(Debug, Clone)]
+pub struct PreparedBed {
+    /// The world after settling (clock at zero, bodies at their reference poses).
+    pub world: World,
+    /// Settling time (both stages), s.
+    pub settling_time_s: f64,
+    /// What each drop-down group did.
+    pub drop_down: Vec<DropDownReport>,
+}
+
+/// Seed of packing `k` of an ensemble: packing 0 is the scenario's own seed, the others are
+/// spaced far apart so that the size draws and insertions of different packings and groups
+/// never share a stream.
+pub fn packing_seed(seed: u64, k: usize) -> u64 {
+    seed.wrapping_add(1_000_003u64.wrapping_mul(k as u64))
+}
+
+/// The scenario with the seed of packing `k` ([`packing_seed`]).
+pub fn scenario_for_packing(scenario: &Scenario, k: usize) -> Scenario {
+    let mut s = scenario.clone();
+    s.simulation.seed = packing_seed(scenario.simulation.seed, k);
+    s
+}
+
+/// Builds and settles the bed of `scenario` (paths relative to `base_dir`);
+/// `progress(phase, fraction)` follows the drop-down and the settling.
+pub fn prepare_bed(
+    scenario: &Scenario,
+    base_dir: &Path,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<PreparedBed, String> {
+    let (mut world, drop_down) =
+        scenario.build_world_reporting(base_dir, Preparation::Full, progress)?;
+    // A damper's bed is made in the container at rest (its excitation belongs to the points).
+    if let Some(d) = &scenario.damper
+        && let Some(b) = world.bodies.iter_mut().find(|b| b.name == d.container_body)
+    {
+        b.motion = pdamp_dem::Motion::Fixed;
+    }
+    let main_gravity = world.gravity_m_s2;
+    let settling_time_s = match &scenario.settle {
+        Some(s) => {
+            let t = crate::run::settle_with(&mut world, s, |f| progress("settling", f));
+            let turned = s
+                .gravity_m_s2
+                .is_some_and(|g| Vec3::from(g) != main_gravity);
+            t + if turned {
+                crate::run::settle_after_turn(
+                    &mut world,
+                    s.turn_max_duration_s.unwrap_or(s.max_duration_s),
+                    s.kinetic_energy_per_particle_j,
+                    |f| progress("settling", f),
+                )
+            } else {
+                0.0
+            }
+        }
+        None => {
+            world.initialize();
+            0.0
+        }
+    };
+    Ok(PreparedBed {
+        world,
+        settling_time_s,
+        drop_down,
+    })
+}
+
+/// The excitation direction of a damper scenario (for the clearance), if it has one.
+pub fn excitation_direction(scenario: &Scenario) -> Option<Vec3> {
+    scenario.damper.as_ref().map(|d| Vec3::from(d.direction))
+}
+
+/// `summary.json` of `pdamp settle`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SettleSummary {
+    /// pdamp version.
+    pub pdamp_version: String,
+    /// Scenario title.
+    pub title: String,
+    /// Digest of the scenario.
+    pub scenario_digest: String,
+    /// Seed of this bed.
+    pub seed: u64,
+    /// Bed statistics.
+    pub bed: BedStatistics,
+    /// What each drop-down group did.
+    pub drop_down: Vec<DropDownReport>,
+    /// Settling time, s.
+    pub settling_time_s: f64,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// Files written (relative to the output directory).
+    pub files: Vec<String>,
+}
+
+/// `pdamp settle`: prepares the bed of `scenario` and writes into `out` the native bed
+/// `bed.pdbed` (exact continuation), `bed.csv` and `bed.data` (LAMMPS `atom_style sphere`, SI)
+/// for other codes, `bed.vtp` (ParaView), `summary.json` with the statistics, and
+/// `provenance.json`.
+pub fn settle_scenario(
+    scenario: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<SettleSummary, String> {
+    let start = std::time::Instant::now();
+    let io = |e: std::io::Error| format!("output: {e}");
+    let prepared = prepare_bed(scenario, base_dir, progress)?;
+    let world = &prepared.world;
+    crate::provenance::Provenance::of(scenario)
+        .write(scenario, out)
+        .map_err(io)?;
+    let stats = bed_statistics(world, excitation_direction(scenario));
+    let digest = crate::run::scenario_digest(scenario);
+    let bed = Bed::from_world(world);
+    save_bed(
+        &out.join("bed.pdbed"),
+        &BedFile {
+            bed: bed.clone(),
+            statistics: Some(stats.clone()),
+            drop_down: prepared.drop_down.first().cloned(),
+            settling_time_s: prepared.settling_time_s,
+            state: Some(world.save_state()),
+        },
+        &digest,
+    )?;
+    crate::atomic::write_atomic(
+        out.join("bed.csv"),
+        crate::bed_formats::write_bed_csv(&bed).as_bytes(),
+    )
+    .map_err(io)?;
+    let densities: Vec<f64> = world.materials.iter().map(|m| m.density_kg_m3).collect();
+    let p = &world.particles;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (x, r) in p.position.iter().zip(&p.radius) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(x[k] - r);
+            hi[k] = hi[k].max(x[k] + r);
+        }
+    }
+    crate::atomic::write_atomic(
+        out.join("bed.data"),
+        crate::bed_formats::write_lammps_data(&bed, &densities, (lo, hi)).as_bytes(),
+    )
+    .map_err(io)?;
+    crate::vtk::write_particles_vtp(
+        out.join("bed.vtp"),
+        &p.position,
+        &p.radius,
+        &[
+            ("velocity_m_s", crate::vtk::PointField::Vector(&p.velocity)),
+            (
+                "material",
+                crate::vtk::PointField::Int(
+                    &p.material.iter().map(|&m| m as u32).collect::<Vec<_>>(),
+                ),
+            ),
+        ],
+    )
+    .map_err(|e| format!("output: {e}"))?;
+    let summary = SettleSummary {
+        pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+        title: scenario.title.clone(),
+        scenario_digest: digest,
+        seed: scenario.simulation.seed,
+        bed: stats,
+        drop_down: prepared.drop_down,
+        settling_time_s: prepared.settling_time_s,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        files: [
+            "bed.pdbed",
+            "bed.csv",
+            "bed.data",
+            "bed.vtp",
+            "summary.json",
+        ]
+        .map(String::from)
+        .to_vec(),
+    };
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    crate::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
+    Ok(summary)
+}
