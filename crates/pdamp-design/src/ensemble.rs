@@ -105,6 +105,77 @@ impl EnsembleStat {
     }
 }
 
+/// The mean over packings of every quantity of a point (failed members, NaN, left out): the
+/// ensemble's point for `fields.csv` and the maps. Counters are averaged and rounded.
+pub fn mean_point(members: &[crate::damper::PointResult]) -> crate::damper::PointResult {
+    use crate::damper::PointResult;
+    let m = |f: fn(&PointResult) -> f64| {
+        EnsembleStat::of(&members.iter().map(f).collect::<Vec<_>>()).mean
+    };
+    let first = &members[0];
+    PointResult {
+        frequency_hz: first.frequency_hz,
+        amplitude_m: first.amplitude_m,
+        acceleration_m_s2: first.acceleration_m_s2,
+        intensity: first.intensity,
+        velocity_amplitude_m_s: first.velocity_amplitude_m_s,
+        dissipated_energy_per_cycle_j: m(|p| p.dissipated_energy_per_cycle_j),
+        loss_factor: m(|p| p.loss_factor),
+        effective_loss_factor: m(|p| p.effective_loss_factor),
+        effective_mass_ratio: m(|p| p.effective_mass_ratio),
+        effective_moving_mass_re_kg: m(|p| p.effective_moving_mass_re_kg),
+        effective_moving_mass_im_kg: m(|p| p.effective_moving_mass_im_kg),
+        ledger_dissipated_per_cycle_j: m(|p| p.ledger_dissipated_per_cycle_j),
+        ledger_wall_work_per_cycle_j: m(|p| p.ledger_wall_work_per_cycle_j),
+        share_normal_pp: m(|p| p.share_normal_pp),
+        share_normal_pw: m(|p| p.share_normal_pw),
+        share_tangential_pp: m(|p| p.share_tangential_pp),
+        share_tangential_pw: m(|p| p.share_tangential_pw),
+        energy_closure_relative: m(|p| p.energy_closure_relative),
+        cycles_evaluated: m(|p| p.cycles_evaluated as f64).round() as u32,
+        converged: members
+            .iter()
+            .map(|p| p.converged)
+            .try_fold(true, |all, c| c.map(|c| all && c)),
+        time_step_s: first.time_step_s,
+        steps: m(|p| p.steps as f64).round() as u64,
+        wall_time_s: m(|p| p.wall_time_s),
+    }
+}
+
+/// Extra columns of an ensemble's `fields.csv` (after [`crate::fields::FIELD_COLUMNS`], which
+/// then hold the means).
+pub const ENSEMBLE_COLUMNS: [&str; 7] = [
+    "packings",
+    "effective_loss_factor_std",
+    "effective_loss_factor_ci95_half_width",
+    "effective_mass_ratio_std",
+    "effective_mass_ratio_ci95_half_width",
+    "dissipated_energy_per_cycle_j_std",
+    "dissipated_energy_per_cycle_j_ci95_half_width",
+];
+
+/// The [`ENSEMBLE_COLUMNS`] of one point over its packings.
+pub fn ensemble_row(members: &[crate::damper::PointResult]) -> Vec<f64> {
+    let st = |f: fn(&crate::damper::PointResult) -> f64| {
+        EnsembleStat::of(&members.iter().map(f).collect::<Vec<_>>())
+    };
+    let (e, m, d) = (
+        st(|p| p.effective_loss_factor),
+        st(|p| p.effective_mass_ratio),
+        st(|p| p.dissipated_energy_per_cycle_j),
+    );
+    vec![
+        e.count as f64,
+        e.std,
+        e.ci95_half_width,
+        m.std,
+        m.ci95_half_width,
+        d.std,
+        d.ci95_half_width,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -193,3 +193,50 @@ pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
     pdamp_plot::line_plot(out.join("trajectories"), &plot).map_err(err)?;
     Ok(())
 }
+
+/// One map of `values` (grid order, frequency-major, NaN grey) with a linear colour scale from
+/// 0 to the largest finite value: e.g. the half-width of the 95 % confidence interval of η̄ over
+/// an ensemble (`name`.png/.svg).
+pub fn value_map(
+    grid: &FieldGrid,
+    values: &[f64],
+    out: &Path,
+    name: &str,
+    title: &str,
+    colorbar: &str,
+) -> Result<(), String> {
+    let nx = grid.frequencies_hz.len();
+    let ny = grid.amplitude_values.len();
+    if nx < 2 || ny < 2 || values.len() != nx * ny {
+        return Ok(());
+    }
+    let mut v = vec![f64::NAN; nx * ny];
+    for (k, x) in values.iter().enumerate() {
+        v[(k % ny) * nx + k / ny] = *x;
+    }
+    let hi = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(0.0_f64, f64::max);
+    let mut m = HeatMap::new(
+        grid.frequencies_hz.clone(),
+        grid.amplitude_values.clone(),
+        v,
+    );
+    m.x_axis = if grid.frequency_log {
+        Axis::log("frequency f (Hz)")
+    } else {
+        Axis::linear("frequency f (Hz)")
+    };
+    m.y_axis = if grid.amplitude_log {
+        Axis::log(grid.amplitude_title())
+    } else {
+        Axis::linear(grid.amplitude_title())
+    };
+    m.color = ColorScale::linear(0.0, hi.max(1e-300));
+    m.title = title.to_string();
+    m.colorbar_title = colorbar.to_string();
+    pdamp_plot::heat_map(out.join(name), &m).map_err(err)?;
+    Ok(())
+}

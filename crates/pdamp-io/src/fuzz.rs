@@ -86,11 +86,23 @@ pub fn bed_csv(bytes: &[u8]) {
     }
 }
 
+/// Native bed files of `pdamp settle` ([`crate::bed::decode_bed`]), also with a valid
+/// trailing digest so that mutated payloads reach the decoder.
+pub fn bed_native(bytes: &[u8]) {
+    let _ = crate::bed::decode_bed(bytes);
+    if bytes.len() > 24 {
+        let mut b = bytes[..bytes.len() - 16].to_vec();
+        let sum = crate::checkpoint::digest(&b);
+        b.extend_from_slice(sum.as_bytes());
+        let _ = crate::bed::decode_bed(&b);
+    }
+}
+
 /// A named fuzz entry point.
 pub type Target = (&'static str, fn(&[u8]));
 
 /// All readers by name (for the harnesses).
-pub const TARGETS: [Target; 7] = [
+pub const TARGETS: [Target; 8] = [
     ("stl", stl),
     ("scenario", scenario),
     ("csv", csv),
@@ -98,6 +110,7 @@ pub const TARGETS: [Target; 7] = [
     ("checkpoint", checkpoint),
     ("lammps_data", lammps_data),
     ("bed_csv", bed_csv),
+    ("bed_native", bed_native),
 ];
 
 /// Deterministic xorshift64* generator for the mutation fuzzer.

@@ -5,6 +5,7 @@ use crate::csv::CsvWriter;
 use crate::scenario::Scenario;
 use crate::vtk::{PointField, PvdSeries, write_mesh_vtp, write_particles_vtp};
 use pdamp_dem::WorldState;
+use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::{Geometry, Motion, Vec3, World};
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
@@ -66,7 +67,14 @@ pub struct RunSummary {
     pub contacts_pw: usize,
     /// Height of the bed: twice the mean particle height above the lowest particle bottom, m.
     pub bed_height_m: f64,
+    /// Statistics of the bed at the start of the main run (after settling): packing fraction,
+    /// coordination number, surface height ([`pdamp_dem::bed_statistics`]); also in
+    /// `bed_statistics.json`.
+    pub bed: Option<BedStatistics>,
 }
+
+/// File of the bed statistics at the start of a run's main phase.
+pub const BED_STATISTICS_FILE: &str = "bed_statistics.json";
 
 /// Twice the mean height of the particle centres above the lowest particle bottom, measured
 /// against gravity: a robust packing-height measure, m.
@@ -583,6 +591,11 @@ pub fn run_scenario(
         }
         None => {
             world.initialize();
+            // The bed the main run starts from (measured once; a resumed run reads it back).
+            let stats = bed_statistics(&world, crate::prepare::excitation_direction(scenario));
+            let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+            crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes())
+                .map_err(io)?;
             let mut series = if vtk_every > 0.0 {
                 std::fs::create_dir_all(&vtk_dir).map_err(io)?;
                 Some(PvdSeries::new(&pvd_path))
@@ -708,6 +721,9 @@ pub fn run_scenario(
         contacts_pp: world.num_pp_contacts(),
         contacts_pw: world.num_pw_contacts(),
         bed_height_m: bed_height_m(&world),
+        bed: std::fs::read_to_string(out_dir.join(BED_STATISTICS_FILE))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok()),
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
