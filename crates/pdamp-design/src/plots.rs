@@ -16,6 +16,74 @@ fn err(e: impl std::fmt::Display) -> String {
 /// `dissipated_energy`, `dissipation_normal_over_tangential` [D Fig. 8.8],
 /// `dissipation_wall_share` (.png/.svg).
 pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Result<(), String> {
+    field_maps_with(grid, points, out, None)
+}
+
+/// The grid's amplitude-axis value of the displacement amplitude `x_m` at `f_hz`.
+fn axis_value(grid: &FieldGrid, f_hz: f64, x_m: f64) -> f64 {
+    use pdamp_io::scenario::{AmplitudeAxis, STANDARD_GRAVITY_M_S2};
+    let w2 = (2.0 * std::f64::consts::PI * f_hz).powi(2);
+    match grid.amplitude_axis {
+        AmplitudeAxis::Displacement => x_m,
+        AmplitudeAxis::Acceleration => x_m * w2,
+        AmplitudeAxis::Intensity => x_m * w2 / STANDARD_GRAVITY_M_S2,
+    }
+}
+
+/// Lines drawn over the η̄ map as in D's figures: A = g (Γ = 1, where the bed can lift off) and,
+/// when the bed's clearance h is known, the bouncing optimum X_opt = h/π [D Eq. 6.11, 7.16, 8.2].
+fn eta_overlays(grid: &FieldGrid, clearance_m: Option<f64>) -> Vec<pdamp_plot::Polyline> {
+    use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
+    let (f0, f1) = (
+        grid.frequencies_hz[0],
+        *grid
+            .frequencies_hz
+            .last()
+            .unwrap_or(&grid.frequencies_hz[0]),
+    );
+    let fs: Vec<f64> = (0..=64)
+        .map(|k| {
+            let s = k as f64 / 64.0;
+            if grid.frequency_log {
+                f0 * (f1 / f0).powf(s)
+            } else {
+                f0 + (f1 - f0) * s
+            }
+        })
+        .collect();
+    let line = |label: &str, x_of_f: &dyn Fn(f64) -> f64, dashed: bool| {
+        let mut l = pdamp_plot::Polyline::new(
+            label,
+            fs.clone(),
+            fs.iter().map(|&f| axis_value(grid, f, x_of_f(f))).collect(),
+        );
+        l.color = Some(pdamp_plot::Rgb(255, 255, 255));
+        l.dashed = dashed;
+        l
+    };
+    let mut v = vec![line(
+        "A = g",
+        &|f| STANDARD_GRAVITY_M_S2 / (2.0 * std::f64::consts::PI * f).powi(2),
+        false,
+    )];
+    if let Some(h) = clearance_m.filter(|h| h.is_finite() && *h > 0.0) {
+        v.push(line(
+            &format!("X_opt = h/π, h = {:.2} mm", h * 1e3),
+            &|_| h / std::f64::consts::PI,
+            true,
+        ));
+    }
+    v
+}
+
+/// [`field_maps`] with the bed's clearance h along the excitation for the X_opt = h/π line
+/// on the η̄ map (the A = g line is always drawn).
+pub fn field_maps_with(
+    grid: &FieldGrid,
+    points: &[PointResult],
+    out: &Path,
+    clearance_m: Option<f64>,
+) -> Result<(), String> {
     let nx = grid.frequencies_hz.len();
     let ny = grid.amplitude_values.len();
     if nx < 2 || ny < 2 {
@@ -53,16 +121,14 @@ pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Resul
         m
     };
     let eta = pick(&|p| p.effective_loss_factor);
-    pdamp_plot::heat_map(
-        out.join("effective_loss_factor"),
-        &make(
-            eta,
-            ColorScale::linear(0.0, 1.0),
-            "effective loss factor (values ≥ 1 saturate)",
-            "η̄ (-)",
-        ),
-    )
-    .map_err(err)?;
+    let mut eta_map = make(
+        eta,
+        ColorScale::linear(0.0, 1.0),
+        "effective loss factor (values ≥ 1 saturate)",
+        "η̄ (-)",
+    );
+    eta_map.overlays = eta_overlays(grid, clearance_m);
+    pdamp_plot::heat_map(out.join("effective_loss_factor"), &eta_map).map_err(err)?;
     let mass = pick(&|p| p.effective_mass_ratio);
     let mmax = mass
         .iter()
@@ -239,4 +305,50 @@ pub fn value_map(
     m.colorbar_title = colorbar.to_string();
     pdamp_plot::heat_map(out.join(name), &m).map_err(err)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdamp_io::scenario::AmplitudeAxis;
+
+    /// The overlay lines in the units of each amplitude axis: A = g is Γ = 1, A = 9.81 m/s² and
+    /// X = g/Ω²; X_opt = h/π is constant in X and grows as Ω² in Γ.
+    #[test]
+    fn eta_overlays_in_axis_units() {
+        let mut grid = FieldGrid {
+            frequencies_hz: vec![40.0, 1000.0],
+            amplitude_axis: AmplitudeAxis::Intensity,
+            amplitude_values: vec![1.0, 40.0],
+            frequency_log: true,
+            amplitude_log: true,
+        };
+        let h = 3e-3;
+        let lines = eta_overlays(&grid, Some(h));
+        assert_eq!(lines.len(), 2);
+        assert!(lines[0].y.iter().all(|g| (g - 1.0).abs() < 1e-12));
+        let f = lines[1].x[10];
+        let w = 2.0 * std::f64::consts::PI * f;
+        assert!((lines[1].y[10] - h / std::f64::consts::PI * w * w / 9.81).abs() < 1e-9);
+        assert!((lines[1].x[0] - 40.0).abs() < 1e-12 && (lines[1].x[64] - 1000.0).abs() < 1e-9);
+        grid.amplitude_axis = AmplitudeAxis::Displacement;
+        let lines = eta_overlays(&grid, Some(h));
+        assert!(
+            lines[1]
+                .y
+                .iter()
+                .all(|x| (x - h / std::f64::consts::PI).abs() < 1e-15)
+        );
+        assert!(
+            (lines[0].y[0] - 9.81 / (2.0 * std::f64::consts::PI * 40.0f64).powi(2)).abs() < 1e-15
+        );
+        grid.amplitude_axis = AmplitudeAxis::Acceleration;
+        assert!(eta_overlays(&grid, None).len() == 1);
+        assert!(
+            eta_overlays(&grid, None)[0]
+                .y
+                .iter()
+                .all(|a| (a - 9.81).abs() < 1e-9)
+        );
+    }
 }

@@ -441,13 +441,16 @@ pub fn run_fields_scenario(
     let packings = sc.damper.as_ref().map_or(1, |d| d.packings);
     if packings == 1 {
         let damper = Damper::from_scenario(sc, base_dir, &mut settle_progress)?;
+        let bed = damper.bed_statistics();
+        write_bed_statistics(out, &bed)?;
         let outcome = run_fields(&damper, &grid, out, on_point)?;
-        crate::plots::field_maps(&grid, &outcome.points, out)?;
+        crate::plots::field_maps_with(&grid, &outcome.points, out, bed.clearance_m)?;
         return Ok(outcome);
     }
     // An ensemble: every packing's field in packings/packing_KKK/ (resumable like a single
     // field), then the means, spreads and confidence intervals in fields.csv and the maps.
     let mut fields: Vec<FieldsOutcome> = Vec::with_capacity(packings);
+    let mut clearances = Vec::with_capacity(packings);
     let total = grid.points().len() * packings;
     for k in 0..packings {
         let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
@@ -455,6 +458,10 @@ pub fn run_fields_scenario(
             settle_progress((k as f64 + f) / packings as f64)
         })?;
         let dir = out.join("packings").join(format!("packing_{k:03}"));
+        std::fs::create_dir_all(&dir).map_err(io)?;
+        let bed = damper.bed_statistics();
+        write_bed_statistics(&dir, &bed)?;
+        clearances.push(bed.clearance_m.unwrap_or(f64::NAN));
         let done_before = k * grid.points().len();
         let o = run_fields(&damper, &grid, &dir, |d, _| {
             on_point(done_before + d, total)
@@ -478,7 +485,12 @@ pub fn run_fields_scenario(
         .collect();
     pdamp_io::csv::write_csv_atomic(out.join("fields.csv"), &columns, rows.iter().cloned())
         .map_err(|e| format!("output: {e}"))?;
-    crate::plots::field_maps(&grid, &means, out)?;
+    let h = EnsembleStat::of(&clearances);
+    write_bed_statistics(
+        out,
+        &serde_json::json!({ "clearance_m": h, "packings": packings }),
+    )?;
+    crate::plots::field_maps_with(&grid, &means, out, Some(h.mean))?;
     let half: Vec<f64> = rows
         .iter()
         .map(|r| r[crate::fields::FIELD_COLUMNS.len() + 2])
@@ -497,4 +509,12 @@ pub fn run_fields_scenario(
         failed: fields.into_iter().flat_map(|o| o.failed).collect(),
         bed_span_along_direction_m: [f64::NAN; 2],
     })
+}
+
+/// Writes the bed statistics of a field (`bed_statistics.json`: packing fraction, coordination
+/// number, clearance h used for the X_opt = h/π line of the maps).
+fn write_bed_statistics(dir: &Path, stats: &impl Serialize) -> Result<(), String> {
+    let json = serde_json::to_string_pretty(stats).map_err(|e| e.to_string())?;
+    pdamp_io::atomic::write_atomic(dir.join("bed_statistics.json"), json.as_bytes())
+        .map_err(|e| format!("output: {e}"))
 }
