@@ -114,6 +114,27 @@ pub enum MeshError {
         /// Index of the triangle in the input.
         triangle: usize,
     },
+    /// Two triangles sharing an edge run along it in the same direction: one of them is
+    /// reversed, so its normal points out of the particle region (a reversed STL facet).
+    #[error(
+        "triangle {triangle} is oriented against its neighbour {neighbour} (they run along their \
+         shared edge in the same direction): its normal points the wrong way; fix the facet's \
+         vertex order in the mesh"
+    )]
+    InconsistentOrientation {
+        /// Index of the triangle (input order).
+        triangle: usize,
+        /// The neighbour it disagrees with.
+        neighbour: usize,
+    },
+    /// Two triangles have the same three vertices.
+    #[error("triangle {duplicate} repeats triangle {triangle} (same three vertices); remove it")]
+    DuplicateFacet {
+        /// The first of the two.
+        triangle: usize,
+        /// The repetition.
+        duplicate: usize,
+    },
     /// A scale factor is not positive and finite.
     #[error("scale factor must be positive and finite, got {0}")]
     BadScale(f64),
@@ -397,6 +418,36 @@ impl TriMesh {
             tris.push(Tri { n, g, e });
         }
         let (edge_tri_start, edge_tris) = csr(edges.len(), &edge_tri_pairs);
+        // A reversed facet creates energy (its normal points out of the particle region); two
+        // coincident facets double the wall force. Refuse both, naming the triangles.
+        let mut seen: HashMap<[u32; 3], usize> = HashMap::with_capacity(faces.len());
+        for (t, f) in faces.iter().enumerate() {
+            let mut key = *f;
+            key.sort_unstable();
+            if let Some(&first) = seen.get(&key) {
+                return Err(MeshError::DuplicateFacet {
+                    triangle: first,
+                    duplicate: t,
+                });
+            }
+            seen.insert(key, t);
+        }
+        for e in 0..edges.len() {
+            let (s0, s1) = (edge_tri_start[e] as usize, edge_tri_start[e + 1] as usize);
+            if s1 - s0 == 2 {
+                let forward = |(t, l): (u32, u8)| {
+                    let f = faces[t as usize];
+                    f[l as usize] < f[(l as usize + 1) % 3]
+                };
+                let (a, b) = (edge_tris[s0], edge_tris[s0 + 1]);
+                if forward(a) == forward(b) {
+                    return Err(MeshError::InconsistentOrientation {
+                        triangle: a.0.max(b.0) as usize,
+                        neighbour: a.0.min(b.0) as usize,
+                    });
+                }
+            }
+        }
         let vert_edge_pairs: Vec<(u32, u32)> = edges
             .iter()
             .enumerate()

@@ -494,3 +494,32 @@ fn winding_number_and_closedness() {
     assert!(!open.is_closed());
     assert!(open.in_particle_region(&c));
 }
+
+/// A closed box with one reversed facet (the severe defect of the reliability audit: it created
+/// ≈ 200 J from 5e-4 J) and a box with a repeated facet are refused, naming the triangles.
+#[test]
+fn reversed_or_repeated_facet_is_refused() {
+    let good = TriMesh::box_inside(Vec3::zeros(), Vec3::repeat(0.02));
+    let mut faces = good.faces().to_vec();
+    faces[5].swap(1, 2);
+    match TriMesh::from_indexed(good.vertices().to_vec(), faces) {
+        Err(MeshError::InconsistentOrientation {
+            triangle,
+            neighbour,
+        }) => {
+            assert!(triangle == 5 || neighbour == 5, "{triangle} {neighbour}");
+        }
+        other => panic!("reversed facet accepted: {other:?}"),
+    }
+    let mut faces = good.faces().to_vec();
+    faces.push([faces[3][1], faces[3][2], faces[3][0]]);
+    assert_eq!(
+        TriMesh::from_indexed(good.vertices().to_vec(), faces).unwrap_err(),
+        MeshError::DuplicateFacet {
+            triangle: 3,
+            duplicate: 12
+        }
+    );
+    // An open but consistent mesh (a box without its lid) stays valid.
+    assert!(TriMesh::from_indexed(good.vertices().to_vec(), good.faces()[..10].to_vec()).is_ok());
+}
