@@ -9,7 +9,8 @@
 //! A round inserts as many of the waiting particles as find a place in
 //! `max_attempts_per_particle` uniform trials each (in order; the first that finds none ends the
 //! round), in the slab of the region above the current bed top (highest particle top along
-//! −g). Then the world is stepped with the bodies held until the kinetic energy per particle
+//! −g) and in the pockets of the bed's surface layer (down to two largest diameters below that
+//! top). Then the world is stepped with the bodies held until the kinetic energy per particle
 //! falls below the round threshold (after at least the free-fall time of the slab) or the round's
 //! time limit is reached. A dense fill thus pours in like a real filling; a bed that fits the
 //! region in one random insertion needs one round.
@@ -84,9 +85,16 @@ pub enum DropDownError {
     Interrupted,
 }
 
-/// Final state of the dropped particles, in the order of `radii`.
+/// Final state after a drop-down: the dropped particles in the order of `radii`, and the
+/// particles that were in the world before (they settle further under the new ones).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DroppedParticles {
+    /// Final centres of the particles that were in the world before, in its order, m.
+    pub earlier_position_m: Vec<Vec3>,
+    /// Their final velocities, m/s.
+    pub earlier_velocity_m_s: Vec<Vec3>,
+    /// Their final angular velocities, rad/s.
+    pub earlier_angular_velocity_rad_s: Vec<Vec3>,
     /// Centres, m.
     pub position_m: Vec<Vec3>,
     /// Velocities, m/s.
@@ -205,7 +213,9 @@ pub fn drop_down(
         let mut inserted = 0usize;
         while next < n_total {
             let r = radii[next];
-            let z_lo = (ext[2].0 + r).max(bed_top + r);
+            // Above the bed and in the pockets of its surface layer (two diameters below the
+            // highest top), so that a bed can be poured up to about one radius under a lid.
+            let z_lo = (ext[2].0 + r).max(bed_top - 4.0 * r_max + r);
             let z_hi = ext[2].1 - r;
             let (x_lo, x_hi) = (ext[0].0 + r, ext[0].1 - r);
             let (y_lo, y_hi) = (ext[1].0 + r, ext[1].1 - r);
@@ -263,6 +273,9 @@ pub fn drop_down(
     }
     let p = &w.particles;
     Ok(DroppedParticles {
+        earlier_position_m: p.position[..first].to_vec(),
+        earlier_velocity_m_s: p.velocity[..first].to_vec(),
+        earlier_angular_velocity_rad_s: p.angular_velocity[..first].to_vec(),
         position_m: p.position[first..].to_vec(),
         velocity_m_s: p.velocity[first..].to_vec(),
         angular_velocity_rad_s: p.angular_velocity[first..].to_vec(),

@@ -1538,6 +1538,12 @@ impl Scenario {
                 let dropped =
                     self.drop_down_group(&world, g, mat, region, &radii, seed, progress)?;
                 reports.push(dropped.report.clone());
+                // Earlier groups settled further under this one.
+                for (i, x) in dropped.earlier_position_m.iter().enumerate() {
+                    world.particles.position[i] = *x;
+                    world.particles.velocity[i] = dropped.earlier_velocity_m_s[i];
+                    world.particles.angular_velocity[i] = dropped.earlier_angular_velocity_rad_s[i];
+                }
                 settled_bed = true;
                 let r_max = radii.iter().cloned().fold(0.0, f64::max);
                 let order = pdamp_dem::generate::layer_order(&dropped.position_m, 2.0 * r_max);

@@ -371,3 +371,38 @@ fn tempdir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Two drop-down groups (a layer of large spheres, then small ones on top): the first group
+/// settles further under the second, and the whole bed starts without overlap beyond contact.
+#[test]
+fn two_drop_down_groups_stack() {
+    let two = cube(CUBE_DROP, true).replace(
+        "[settle]",
+        &format!(
+            "[[particles]]\nmaterial = \"steel\"\ncount = 400\nsize = {{ type = \"monodisperse\", radius_m = 1.2e-3 }}\nplacement = {CUBE_DROP}\n[settle]"
+        ),
+    );
+    let two = two.replace("count = 1000", "count = 300");
+    let sc = Scenario::from_toml(&two).expect("parse");
+    sc.validate().expect("valid");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("two groups drop");
+    assert_eq!(bed.world.particles.len(), 700);
+    assert_eq!(bed.drop_down.len(), 2);
+    let (pp, pw) = max_overlaps(&bed.world);
+    assert!(pp < 1e-2 && pw < 1e-2, "overlaps {pp} {pw}");
+    // The small spheres lie on the large ones on average.
+    let p = &bed.world.particles;
+    let mean_z = |r: f64| {
+        let z: Vec<f64> = (0..p.len())
+            .filter(|&i| p.radius[i] == r)
+            .map(|i| p.position[i].z)
+            .collect();
+        z.iter().sum::<f64>() / z.len() as f64
+    };
+    assert!(
+        mean_z(1.2e-3) > mean_z(1.75e-3),
+        "{} {}",
+        mean_z(1.2e-3),
+        mean_z(1.75e-3)
+    );
+}
