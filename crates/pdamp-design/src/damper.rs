@@ -36,6 +36,9 @@ pub struct Damper {
     pub settling_time_s: f64,
     /// Early stop of a point on convergence (`None`: always `cycles` cycles).
     pub convergence: Option<ConvergenceSpec>,
+    /// Statistics of the bed as filled, before the container was turned (fills under
+    /// `settle.gravity_m_s2`); its clearance is D's h.
+    pub fill_statistics: Option<pdamp_dem::bed_statistics::BedStatistics>,
 }
 
 /// Result of one excitation point.
@@ -167,7 +170,17 @@ impl Damper {
             settling_time_s: prepared.settling_time_s,
             settled: world,
             convergence: spec.convergence.clone(),
+            fill_statistics: prepared.fill_statistics,
         })
+    }
+
+    /// The clearance h of D Eq. 8.1/8.2 along the excitation: of the bed as filled when it was
+    /// turned afterwards, else of the settled bed, m.
+    pub fn clearance_m(&self) -> Option<f64> {
+        self.fill_statistics
+            .as_ref()
+            .and_then(|s| s.clearance_m)
+            .or_else(|| self.bed_statistics().clearance_m)
     }
 
     /// Statistics of the settled bed, with the clearance along the excitation direction.
@@ -200,6 +213,7 @@ impl Damper {
             time_step_s,
             settling_time_s: 0.0,
             convergence: None,
+            fill_statistics: None,
         }
     }
 

@@ -56,6 +56,9 @@ pub struct DamperRunSummary {
     /// Statistics of the settled bed of packing 0 (packing fraction, coordination number,
     /// clearance h along the excitation).
     pub bed: BedStatistics,
+    /// Statistics of packing 0's bed as filled, before the "turn" (fills under
+    /// `settle.gravity_m_s2`): its `clearance_m` is D's h (Eq. 8.1/8.2).
+    pub bed_at_fill: Option<BedStatistics>,
     /// Independently prepared beds the point ran on (`[damper] packings`). With more than one,
     /// the top-level Ẽ, η, η̄ and m̄_bed/m_bed are the ensemble means and `ensemble` holds their
     /// spread and 95 % confidence intervals; `point`, `bed` and the motion outputs are packing 0's.
@@ -132,10 +135,10 @@ impl EnsembleSummary {
 fn packing_result(
     k: usize,
     seed: u64,
-    r: Result<(PointResult, BedStatistics), String>,
+    r: Result<(PointResult, BedStatistics, Option<f64>), String>,
 ) -> PackingResult {
     match r {
-        Ok((p, b)) => PackingResult {
+        Ok((p, b, clearance)) => PackingResult {
             packing: k,
             seed,
             dissipated_energy_per_cycle_j: p.dissipated_energy_per_cycle_j,
@@ -144,7 +147,7 @@ fn packing_result(
             effective_mass_ratio: p.effective_mass_ratio,
             energy_closure_relative: p.energy_closure_relative,
             packing_fraction: b.packing_fraction,
-            clearance_m: b.clearance_m.unwrap_or(f64::NAN),
+            clearance_m: clearance.unwrap_or(f64::NAN),
             error: None,
         },
         Err(e) => PackingResult {
@@ -186,7 +189,7 @@ pub fn run_other_packings(
             let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
             let r = Damper::from_scenario(&sk, base_dir, |_| {}).and_then(|d| {
                 let p = d.run_point(frequency_hz, amplitude_m, &mut ())?;
-                Ok((p, d.bed_statistics()))
+                Ok((p, d.bed_statistics(), d.clearance_m()))
             });
             if let Err(e) = &r
                 && (e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED))
@@ -282,7 +285,7 @@ pub fn run_damper_scenario(
         let mut members = vec![packing_result(
             0,
             sc.simulation.seed,
-            Ok((p.clone(), bed.clone())),
+            Ok((p.clone(), bed.clone(), damper.clearance_m())),
         )];
         members.extend(run_other_packings(
             sc,
@@ -326,6 +329,7 @@ pub fn run_damper_scenario(
         cycles_evaluated: p.cycles_evaluated,
         converged: p.converged,
         bed,
+        bed_at_fill: damper.fill_statistics.clone(),
         packings,
         ensemble,
         point: p,
@@ -442,9 +446,12 @@ pub fn run_fields_scenario(
     if packings == 1 {
         let damper = Damper::from_scenario(sc, base_dir, &mut settle_progress)?;
         let bed = damper.bed_statistics();
-        write_bed_statistics(out, &bed)?;
+        write_bed_statistics(
+            out,
+            &serde_json::json!({ "bed": bed, "bed_at_fill": damper.fill_statistics }),
+        )?;
         let outcome = run_fields(&damper, &grid, out, on_point)?;
-        crate::plots::field_maps_with(&grid, &outcome.points, out, bed.clearance_m)?;
+        crate::plots::field_maps_with(&grid, &outcome.points, out, damper.clearance_m())?;
         return Ok(outcome);
     }
     // An ensemble: every packing's field in packings/packing_KKK/ (resumable like a single
@@ -460,8 +467,11 @@ pub fn run_fields_scenario(
         let dir = out.join("packings").join(format!("packing_{k:03}"));
         std::fs::create_dir_all(&dir).map_err(io)?;
         let bed = damper.bed_statistics();
-        write_bed_statistics(&dir, &bed)?;
-        clearances.push(bed.clearance_m.unwrap_or(f64::NAN));
+        write_bed_statistics(
+            &dir,
+            &serde_json::json!({ "bed": bed, "bed_at_fill": damper.fill_statistics }),
+        )?;
+        clearances.push(damper.clearance_m().unwrap_or(f64::NAN));
         let done_before = k * grid.points().len();
         let o = run_fields(&damper, &grid, &dir, |d, _| {
             on_point(done_before + d, total)

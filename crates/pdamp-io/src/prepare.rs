@@ -21,6 +21,11 @@ pub struct PreparedBed {
     pub settling_time_s: f64,
     /// What each drop-down group did.
     pub drop_down: Vec<DropDownReport>,
+    /// Statistics of the bed as filled, before the container was "turned" (only for a fill under
+    /// `settle.gravity_m_s2`): its clearance along the excitation is the h of D Eq. 8.1/8.2 — the
+    /// gap the filled bed leaves to the cap —, which the turned bed no longer shows along the
+    /// axis.
+    pub fill_statistics: Option<BedStatistics>,
 }
 
 /// Seed of packing `k` of an ensemble: packing 0 is the scenario's own seed, the others are
@@ -53,12 +58,19 @@ pub fn prepare_bed(
         b.motion = pdamp_dem::Motion::Fixed;
     }
     let main_gravity = world.gravity_m_s2;
+    let mut fill_statistics = None;
     let settling_time_s = match &scenario.settle {
         Some(s) => {
             let t = crate::run::settle_with(&mut world, s, |f| progress("settling", f));
             let turned = s
                 .gravity_m_s2
                 .is_some_and(|g| Vec3::from(g) != main_gravity);
+            if turned {
+                // Measured under the filling gravity (settle_with put the run's back).
+                let mut filled = world.clone();
+                filled.gravity_m_s2 = Vec3::from(s.gravity_m_s2.unwrap_or([0.0; 3]));
+                fill_statistics = Some(bed_statistics(&filled, excitation_direction(scenario)));
+            }
             t + if turned {
                 crate::run::settle_after_turn(
                     &mut world,
@@ -79,6 +91,7 @@ pub fn prepare_bed(
         world,
         settling_time_s,
         drop_down,
+        fill_statistics,
     })
 }
 
@@ -100,6 +113,8 @@ pub struct SettleSummary {
     pub seed: u64,
     /// Bed statistics.
     pub bed: BedStatistics,
+    /// Statistics of the bed as filled, before the "turn" (fills under `settle.gravity_m_s2`).
+    pub bed_at_fill: Option<BedStatistics>,
     /// What each drop-down group did.
     pub drop_down: Vec<DropDownReport>,
     /// Settling time, s.
@@ -181,6 +196,7 @@ pub fn settle_scenario(
         scenario_digest: digest,
         seed: scenario.simulation.seed,
         bed: stats,
+        bed_at_fill: prepared.fill_statistics.clone(),
         drop_down: prepared.drop_down,
         settling_time_s: prepared.settling_time_s,
         wall_time_s: start.elapsed().as_secs_f64(),
