@@ -31,6 +31,7 @@ pub use bed::Bed;
 pub use body::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, Wall};
 pub use contact::{ContactModel, FrictionLaw, NormalLaw};
 pub use energy::EnergyLedger;
+pub use forces::{PairState, PpContact, WallSlot};
 pub use integrate::{GearParams, Integrator};
 pub use material::Material;
 pub use math::Vec3;

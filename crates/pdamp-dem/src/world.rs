@@ -4,7 +4,7 @@
 use crate::body::{BodyState, RigidBody};
 use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
-use crate::forces::{PpChunk, WallSlot};
+use crate::forces::{PpChunk, PpContact, WallSlot};
 use crate::integrate::{GearState, Integrator};
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
@@ -348,6 +348,24 @@ impl World {
             }
         }
         std::f64::consts::PI / omega.max(1e-300)
+    }
+
+    /// Neighbour-list skin in m (0 before the first [`World::initialize`] picks the default).
+    pub fn skin_m(&self) -> f64 {
+        self.neighbors.skin_m
+    }
+
+    /// The active particle–particle contacts with their state (history, previous forces and
+    /// stored energies), sorted by `(i, j)`: what another backend needs to continue the run
+    /// exactly (see `pdamp-gpu`).
+    pub fn particle_contacts(&self) -> Vec<PpContact> {
+        self.pp_contacts()
+    }
+
+    /// The particle–wall contacts of every particle with their state (see
+    /// [`World::particle_contacts`]).
+    pub fn wall_contacts(&self) -> &[Vec<WallSlot>] {
+        &self.wall_slots
     }
 
     /// Prepares neighbour lists and evaluates the initial forces (called by the first step).
