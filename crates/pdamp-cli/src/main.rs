@@ -11,6 +11,8 @@ use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
 use std::path::PathBuf;
 
 mod cor;
+#[cfg(feature = "gpu")]
+mod gpu;
 mod powder;
 mod structure;
 
@@ -142,7 +144,26 @@ enum Command {
         /// Print the energy balance of the timed steps too (peer comparison).
         #[arg(long)]
         peer: bool,
+        /// Where the steps run: `cpu` (the reference engine) or `gpu` (the wgpu/Vulkan
+        /// backend; lavapipe counts as a GPU driver).
+        #[arg(long, value_enum, default_value_t = Device::Cpu)]
+        device: Device,
+        /// GPU: independent shaken boxes advanced together (the points of a field).
+        #[arg(long, default_value_t = 1)]
+        batch: usize,
+        /// GPU: steps of settling with the boxes at rest before the timed steps (not timed).
+        #[arg(long, default_value_t = 10_000)]
+        settle_steps: u64,
     },
+}
+
+/// Where DEM steps run.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+enum Device {
+    /// The CPU engine (pdamp-dem).
+    Cpu,
+    /// The GPU backend (pdamp-gpu).
+    Gpu,
 }
 
 /// Excitation of a damper scenario given on the command line (overrides `[damper]`).
@@ -387,7 +408,29 @@ fn dispatch(command: Command) -> Result<()> {
             settled,
             export_liggghts,
             peer,
+            device,
+            batch,
+            settle_steps,
         } => {
+            if device == Device::Gpu {
+                #[cfg(feature = "gpu")]
+                {
+                    if peer || settled.is_some() || export_liggghts.is_some() || batch == 0 {
+                        bail!("--device gpu takes --particles, --steps, --batch (≥ 1) and --settle-steps only");
+                    }
+                    let r = gpu::bench(particles, steps, batch, settle_steps)?;
+                    println!("{r}");
+                    return Ok(());
+                }
+                #[cfg(not(feature = "gpu"))]
+                {
+                    let _ = (batch, settle_steps);
+                    bail!("this pdamp was built without the `gpu` feature");
+                }
+            }
+            if batch != 1 {
+                bail!("--batch needs --device gpu");
+            }
             if !peer && settled.is_none() && export_liggghts.is_none() {
                 let r = pdamp_io::bench::shaken_box_bench(particles, steps)
                     .map_err(anyhow::Error::msg)?;

@@ -763,6 +763,37 @@ impl GpuBatch {
         self.worlds[w].time_s
     }
 
+    /// Gives body `body` of world `w` a new motion law (e.g. the excitation after settling in a
+    /// container at rest); it takes effect from the next step, relative to the body's reference
+    /// pose.
+    pub fn set_motion(&mut self, w: usize, body: usize, motion: Motion) -> Result<(), GpuError> {
+        let b = self.worlds[w].bodies.get_mut(body).ok_or_else(|| GpuError::Body {
+            world: w,
+            body: format!("#{body}"),
+            what: "no such body".into(),
+        })?;
+        if matches!(motion, Motion::Driven) {
+            return Err(GpuError::Unsupported {
+                world: w,
+                what: format!("body '{}' driven from outside (coupling)", b.name),
+            });
+        }
+        b.motion = motion;
+        Ok(())
+    }
+
+    /// Sets the clock of world `w` back to 0 and puts its bodies at their pose of t = 0 (the
+    /// particles stay where they are), as `World::restart_clock` does after settling.
+    pub fn restart_clock(&mut self, w: usize) {
+        let meta = &mut self.worlds[w];
+        meta.time_s = 0.0;
+        for b in meta.bodies.iter_mut() {
+            let s = b.prescribed_state(0.0);
+            b.state = s;
+            b.previous = s;
+        }
+    }
+
     /// Advances every world by `steps` velocity-Verlet steps, then checks the device's error
     /// flags (non-finite states, exceeded capacities).
     pub fn step(&mut self, steps: u64) -> Result<(), GpuError> {
