@@ -53,7 +53,7 @@ fn impact(gpu: &pdamp_gpu::GpuDevice, w: &World, v_rel0: f64, max_steps: usize) 
 fn hertz_impact_matches_closed_form() {
     let Some(gpu) = device() else { return };
     let m = soft_steel();
-    let r = 1e-3;
+    let r: f64 = 1e-3;
     let v = 1.0;
     let e_eff = effective_modulus(&m, &m);
     let mass = 4.0 / 3.0 * std::f64::consts::PI * m.density_kg_m3 * r.powi(3);
@@ -81,7 +81,7 @@ fn hertz_impact_matches_closed_form() {
 #[test]
 fn damped_laws_return_their_restitution() {
     let Some(gpu) = device() else { return };
-    let r = 1e-3;
+    let r: f64 = 1e-3;
     for (name, normal, eps_want) in [
         (
             "gonthier",
@@ -166,7 +166,7 @@ fn incline_roll_and_slide() {
     let Some(gpu) = device() else { return };
     let th = 20f64.to_radians();
     let g = 9.81;
-    let r = 1e-3;
+    let r: f64 = 1e-3;
     for (mu, a_want) in [(0.5, 5.0 / 7.0 * g * th.sin()), (0.05, g * (th.sin() - 0.05 * th.cos()))] {
         let model = law(
             NormalLaw::HertzMindlin {
