@@ -18,7 +18,9 @@ LOG="$OUT/log.txt"
 GPU_STEPS=${GPU_STEPS:-1000}
 GPU_SETTLE=${GPU_SETTLE:-2000}
 CPU_THREADS=${CPU_THREADS:-"1 2 4 8 16"}
-# NVIDIA's Vulkan driver where the loader does not find it by itself.
+# NVIDIA's Vulkan driver where the loader does not find it by itself. The ICD
+# (libGLX_nvidia.so.0) needs libglvnd (libGLdispatch) besides the Vulkan loader libvulkan.so.1:
+# on a bare image install libvulkan1 libglvnd0 libgl1 libglx0 libegl1 (Debian/Ubuntu).
 if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
   export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 fi

@@ -39,7 +39,9 @@ pub fn bench(n: usize, steps: u64, batch: usize, settle_steps: u64) -> Result<se
         b.set_motion(k, 0, m)?;
         b.restart_clock(k);
     }
-    let before: Vec<_> = (0..batch.min(4)).map(|k| b.snapshot(k)).collect::<Result<_, _>>()?;
+    let before: Vec<_> = (0..batch.min(4))
+        .map(|k| b.snapshot(k))
+        .collect::<Result<_, _>>()?;
     let builds0 = b.neighbor_builds();
     let t = Instant::now();
     b.step(steps)?;
@@ -53,7 +55,12 @@ pub fn bench(n: usize, steps: u64, batch: usize, settle_steps: u64) -> Result<se
         let (dk, dp) = (l1.kinetic_j - l0.kinetic_j, l1.potential_j - l0.potential_j);
         let dd = l1.dissipated_j() - l0.dissipated_j();
         let change = dk + dp + (l1.elastic_j - l0.elastic_j) + dd;
-        let turnover = work.abs().max(dk.abs()).max(dp.abs()).max(dd.abs()).max(1e-300);
+        let turnover = work
+            .abs()
+            .max(dk.abs())
+            .max(dp.abs())
+            .max(dd.abs())
+            .max(1e-300);
         closure = closure.max((work - change).abs() / turnover);
     }
     // Digest of world 0's final positions and velocities (bits): equal digests of two runs

@@ -416,7 +416,9 @@ fn dispatch(command: Command) -> Result<()> {
                 #[cfg(feature = "gpu")]
                 {
                     if peer || settled.is_some() || export_liggghts.is_some() || batch == 0 {
-                        bail!("--device gpu takes --particles, --steps, --batch (≥ 1) and --settle-steps only");
+                        bail!(
+                            "--device gpu takes --particles, --steps, --batch (≥ 1) and --settle-steps only"
+                        );
                     }
                     let r = gpu::bench(particles, steps, batch, settle_steps)?;
                     println!("{r}");

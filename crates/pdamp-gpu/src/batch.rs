@@ -138,7 +138,10 @@ impl std::fmt::Debug for GpuBatch {
 }
 
 /// Parameters of one contact law for the kernels: `LAW_F` numbers and the kinds.
-fn law_row(model: &ContactModel, el: &pdamp_dem::interaction::PairElastic) -> Result<([f64; LAW_F], [u32; 4]), String> {
+fn law_row(
+    model: &ContactModel,
+    el: &pdamp_dem::interaction::PairElastic,
+) -> Result<([f64; LAW_F], [u32; 4]), String> {
     if model.rolling.is_some() {
         return Err("rolling resistance".into());
     }
@@ -222,11 +225,23 @@ fn law_row(model: &ContactModel, el: &pdamp_dem::interaction::PairElastic) -> Re
 fn wall_rows(g: &Geometry) -> Result<(u32, [[f64; 4]; 3], u32), String> {
     let v = |a: &Vec3, w: f64| [a.x, a.y, a.z, w];
     Ok(match g {
-        Geometry::Plane(p) => (0, [v(&p.point_m, 0.0), v(&p.normal, 0.0), [0.0; 4]], p.two_sided as u32),
-        Geometry::BoxInside(b) => (1, [v(&b.center_m, 0.0), v(&b.half_extents_m, 0.0), [0.0; 4]], 0),
+        Geometry::Plane(p) => (
+            0,
+            [v(&p.point_m, 0.0), v(&p.normal, 0.0), [0.0; 4]],
+            p.two_sided as u32,
+        ),
+        Geometry::BoxInside(b) => (
+            1,
+            [v(&b.center_m, 0.0), v(&b.half_extents_m, 0.0), [0.0; 4]],
+            0,
+        ),
         Geometry::CylinderInside(c) => (
             2,
-            [v(&c.base_center_m, 0.0), v(&c.axis, 0.0), [c.radius_m, c.length_m, 0.0, 0.0]],
+            [
+                v(&c.base_center_m, 0.0),
+                v(&c.axis, 0.0),
+                [c.radius_m, c.length_m, 0.0, 0.0],
+            ],
             0,
         ),
         Geometry::CylinderOutside(_) => return Err("a cylinder_outside wall (inner rod)".into()),
@@ -257,13 +272,19 @@ impl GpuBatch {
         for (k, w) in worlds.iter().enumerate() {
             let unsupported = |what: String| GpuError::Unsupported { world: k, what };
             if !matches!(w.integrator, Integrator::VelocityVerlet) {
-                return Err(unsupported("an integrator other than velocity Verlet".into()));
+                return Err(unsupported(
+                    "an integrator other than velocity Verlet".into(),
+                ));
             }
             if w.step_pending() {
-                return Err(unsupported("a world with a half kick pending (call complete_step)".into()));
+                return Err(unsupported(
+                    "a world with a half kick pending (call complete_step)".into(),
+                ));
             }
             if w.skin_m() <= 0.0 {
-                return Err(unsupported("an uninitialised world (call initialize)".into()));
+                return Err(unsupported(
+                    "an uninitialised world (call initialize)".into(),
+                ));
             }
             if w.dt_s != dt {
                 return Err(GpuError::Mismatch {
@@ -277,16 +298,24 @@ impl GpuBatch {
                     what: "materials or contact laws".into(),
                 });
             }
-            if w.particles.external_force.iter().any(|f| *f != Vec3::zeros()) {
+            if w.particles
+                .external_force
+                .iter()
+                .any(|f| *f != Vec3::zeros())
+            {
                 return Err(unsupported("external particle forces".into()));
             }
             for b in &w.bodies {
                 if matches!(b.motion, Motion::Driven) {
-                    return Err(unsupported(format!("body '{}' driven from outside (coupling)", b.name)));
+                    return Err(unsupported(format!(
+                        "body '{}' driven from outside (coupling)",
+                        b.name
+                    )));
                 }
                 for wall in &b.walls {
-                    wall_rows(&wall.geometry)
-                        .map_err(|e| unsupported(format!("{e} ('{}' of body '{}')", wall.name, b.name)))?;
+                    wall_rows(&wall.geometry).map_err(|e| {
+                        unsupported(format!("{e} ('{}' of body '{}')", wall.name, b.name))
+                    })?;
                 }
             }
             skin = skin.max(w.skin_m());
@@ -300,7 +329,10 @@ impl GpuBatch {
                 let (model, el) = w0.interactions.get(a as u16, b as u16);
                 let (f, u) = law_row(model, el).map_err(|what| GpuError::Unsupported {
                     world: 0,
-                    what: format!("{what} (materials '{}' and '{}')", w0.materials[a].name, w0.materials[b].name),
+                    what: format!(
+                        "{what} (materials '{}' and '{}')",
+                        w0.materials[a].name, w0.materials[b].name
+                    ),
                 })?;
                 law_f.extend_from_slice(&f);
                 law_u.push(u);
@@ -308,12 +340,16 @@ impl GpuBatch {
         }
         let n: usize = worlds.iter().map(|w| w.particles.len()).sum();
         if n == 0 {
-            return Err(GpuError::Mismatch { world: 0, what: "no particles".into() });
+            return Err(GpuError::Mismatch {
+                world: 0,
+                what: "no particles".into(),
+            });
         }
         // Capacities from the size distribution.
         let q = rmax / rmin;
         let max_c = ((12.0 * (0.5 * (1.0 + q)).powi(2)).ceil() as u32 + 2).min(32);
-        let max_nb = ((18.0 * ((2.0 * rmax + skin) / (2.0 * rmin)).powi(3)).ceil() as u32).clamp(16, 512);
+        let max_nb =
+            ((18.0 * ((2.0 * rmax + skin) / (2.0 * rmin)).powi(3)).ceil() as u32).clamp(16, 512);
         let max_wc = 4u32;
         // Neighbour grids, one per world.
         let mut world_f: Vec<[f64; 4]> = Vec::new();
@@ -400,8 +436,14 @@ impl GpuBatch {
             ("particle state", 5 * nu * 32 + nu * 16 + nu * 32),
             ("neighbour cells", n_cells * 4 * (1 + cell_cap as u64)),
             ("neighbour lists", nu * 4 * (1 + max_nb as u64)),
-            ("contacts", 2 * nu * 4 * (1 + max_c as u64) + 2 * 3 * nu * max_c as u64 * 32),
-            ("wall contacts", 2 * nu * 4 * (1 + max_wc as u64) + 2 * 4 * nu * max_wc as u64 * 32),
+            (
+                "contacts",
+                2 * nu * 4 * (1 + max_c as u64) + 2 * 3 * nu * max_c as u64 * 32,
+            ),
+            (
+                "wall contacts",
+                2 * nu * 4 * (1 + max_wc as u64) + 2 * 4 * nu * max_wc as u64 * 32,
+            ),
             ("ledger and loads", nu * 128),
             ("body table", (CHUNK_STEPS * n_bodies * 64) as u64),
         ];
@@ -425,7 +467,9 @@ impl GpuBatch {
             neighbors_per_particle: max_nb,
         };
         let limits = gpu.limits();
-        let binding_limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let binding_limit = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
         if largest > binding_limit {
             return Err(GpuError::TooLarge {
                 what: "one buffer".into(),
@@ -433,7 +477,9 @@ impl GpuBatch {
                 limit_bytes: binding_limit,
             });
         }
-        let wg = n.div_ceil(WG as usize).max(n_cells as usize / WG as usize + 1);
+        let wg = n
+            .div_ceil(WG as usize)
+            .max(n_cells as usize / WG as usize + 1);
         if wg > limits.max_compute_workgroups_per_dimension as usize {
             return Err(GpuError::TooLarge {
                 what: "workgroups of one dispatch (particles or cells / 256)".into(),
@@ -451,7 +497,11 @@ impl GpuBatch {
         let mut pinfo = vec![[0u32; 4]; n];
         let mc = max_c as usize;
         let mut c_ids = vec![0u32; n * (mc + 1)];
-        let mut c_s = [vec![[0.0f64; 4]; n * mc], vec![[0.0f64; 4]; n * mc], vec![[0.0f64; 4]; n * mc]];
+        let mut c_s = [
+            vec![[0.0f64; 4]; n * mc],
+            vec![[0.0f64; 4]; n * mc],
+            vec![[0.0f64; 4]; n * mc],
+        ];
         let mw = max_wc as usize;
         let mut w_keys = vec![0u32; n * (mw + 1)];
         let mut w_st = vec![[0.0f64; 4]; 4 * n * mw];
@@ -488,7 +538,8 @@ impl GpuBatch {
                     c_ids[g * (mc + 1) + 1 + m] = meta.first as u32 + b;
                     c_s[0][g * mc + m] = v4(&(h.spring_m * sign), h.impact_velocity_m_s);
                     c_s[1][g * mc + m] = v4(&(s.normal_force_prev * sign), s.normal_energy_prev);
-                    c_s[2][g * mc + m] = v4(&(s.tangential_force_prev * sign), s.tangential_energy_prev);
+                    c_s[2][g * mc + m] =
+                        v4(&(s.tangential_force_prev * sign), s.tangential_energy_prev);
                     c_ids[g * (mc + 1)] += 1;
                 }
             }
@@ -551,7 +602,9 @@ impl GpuBatch {
 
         let device = gpu.device.clone();
         let queue = gpu.queue.clone();
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let storage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
         let init = |label: &str, bytes: &[u8]| {
             let mut v = bytes.to_vec();
             if v.len() < 32 {
@@ -605,7 +658,10 @@ impl GpuBatch {
         ];
         let ledger = zeroed("ledger", nu * 128);
         // ctrl: displacement bits, step, builds, flags, first failing particle, force rebuild
-        let ctrl = init("ctrl", bytemuck::cast_slice(&[0u32, 0, 0, 0, u32::MAX, 1, 0, 0]));
+        let ctrl = init(
+            "ctrl",
+            bytemuck::cast_slice(&[0u32, 0, 0, 0, u32::MAX, 1, 0, 0]),
+        );
         let args = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("args"),
             size: 32,
@@ -629,10 +685,20 @@ impl GpuBatch {
                 })
                 .collect::<Vec<_>>(),
         });
-        let group = |inp: (&[wgpu::Buffer; 4], &[wgpu::Buffer; 2]), out: (&[wgpu::Buffer; 4], &[wgpu::Buffer; 2])| {
+        let group = |inp: (&[wgpu::Buffer; 4], &[wgpu::Buffer; 2]),
+                     out: (&[wgpu::Buffer; 4], &[wgpu::Buffer; 2])| {
             let mut list: Vec<&wgpu::Buffer> = vec![
-                &p_buf, &pos_buf, &vel_buf, &omg_buf, &frc_buf, &trq_buf, &tab_f_buf, &tab_u_buf, &cell_count,
-                &cell_items, &nb,
+                &p_buf,
+                &pos_buf,
+                &vel_buf,
+                &omg_buf,
+                &frc_buf,
+                &trq_buf,
+                &tab_f_buf,
+                &tab_u_buf,
+                &cell_count,
+                &cell_items,
+                &nb,
             ];
             list.extend(inp.0.iter());
             list.extend(out.0.iter());
@@ -654,7 +720,10 @@ impl GpuBatch {
                 entries: &entries,
             })
         };
-        let groups = [group((&c_a, &w_a), (&c_b, &w_b)), group((&c_b, &w_b), (&c_a, &w_a))];
+        let groups = [
+            group((&c_a, &w_a), (&c_b, &w_b)),
+            group((&c_b, &w_b), (&c_a, &w_a)),
+        ];
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("dem.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("dem.wgsl").into()),
@@ -767,11 +836,14 @@ impl GpuBatch {
     /// container at rest); it takes effect from the next step, relative to the body's reference
     /// pose.
     pub fn set_motion(&mut self, w: usize, body: usize, motion: Motion) -> Result<(), GpuError> {
-        let b = self.worlds[w].bodies.get_mut(body).ok_or_else(|| GpuError::Body {
-            world: w,
-            body: format!("#{body}"),
-            what: "no such body".into(),
-        })?;
+        let b = self.worlds[w]
+            .bodies
+            .get_mut(body)
+            .ok_or_else(|| GpuError::Body {
+                world: w,
+                body: format!("#{body}"),
+                what: "no such body".into(),
+            })?;
         if matches!(motion, Motion::Driven) {
             return Err(GpuError::Unsupported {
                 world: w,
@@ -805,7 +877,8 @@ impl GpuBatch {
         while left > 0 {
             let k = left.min(CHUNK_STEPS);
             self.fill_body_table(k)?;
-            self.queue.write_buffer(&self.ctrl, 4, bytemuck::bytes_of(&0u32));
+            self.queue
+                .write_buffer(&self.ctrl, 4, bytemuck::bytes_of(&0u32));
             let mut enc = self.device.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
@@ -842,8 +915,16 @@ impl GpuBatch {
         self.builds = ctrl[2] as u64;
         if ctrl[3] != 0 {
             let g = ctrl[4] as usize;
-            let k = self.worlds.iter().position(|w| g >= w.first && g < w.first + w.n).unwrap_or(0);
-            let (world, particle, time_s) = (k, g.saturating_sub(self.worlds[k].first), self.worlds[k].time_s);
+            let k = self
+                .worlds
+                .iter()
+                .position(|w| g >= w.first && g < w.first + w.n)
+                .unwrap_or(0);
+            let (world, particle, time_s) = (
+                k,
+                g.saturating_sub(self.worlds[k].first),
+                self.worlds[k].time_s,
+            );
             let (max_c, max_nb, max_wc, cell_cap) = self.caps;
             let flags = ctrl[3];
             let err = if flags & 4 != 0 {
@@ -894,7 +975,9 @@ impl GpuBatch {
                         return Err(GpuError::Body {
                             world: wk,
                             body: b.name.clone(),
-                            what: format!("rotates at t = {t1} s; the GPU kernels take translating bodies only"),
+                            what: format!(
+                                "rotates at t = {t1} s; the GPU kernels take translating bodies only"
+                            ),
                         });
                     }
                     let st = b.step_state(self.dt);
@@ -906,11 +989,17 @@ impl GpuBatch {
             }
             w.time_s = t;
         }
-        self.queue.write_buffer(&self.tab_f, self.off_body * 32, bytemuck::cast_slice(&tab));
+        self.queue
+            .write_buffer(&self.tab_f, self.off_body * 32, bytemuck::cast_slice(&tab));
         Ok(())
     }
 
-    fn read<T: bytemuck::Pod>(&self, buf: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<T>, GpuError> {
+    fn read<T: bytemuck::Pod>(
+        &self,
+        buf: &wgpu::Buffer,
+        offset: u64,
+        size: u64,
+    ) -> Result<Vec<T>, GpuError> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -949,7 +1038,11 @@ impl GpuBatch {
         let omg = self.read_vec3(&self.omg, meta)?;
         let frc = self.read_vec3(&self.frc, meta)?;
         let trq = self.read_vec3(&self.trq, meta)?;
-        let led: Vec<[f64; 4]> = self.read(&self.ledger, meta.first as u64 * 128, (meta.n as u64 * 128).max(32))?;
+        let led: Vec<[f64; 4]> = self.read(
+            &self.ledger,
+            meta.first as u64 * 128,
+            (meta.n as u64 * 128).max(32),
+        )?;
         let mut ledger = meta.ledger0;
         let mut sums = [0.0f64; 6];
         for i in 0..meta.n {

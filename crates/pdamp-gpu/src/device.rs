@@ -33,7 +33,10 @@ impl GpuDevice {
         for a in adapters {
             let info = a.get_info();
             let f64_ok = a.features().contains(wgpu::Features::SHADER_F64);
-            seen.push(format!("{} ({:?}, f64 {})", info.name, info.device_type, f64_ok));
+            seen.push(format!(
+                "{} ({:?}, f64 {})",
+                info.name, info.device_type, f64_ok
+            ));
             if !f64_ok {
                 continue;
             }
@@ -83,7 +86,10 @@ impl GpuDevice {
 
     /// Name and driver of the adapter, e.g. "NVIDIA H200 (NVIDIA 580.159.04)".
     pub fn name(&self) -> String {
-        format!("{} ({} {})", self.info.name, self.info.driver, self.info.driver_info)
+        format!(
+            "{} ({} {})",
+            self.info.name, self.info.driver, self.info.driver_info
+        )
     }
 
     /// Whether this is a CPU driver (lavapipe) rather than a GPU.

@@ -29,7 +29,10 @@ fn shaken_box_trajectory_matches_cpu() {
         "largest position difference over 1 000 steps: {worst:.3e} m; neighbour builds {}",
         batch.neighbor_builds()
     );
-    assert!(worst <= 1e-9, "GPU trajectory left the CPU one by {worst:e} m");
+    assert!(
+        worst <= 1e-9,
+        "GPU trajectory left the CPU one by {worst:e} m"
+    );
     let (a, b) = (&w.ledger, &s.ledger);
     eprintln!("CPU ledger {a:?}\nGPU ledger {b:?}");
     let rel = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs()).max(1e-300);
