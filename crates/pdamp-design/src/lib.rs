@@ -7,6 +7,8 @@ pub mod damper;
 pub mod ensemble;
 pub mod event_driven;
 pub mod fields;
+#[cfg(feature = "gpu")]
+pub mod gpu_points;
 pub mod motion;
 pub mod plots;
 pub mod report;

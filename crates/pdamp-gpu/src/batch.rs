@@ -32,12 +32,28 @@ struct Params {
     off_world_u: u32,
     off_wall_u: u32,
     off_law_u: u32,
-    pad0: u32,
-    pad1: u32,
-    dt: f64,
-    half: f64,
+    n_worlds: u32,
+    off_wstep: u32,
     skin: f64,
     pad: f64,
+}
+
+/// How far a world goes in the next `GpuBatch` run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    /// This many steps of the nominal time step.
+    Steps(u64),
+    /// Until this time, the last step shortened to end on it (as `World::run_until`).
+    Until(f64),
+}
+
+/// The single-bin DFT of a body's load over a time window [D Eq. 3.12–3.17].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Sampling {
+    body: usize,
+    omega: f64,
+    t_start: f64,
+    t_end: f64,
 }
 
 /// Device memory a batch needs, computed before anything is allocated.
@@ -84,6 +100,11 @@ struct WorldMeta {
     bodies: Vec<RigidBody>,
     body_offset: usize,
     time_s: f64,
+    dt_s: f64,
+    target: Target,
+    sampling: Option<Sampling>,
+    sample_times: Vec<f64>,
+    steps: u64,
     ledger0: EnergyLedger,
     stepped: bool,
     gravity: Vec3,
@@ -117,10 +138,10 @@ pub struct GpuBatch {
     args: wgpu::Buffer,
     tab_f: wgpu::Buffer,
     off_body: u64,
+    off_wstep: u64,
     worlds: Vec<WorldMeta>,
     n: usize,
     n_bodies: usize,
-    dt: f64,
     parity: usize,
     memory: MemoryEstimate,
     caps: (u32, u32, u32, u32),
@@ -264,7 +285,6 @@ impl GpuBatch {
             world: 0,
             what: "the batch has no world".into(),
         })?;
-        let dt = w0.dt_s;
         let n_mat = w0.interactions.num_materials();
         // Check everything before allocating.
         let mut skin: f64 = 0.0;
@@ -286,11 +306,8 @@ impl GpuBatch {
                     "an uninitialised world (call initialize)".into(),
                 ));
             }
-            if w.dt_s != dt {
-                return Err(GpuError::Mismatch {
-                    world: k,
-                    what: format!("time step {} s against {} s", w.dt_s, dt),
-                });
+            if !(w.dt_s > 0.0 && w.dt_s.is_finite()) {
+                return Err(unsupported(format!("time step {} s", w.dt_s)));
             }
             if w.materials != w0.materials || w.interactions.models() != w0.interactions.models() {
                 return Err(GpuError::Mismatch {
@@ -414,6 +431,11 @@ impl GpuBatch {
                 bodies: w.bodies.clone(),
                 body_offset,
                 time_s: w.time_s,
+                dt_s: w.dt_s,
+                target: Target::Steps(0),
+                sampling: None,
+                sample_times: Vec::new(),
+                steps: 0,
                 ledger0: w.ledger,
                 stepped: false,
                 gravity: w.gravity_m_s2,
@@ -444,7 +466,7 @@ impl GpuBatch {
                 "wall contacts",
                 2 * nu * 4 * (1 + max_wc as u64) + 2 * 4 * nu * max_wc as u64 * 32,
             ),
-            ("ledger and loads", nu * 128),
+            ("ledger and loads", nu * 192),
             ("body table", (CHUNK_STEPS * n_bodies * 64) as u64),
         ];
         let largest = [
@@ -453,7 +475,7 @@ impl GpuBatch {
             nu * 4 * max_nb as u64,
             nu * max_c as u64 * 32,
             nu * max_wc as u64 * 128,
-            nu * 128,
+            nu * 192,
         ]
         .into_iter()
         .max()
@@ -505,6 +527,8 @@ impl GpuBatch {
         let mw = max_wc as usize;
         let mut w_keys = vec![0u32; n * (mw + 1)];
         let mut w_st = vec![[0.0f64; 4]; 4 * n * mw];
+        // ledger rows; row 2 = the wall load of the last evaluation (the DFT's first sample)
+        let mut ledger0 = vec![[0.0f64; 4]; 6 * n];
         for (k, (w, meta)) in worlds.iter().zip(&metas).enumerate() {
             let p = &w.particles;
             for i in 0..p.len() {
@@ -559,6 +583,10 @@ impl GpuBatch {
                     w_st[r + 2] = v4(&st.tangential_force_prev, st.tangential_energy_prev);
                     w_st[r + 3] = v4(&s.normal, 0.0);
                     w_keys[g * (mw + 1)] += 1;
+                    let l = &mut ledger0[6 * g + 2];
+                    for c in 0..3 {
+                        l[c] += s.force[c];
+                    }
                 }
             }
         }
@@ -569,7 +597,8 @@ impl GpuBatch {
         let mut tab_f = world_f;
         tab_f.extend_from_slice(&wall_f);
         tab_f.extend(law_f.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]));
-        tab_f.resize(off_body + 2 * CHUNK_STEPS * n_bodies, [0.0; 4]);
+        let off_wstep = off_body + 2 * CHUNK_STEPS * n_bodies;
+        tab_f.resize(off_wstep + 2 * CHUNK_STEPS * worlds.len(), [0.0; 4]);
         let off_world_u = n;
         let off_wall_u = off_world_u + world_u.len();
         let off_law_u = off_wall_u + wall_u.len();
@@ -592,10 +621,8 @@ impl GpuBatch {
             off_world_u: off_world_u as u32,
             off_wall_u: off_wall_u as u32,
             off_law_u: off_law_u as u32,
-            pad0: 0,
-            pad1: 0,
-            dt,
-            half: 0.5 * dt,
+            n_worlds: worlds.len() as u32,
+            off_wstep: off_wstep as u32,
             skin,
             pad: 0.0,
         };
@@ -656,7 +683,7 @@ impl GpuBatch {
             zeroed("w_keys_b", nu * 4 * (1 + max_wc as u64)),
             zeroed("w_st_b", nu * 128 * max_wc as u64),
         ];
-        let ledger = zeroed("ledger", nu * 128);
+        let ledger = init("ledger", b(&ledger0));
         // ctrl: displacement bits, step, builds, flags, first failing particle, force rebuild
         let ctrl = init(
             "ctrl",
@@ -795,10 +822,10 @@ impl GpuBatch {
             args,
             tab_f: tab_f_buf,
             off_body: off_body as u64,
+            off_wstep: off_wstep as u64,
             worlds: metas,
             n,
             n_bodies,
-            dt,
             parity: 0,
             memory,
             caps: (max_c, max_nb, max_wc, cell_cap),
@@ -866,17 +893,96 @@ impl GpuBatch {
         }
     }
 
-    /// Advances every world by `steps` velocity-Verlet steps, then checks the device's error
-    /// flags (non-finite states, exceeded capacities).
+    /// Advances every world by `steps` velocity-Verlet steps of its own time step, then checks
+    /// the device's error flags (non-finite states, exceeded capacities).
     pub fn step(&mut self, steps: u64) -> Result<(), GpuError> {
+        for w in &mut self.worlds {
+            w.target = Target::Steps(steps);
+        }
+        self.advance()
+    }
+
+    /// Advances every world `w` until its clock reaches `t_end_s[w]`, with its own time step and
+    /// the last step shortened to end on the time, as `World::run_until` does (worlds that are
+    /// already there do not move); then checks the error flags.
+    pub fn run_until(&mut self, t_end_s: &[f64]) -> Result<(), GpuError> {
+        assert_eq!(t_end_s.len(), self.worlds.len(), "one end time per world");
+        for (w, &t) in self.worlds.iter_mut().zip(t_end_s) {
+            w.target = Target::Until(t);
+        }
+        self.advance()
+    }
+
+    /// Sets the nominal time step of world `w`, s.
+    pub fn set_time_step(&mut self, w: usize, dt_s: f64) {
+        self.worlds[w].dt_s = dt_s;
+    }
+
+    /// Nominal time step of world `w`, s.
+    pub fn time_step_s(&self, w: usize) -> f64 {
+        self.worlds[w].dt_s
+    }
+
+    /// Steps world `w` has taken on the device.
+    pub fn steps(&self, w: usize) -> u64 {
+        self.worlds[w].steps
+    }
+
+    /// From now on only body `body` of world `w` counts in the loads read back, and its load
+    /// (the force of the particles on it) is transformed into the single-bin DFT at angular
+    /// frequency `omega_rad_s` over the samples from `t_start_s` to `t_end_s`, trapezoidal over
+    /// the steps — the sums `harmonic_amplitude` of the complex power method [D Eq. 3.12] forms,
+    /// accumulated on the device per particle (see [`GpuBatch::load_dft`]).
+    pub fn set_load_sampling(
+        &mut self,
+        w: usize,
+        body: usize,
+        omega_rad_s: f64,
+        t_start_s: f64,
+        t_end_s: f64,
+    ) {
+        let m = &mut self.worlds[w];
+        assert!(body < m.bodies.len(), "world {w} has no body {body}");
+        m.sampling = Some(Sampling {
+            body,
+            omega: omega_rad_s,
+            t_start: t_start_s,
+            t_end: t_end_s,
+        });
+        m.sample_times.clear();
+    }
+
+    /// The load DFT of world `w` (see [`GpuBatch::set_load_sampling`]): the sample times and
+    /// the sums Σ ½h (F₀ cos Ωt₀ + F₁ cos Ωt₁) and −Σ ½h (F₀ sin Ωt₀ + F₁ sin Ωt₁) of the force F of
+    /// the particles on the body, N·s. `2 / (t_last − t_first)` times these is the complex
+    /// amplitude of the body's load.
+    pub fn load_dft(&self, w: usize) -> Result<(Vec<f64>, Vec3, Vec3), GpuError> {
+        let meta = &self.worlds[w];
+        let led: Vec<[f64; 4]> = self.read(
+            &self.ledger,
+            meta.first as u64 * 192,
+            (meta.n as u64 * 192).max(32),
+        )?;
+        let (mut re, mut im) = (Vec3::zeros(), Vec3::zeros());
+        for i in 0..meta.n {
+            let (a, b) = (&led[6 * i + 4], &led[6 * i + 5]);
+            // rows hold the force on the particles: the body receives the opposite
+            re -= Vec3::new(a[0], a[1], a[2]);
+            im -= Vec3::new(b[0], b[1], b[2]);
+        }
+        Ok((meta.sample_times.clone(), re, im))
+    }
+
+    fn advance(&mut self) -> Result<(), GpuError> {
         if let Some(e) = &self.failed {
             return Err(GpuError::Device(format!("the batch failed earlier: {e}")));
         }
-        let mut left = steps as usize;
         let before: Vec<f64> = self.worlds.iter().map(|w| w.time_s).collect();
-        while left > 0 {
-            let k = left.min(CHUNK_STEPS);
-            self.fill_body_table(k)?;
+        loop {
+            let k = self.fill_tables()?;
+            if k == 0 {
+                break;
+            }
             self.queue
                 .write_buffer(&self.ctrl, 4, bytemuck::bytes_of(&0u32));
             let mut enc = self.device.create_command_encoder(&Default::default());
@@ -906,10 +1012,6 @@ impl GpuBatch {
                 }
             }
             self.queue.submit([enc.finish()]);
-            left -= k;
-        }
-        for w in &mut self.worlds {
-            w.stepped |= steps > 0;
         }
         let ctrl: Vec<u32> = self.read(&self.ctrl, 0, 32)?;
         self.builds = ctrl[2] as u64;
@@ -958,14 +1060,36 @@ impl GpuBatch {
         Ok(())
     }
 
-    /// Poses and step velocities of every body for the next `k` steps (the CPU engine's own
-    /// motion laws, evaluated here: rows identical to what `World::step` uses).
-    fn fill_body_table(&mut self, k: usize) -> Result<(), GpuError> {
-        let mut tab = vec![[0.0f64; 4]; 2 * k * self.n_bodies];
+    /// The per-step tables of the next launch (up to `CHUNK_STEPS` steps): every world's time
+    /// step and whether it steps, its bodies' poses and step velocities (the CPU engine's own
+    /// motion laws evaluated here: the rows `World::step` would use), and the DFT weights of
+    /// its load. Returns the number of steps in which some world moves (0: all are done).
+    fn fill_tables(&mut self) -> Result<usize, GpuError> {
+        let nw = self.worlds.len();
+        let mut body = vec![[0.0f64; 4]; 2 * CHUNK_STEPS * self.n_bodies];
+        let mut wstep = vec![[0.0f64; 4]; 2 * CHUNK_STEPS * nw];
+        let mut used = 0usize;
         for (wk, w) in self.worlds.iter_mut().enumerate() {
-            let mut t = w.time_s;
-            for s in 0..k {
-                let t1 = t + self.dt;
+            for s in 0..CHUNK_STEPS {
+                let h = match &mut w.target {
+                    Target::Steps(0) => None,
+                    Target::Steps(r) => {
+                        *r -= 1;
+                        Some(w.dt_s)
+                    }
+                    Target::Until(t_end) => {
+                        let tol = 1e-12 * t_end.abs().max(1e-300);
+                        (w.time_s < *t_end - tol).then(|| w.dt_s.min(*t_end - w.time_s))
+                    }
+                };
+                let Some(h) = h else {
+                    wstep[2 * (s * nw + wk)] = [w.dt_s, 0.0, 0.0, 0.0];
+                    continue;
+                };
+                used = used.max(s + 1);
+                w.stepped = true;
+                w.steps += 1;
+                let (t0, t1) = (w.time_s, w.time_s + h);
                 for (bi, b) in w.bodies.iter_mut().enumerate() {
                     b.previous = b.state;
                     b.state = b.prescribed_state(t1);
@@ -980,18 +1104,47 @@ impl GpuBatch {
                             ),
                         });
                     }
-                    let st = b.step_state(self.dt);
+                    let st = b.step_state(h);
+                    let flag = match w.sampling {
+                        Some(sm) if sm.body != bi => 0.0,
+                        _ => 1.0,
+                    };
                     let row = s * self.n_bodies + w.body_offset + bi;
-                    tab[2 * row] = v4(&st.position_m, 0.0);
-                    tab[2 * row + 1] = v4(&st.velocity_m_s, 0.0);
+                    body[2 * row] = v4(&st.position_m, 0.0);
+                    body[2 * row + 1] = v4(&st.velocity_m_s, flag);
                 }
-                t = t1;
+                wstep[2 * (s * nw + wk)] = [h, 1.0, 0.0, 0.0];
+                if let Some(sm) = w.sampling {
+                    let tol = 1e-9 * h;
+                    if t0 >= sm.t_start - tol && t1 <= sm.t_end + tol {
+                        let (s0, c0) = (sm.omega * t0).sin_cos();
+                        let (s1, c1) = (sm.omega * t1).sin_cos();
+                        wstep[2 * (s * nw + wk) + 1] =
+                            [0.5 * h * c0, -0.5 * h * s0, 0.5 * h * c1, -0.5 * h * s1];
+                        if w.sample_times.is_empty() {
+                            w.sample_times.push(t0);
+                        }
+                        w.sample_times.push(t1);
+                    }
+                }
+                w.time_s = t1;
             }
-            w.time_s = t;
         }
-        self.queue
-            .write_buffer(&self.tab_f, self.off_body * 32, bytemuck::cast_slice(&tab));
-        Ok(())
+        if used > 0 {
+            let nb = 2 * used * self.n_bodies;
+            self.queue.write_buffer(
+                &self.tab_f,
+                self.off_body * 32,
+                bytemuck::cast_slice(&body[..nb]),
+            );
+            // (rows of steps past `used` are never read)
+            self.queue.write_buffer(
+                &self.tab_f,
+                self.off_wstep * 32,
+                bytemuck::cast_slice(&wstep[..2 * used * nw]),
+            );
+        }
+        Ok(used)
     }
 
     fn read<T: bytemuck::Pod>(
@@ -1040,14 +1193,14 @@ impl GpuBatch {
         let trq = self.read_vec3(&self.trq, meta)?;
         let led: Vec<[f64; 4]> = self.read(
             &self.ledger,
-            meta.first as u64 * 128,
-            (meta.n as u64 * 128).max(32),
+            meta.first as u64 * 192,
+            (meta.n as u64 * 192).max(32),
         )?;
         let mut ledger = meta.ledger0;
         let mut sums = [0.0f64; 6];
         for i in 0..meta.n {
             for (k, s) in sums.iter_mut().enumerate() {
-                *s += led[4 * i + k / 4][k % 4];
+                *s += led[6 * i + k / 4][k % 4];
             }
         }
         ledger.dissipated_normal_pp_j += sums[0];
@@ -1066,8 +1219,8 @@ impl GpuBatch {
             let (v, om, x) = (to3(&vel[i]), to3(&omg[i]), to3(&pos[i]));
             kin += 0.5 * m * v.norm_squared() + 0.5 * om.norm_squared() / jinv;
             pot += m * g.dot(&x);
-            bf -= to3(&led[4 * i + 2]);
-            bt += to3(&led[4 * i + 3]);
+            bf -= to3(&led[6 * i + 2]);
+            bt += to3(&led[6 * i + 3]);
         }
         ledger.kinetic_j = kin;
         ledger.potential_j = -pot;

@@ -26,10 +26,8 @@ struct Params {
     off_world_u: u32,
     off_wall_u: u32,
     off_law_u: u32,
-    pad0: u32,
-    pad1: u32,
-    dt: f64,
-    half: f64,
+    n_worlds: u32,
+    off_wstep: u32,
     skin: f64,
     pad: f64,
 }
@@ -47,7 +45,9 @@ struct Params {
 // f64 tables, rows of 4: per world 2 rows (grid origin xyz, cell size), (gravity xyz, 0);
 // per wall (from off_wall_f) 3 rows of geometry; per material pair (from off_law_f) 4 rows
 // = LAW_F parameters; from off_body the body states of this chunk's steps, per (step, body)
-// (position, 0), (step velocity, 0)
+// (position, 0), (step velocity, load flag: 1 if its loads are summed); from off_wstep per (step,
+// world) (time step, active, 0, 0), (trapezoid weights of the load's single-bin DFT at the start
+// and end of the step: ½h cos Ωt₀, −½h sin Ωt₀, ½h cos Ωt₁, −½h sin Ωt₁)
 @group(0) @binding(6) var<storage, read_write> tab_f: array<vec4<f64>>;
 // u32 tables, rows of 4: per particle (material, world, 0, 0); per world (from off_world_u)
 // (cells x, y, z, first cell), (first wall, walls, 0, 0); per wall (from off_wall_u) (kind,
@@ -75,9 +75,10 @@ struct Params {
 @group(0) @binding(20) var<storage, read_write> w_st_in: array<vec4<f64>>;
 @group(0) @binding(21) var<storage, read_write> w_keys_out: array<u32>;
 @group(0) @binding(22) var<storage, read_write> w_st_out: array<vec4<f64>>;
-// per particle 4 rows: cumulative dissipation (normal pp, tangential pp, normal pw,
+// per particle 6 rows: cumulative dissipation (normal pp, tangential pp, normal pw,
 // tangential pw); (cumulative wall work, stored elastic energy, 0, 0); load of its wall
-// contacts: (force on the particle, 0), (torque on the bodies about their positions, 0)
+// contacts with the flagged bodies: (force on the particle, 0), (torque on the bodies about
+// their positions, 0); the load's single-bin DFT sums (Σ re xyz, 0), (Σ im xyz, 0)
 @group(0) @binding(23) var<storage, read_write> ledger: array<vec4<f64>>;
 // 0: largest squared displacement (f32 bits), 1: step within the chunk, 2: neighbour builds,
 // 3: error flags, 4: first failing particle, 5: force a rebuild
@@ -159,6 +160,11 @@ fn world_f(w: u32, row: u32) -> vec4<f64> {
 
 fn world_u(w: u32, row: u32) -> vec4<u32> {
     return tab_u[P.off_world_u + 2u * w + row];
+}
+
+// per (step, world): (time step, active, 0, 0) and the DFT weights
+fn wstep(step: u32, w: u32, row: u32) -> vec4<f64> {
+    return tab_f[P.off_wstep + 2u * (step * P.n_worlds + w) + row];
 }
 
 fn pinfo(i: u32) -> vec4<u32> {
@@ -349,7 +355,10 @@ fn finite3(a: vec3<f64>) -> bool {
 fn drift(@builtin(global_invocation_id) g: vec3<u32>) {
     let i = g.x;
     if (i >= P.n) { return; }
-    let h = P.half;
+    let ws = wstep(atomicLoad(&ctrl[1]), pinfo(i).y, 0u);
+    if (ws.y == 0.0lf) { return; }
+    let dt = ws.x;
+    let h = 0.5lf * dt;
     var v = vel[i];
     var w = omg[i];
     let m = v.w;
@@ -358,7 +367,7 @@ fn drift(@builtin(global_invocation_id) g: vec3<u32>) {
     vel[i] = vec4<f64>(v3, m);
     omg[i] = vec4<f64>(w3, w.w);
     let x = pos[i];
-    let x3 = x.xyz + v3 * P.dt;
+    let x3 = x.xyz + v3 * dt;
     pos[i] = vec4<f64>(x3, x.w);
     let d = x3 - ref_pos[i].xyz;
     let d2 = f32(norm2(d));
@@ -471,6 +480,31 @@ fn neighbors(@builtin(global_invocation_id) g: vec3<u32>) {
     nb[base - 1u] = cnt;
 }
 
+// A particle of a world that does not step this time: its contacts are carried over unchanged
+// to the lists of the next step.
+fn keep_contacts(i: u32) {
+    let ib = i * (P.max_c + 1u);
+    let cnt = c_ids_in[ib];
+    c_ids_out[ib] = cnt;
+    for (var o = 0u; o < cnt; o++) {
+        let k = i * P.max_c + o;
+        c_ids_out[ib + 1u + o] = c_ids_in[ib + 1u + o];
+        c_s0_out[k] = c_s0_in[k];
+        c_s1_out[k] = c_s1_in[k];
+        c_s2_out[k] = c_s2_in[k];
+    }
+    let kb = i * (P.max_wc + 1u);
+    let wc = w_keys_in[kb];
+    w_keys_out[kb] = wc;
+    for (var o = 0u; o < wc; o++) {
+        let k = i * P.max_wc + o;
+        w_keys_out[kb + 1u + o] = w_keys_in[kb + 1u + o];
+        for (var r = 0u; r < 4u; r++) {
+            w_st_out[4u * k + r] = w_st_in[4u * k + r];
+        }
+    }
+}
+
 // Forces and torques of every particle: gravity, contacts with the particles of its list and
 // with the walls of its world; contact states are read from the `_in` and written to the `_out`
 // lists. Energies: each pair is booked by its lower-index partner.
@@ -479,14 +513,19 @@ fn forces(@builtin(global_invocation_id) g: vec3<u32>) {
     let i = g.x;
     if (i >= P.n) { return; }
     let step = atomicLoad(&ctrl[1]) - 1u;
-    let dt = P.dt;
+    let info = pinfo(i);
+    let world = info.y;
+    let ws = wstep(step, world, 0u);
+    if (ws.y == 0.0lf) {
+        keep_contacts(i);
+        return;
+    }
+    let dt = ws.x;
     let xi = pos[i];
     let vi = vel[i];
     let wi4 = omg[i];
     let wi = wi4.xyz;
     let mi = vi.w;
-    let info = pinfo(i);
-    let world = info.y;
     let grav = world_f(world, 1u).xyz;
     var f = grav * mi;
     var t = vec3<f64>(0.0lf);
@@ -601,7 +640,9 @@ fn forces(@builtin(global_invocation_id) g: vec3<u32>) {
         let u = tab_u[P.off_wall_u + wall];
         let row = step * P.n_bodies + u.y;
         let bpos = tab_f[P.off_body + 2u * row].xyz;
-        let v_wall = tab_f[P.off_body + 2u * row + 1u].xyz;
+        let bvel = tab_f[P.off_body + 2u * row + 1u];
+        let v_wall = bvel.xyz;
+        let flag = bvel.w;
         let xb = xi.xyz - bpos;
         let g0 = tab_f[P.off_wall_f + 3u * wall];
         let g1 = tab_f[P.off_wall_f + 3u * wall + 1u];
@@ -697,8 +738,8 @@ fn forces(@builtin(global_invocation_id) g: vec3<u32>) {
             elastic += lo.en + lo.et;
             f += f_total;
             t += cross(-rb * nrm, ft);
-            load_f += f_total;
-            load_t += cross(xi.xyz - nrm * (r - ovl) - bpos, -f_total);
+            load_f += f_total * flag;
+            load_t += cross(xi.xyz - nrm * (r - ovl) - bpos, -f_total) * flag;
             s.fnp = fn_vec;
             s.ftp = ft;
             s.enp = lo.en;
@@ -729,10 +770,17 @@ fn forces(@builtin(global_invocation_id) g: vec3<u32>) {
 
     frc[i] = vec4<f64>(f, 0.0lf);
     trq[i] = vec4<f64>(t, 0.0lf);
-    let lb = 4u * i;
+    let lb = 6u * i;
     ledger[lb] += vec4<f64>(dn_pp, dt_pp, dn_pw, dt_pw);
     let l1 = ledger[lb + 1u];
     ledger[lb + 1u] = vec4<f64>(l1.x + work, elastic, 0.0lf, 0.0lf);
+    // single-bin DFT of the load over the sampling window (trapezoid over the step)
+    let q = wstep(step, world, 1u);
+    if (any(q != vec4<f64>(0.0lf))) {
+        let f_prev = ledger[lb + 2u].xyz;
+        ledger[lb + 4u] += vec4<f64>(f_prev * q.x + load_f * q.z, 0.0lf);
+        ledger[lb + 5u] += vec4<f64>(f_prev * q.y + load_f * q.w, 0.0lf);
+    }
     ledger[lb + 2u] = vec4<f64>(load_f, 0.0lf);
     ledger[lb + 3u] = vec4<f64>(load_t, 0.0lf);
 }
@@ -742,7 +790,9 @@ fn forces(@builtin(global_invocation_id) g: vec3<u32>) {
 fn kick(@builtin(global_invocation_id) g: vec3<u32>) {
     let i = g.x;
     if (i >= P.n) { return; }
-    let h = P.half;
+    let ws = wstep(atomicLoad(&ctrl[1]) - 1u, pinfo(i).y, 0u);
+    if (ws.y == 0.0lf) { return; }
+    let h = 0.5lf * ws.x;
     let v = vel[i];
     let w = omg[i];
     let v3 = v.xyz + frc[i].xyz * (h / v.w);
