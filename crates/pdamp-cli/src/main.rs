@@ -57,6 +57,10 @@ enum Command {
         /// Output directory (finished points in DIR/points/ are reused).
         #[arg(long)]
         out: PathBuf,
+        /// Where the points run: `cpu` (points in parallel on the threads) or `gpu` (the
+        /// pending points as batches of worlds on the GPU backend; beds are prepared on the CPU).
+        #[arg(long, value_enum, default_value_t = Device::Cpu)]
+        device: Device,
     },
     /// Prepare the bed of a scenario (drop-down and settling) and save it: DIR/bed.pdbed (exact
     /// continuation, `placement = { method = "file", path = "DIR/bed.pdbed" }`), bed.csv,
@@ -312,7 +316,11 @@ fn dispatch(command: Command) -> Result<()> {
             },
             point,
         ),
-        Command::Fields { scenario, out } => cmd_fields(&scenario, &out),
+        Command::Fields {
+            scenario,
+            out,
+            device,
+        } => cmd_fields(&scenario, &out, device),
         Command::Check { scenario } => cmd_check(&scenario),
         Command::Settle {
             scenario,
@@ -507,7 +515,7 @@ fn cmd_run(
     Ok(())
 }
 
-fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
+fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device) -> Result<()> {
     let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     if sc.fields.is_none() {
         bail!(
@@ -526,12 +534,28 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    #[cfg(feature = "gpu")]
+    let gpu = match device {
+        Device::Gpu => Some(pdamp_gpu::GpuDevice::open()?),
+        Device::Cpu => None,
+    };
+    #[cfg(feature = "gpu")]
+    let engine = match &gpu {
+        Some(g) => pdamp_design::PointEngine::Gpu(g),
+        None => pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
+    };
+    #[cfg(not(feature = "gpu"))]
+    let engine = match device {
+        Device::Gpu => bail!("this pdamp was built without the `gpu` feature"),
+        Device::Cpu => pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
+    };
     bar.set_message("settling");
     let start = std::time::Instant::now();
-    let outcome = pdamp_design::report::run_fields_scenario(
+    let outcome = pdamp_design::report::run_fields_scenario_on(
         &sc,
         &base,
         out,
+        engine,
         |f| bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64),
         |done, total| {
             bar.set_message("points");
@@ -556,6 +580,7 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path) -> Result<()> {
             })).collect::<Vec<_>>(),
             "bed_span_along_direction_m": outcome.bed_span_along_direction_m,
             "wall_time_s": start.elapsed().as_secs_f64(),
+            "device": format!("{device:?}").to_lowercase(),
             "fields_csv": out.join("fields.csv"),
         }))?
     );

@@ -279,12 +279,40 @@ pub fn run_fields(
     run_fields_with(damper, grid, out_dir, ThreadSplit::default(), on_point)
 }
 
+/// Where the points of a field run.
+#[derive(Debug, Clone, Copy)]
+pub enum PointEngine<'a> {
+    /// On the CPU engine, points in parallel with the threads split as given.
+    Cpu(ThreadSplit),
+    /// On the GPU backend: the pending points in batches of worlds advanced together (up to
+    /// [`GPU_BATCH_PARTICLES`] particles a batch).
+    #[cfg(feature = "gpu")]
+    Gpu(&'a pdamp_gpu::GpuDevice),
+    #[doc(hidden)]
+    _Lifetime(std::marker::PhantomData<&'a ()>),
+}
+
+/// Largest number of particles of one GPU batch of field points (about 19 GB of device memory
+/// at today's 4.35 GB per million particles).
+pub const GPU_BATCH_PARTICLES: usize = 4_000_000;
+
 /// [`run_fields`] with an explicit split of the threads between and inside the points.
 pub fn run_fields_with(
     damper: &Damper,
     grid: &FieldGrid,
     out_dir: &Path,
     split: ThreadSplit,
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    run_fields_on(damper, grid, out_dir, PointEngine::Cpu(split), on_point)
+}
+
+/// [`run_fields`] on the CPU engine or the GPU backend.
+pub fn run_fields_on(
+    damper: &Damper,
+    grid: &FieldGrid,
+    out_dir: &Path,
+    engine: PointEngine<'_>,
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, String> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
@@ -305,9 +333,9 @@ pub fn run_fields_with(
     let max_steps = |f: f64| damper.cycles as f64 * (1.0 / (f * damper.time_step_s)).ceil();
     pending.sort_by(|&a, &b| max_steps(points[b].2).total_cmp(&max_steps(points[a].2)));
     let particles = damper.settled.particles.len();
-    let fresh = run_split(&pending, split, particles, |k| {
-        let (i, j, f, x) = points[k];
-        let stored = damper.run_point(f, x, &mut ()).and_then(|r| {
+    let store = |k: usize, r: Result<PointResult, String>| {
+        let (i, j, _, _) = points[k];
+        let stored = r.and_then(|r| {
             let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
             pdamp_io::atomic::write_atomic(point_path(out_dir, i, j), json.as_bytes())
                 .map_err(|e| format!("output: {e}"))?;
@@ -316,7 +344,38 @@ pub fn run_fields_with(
         let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         on_point(n, total);
         stored
-    });
+    };
+    let fresh: Vec<(usize, Result<PointResult, String>)> = match engine {
+        PointEngine::Cpu(split) => run_split(&pending, split, particles, |k| {
+            let (_, _, f, x) = points[k];
+            store(k, damper.run_point(f, x, &mut ()))
+        }),
+        #[cfg(feature = "gpu")]
+        PointEngine::Gpu(gpu) => {
+            let per_batch = (GPU_BATCH_PARTICLES / particles.max(1)).max(1);
+            let mut fresh = Vec::with_capacity(pending.len());
+            for batch in pending.chunks(per_batch) {
+                let jobs: Vec<(&Damper, f64, f64)> = batch
+                    .iter()
+                    .map(|&k| (damper, points[k].2, points[k].3))
+                    .collect();
+                match crate::gpu_points::run_points_gpu(gpu, &jobs) {
+                    Ok(results) => {
+                        for (&k, r) in batch.iter().zip(results) {
+                            fresh.push((k, store(k, Ok(r))));
+                        }
+                    }
+                    Err(e) => {
+                        for &k in batch {
+                            fresh.push((k, store(k, Err(e.clone()))));
+                        }
+                    }
+                }
+            }
+            fresh
+        }
+        PointEngine::_Lifetime(_) => Vec::new(),
+    };
     let mut failed = Vec::new();
     let mut interrupted = 0;
     for (k, r) in fresh {

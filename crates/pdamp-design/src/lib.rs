@@ -14,4 +14,4 @@ pub mod plots;
 pub mod report;
 
 pub use damper::{Damper, PointObserver, PointResult};
-pub use fields::{FieldGrid, ThreadSplit, run_fields, run_fields_with};
+pub use fields::{FieldGrid, PointEngine, ThreadSplit, run_fields, run_fields_on, run_fields_with};

@@ -3,7 +3,7 @@
 
 use crate::damper::{Damper, PointResult};
 use crate::ensemble::EnsembleStat;
-use crate::fields::{FieldGrid, FieldsOutcome, run_fields};
+use crate::fields::{FieldGrid, FieldsOutcome};
 use crate::motion::MotionRecorder;
 use pdamp_dem::bed_statistics::BedStatistics;
 use pdamp_io::scenario::Scenario;
@@ -403,6 +403,20 @@ pub fn run_fields_scenario(
     sc: &Scenario,
     base_dir: &Path,
     out: &Path,
+    settle_progress: impl FnMut(f64),
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    let engine = crate::fields::PointEngine::Cpu(crate::fields::ThreadSplit::default());
+    run_fields_scenario_on(sc, base_dir, out, engine, settle_progress, on_point)
+}
+
+/// [`run_fields_scenario`] with the points on the CPU engine or the GPU backend (the beds are
+/// prepared on the CPU either way).
+pub fn run_fields_scenario_on(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    engine: crate::fields::PointEngine<'_>,
     mut settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, String> {
@@ -450,7 +464,7 @@ pub fn run_fields_scenario(
             out,
             &serde_json::json!({ "bed": bed, "bed_at_fill": damper.fill_statistics }),
         )?;
-        let outcome = run_fields(&damper, &grid, out, on_point)?;
+        let outcome = crate::fields::run_fields_on(&damper, &grid, out, engine, on_point)?;
         crate::plots::field_maps_with(&grid, &outcome.points, out, damper.clearance_m())?;
         return Ok(outcome);
     }
@@ -473,7 +487,7 @@ pub fn run_fields_scenario(
         )?;
         clearances.push(damper.clearance_m().unwrap_or(f64::NAN));
         let done_before = k * grid.points().len();
-        let o = run_fields(&damper, &grid, &dir, |d, _| {
+        let o = crate::fields::run_fields_on(&damper, &grid, &dir, engine, |d, _| {
             on_point(done_before + d, total)
         })?;
         fields.push(o);
