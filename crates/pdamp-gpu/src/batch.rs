@@ -584,8 +584,8 @@ impl GpuBatch {
                     w_st[r + 3] = v4(&s.normal, 0.0);
                     w_keys[g * (mw + 1)] += 1;
                     let l = &mut ledger0[6 * g + 2];
-                    for c in 0..3 {
-                        l[c] += s.force[c];
+                    for (a, f) in l.iter_mut().zip(s.force.iter()) {
+                        *a += f;
                     }
                 }
             }
