@@ -159,6 +159,38 @@ impl std::fmt::Debug for GpuBatch {
 }
 
 /// Parameters of one contact law for the kernels: `LAW_F` numbers and the kinds.
+fn law_row_with_table(
+    model: &ContactModel,
+    el: &pdamp_dem::interaction::PairElastic,
+    tables: &mut Vec<f64>,
+) -> Result<([f64; LAW_F], [u32; 4]), String> {
+    if let NormalLaw::GonthierTable {
+        impact_velocities_m_s,
+        restitutions,
+        ..
+    } = &model.normal
+    {
+        // A plain Gonthier row, then the kind, the table's place (relative to the tables,
+        // made absolute when the tables are laid out) and its length.
+        let plain = ContactModel {
+            normal: NormalLaw::Gonthier {
+                restitution: model.normal.restitution(),
+                min_impact_velocity_m_s: model.normal.min_impact_velocity_m_s(),
+            },
+            ..model.clone()
+        };
+        let (mut f, mut u) = law_row(&plain, el)?;
+        u[0] = 2;
+        f[14] = tables.len() as f64;
+        f[15] = impact_velocities_m_s.len() as f64;
+        for (v, e) in impact_velocities_m_s.iter().zip(restitutions) {
+            tables.extend([*v, *e]);
+        }
+        return Ok((f, u));
+    }
+    law_row(model, el)
+}
+
 fn law_row(
     model: &ContactModel,
     el: &pdamp_dem::interaction::PairElastic,
@@ -186,9 +218,7 @@ fn law_row(
             u[0] = 1;
             f[5] = gonthier_damping(restitution) / restitution;
         }
-        NormalLaw::GonthierTable { .. } => {
-            return Err("the gonthier-table normal law (velocity-dependent restitution)".into());
-        }
+        NormalLaw::GonthierTable { .. } => unreachable!("handled by law_row_with_table"),
         NormalLaw::LankaraniNikravesh { restitution, .. } => {
             u[0] = 3;
             f[6] = 0.75 * (1.0 - restitution * restitution);
@@ -341,10 +371,18 @@ impl GpuBatch {
         }
         let mut law_f = Vec::with_capacity(n_mat * n_mat * LAW_F);
         let mut law_u = Vec::with_capacity(n_mat * n_mat);
+        // The tables after the law rows: the dense d̄(ε)/ε of D Eq. 2.79 at ε = k/4096 (the CPU
+        // engine's), then the restitution tables of `gonthier-table` laws.
+        let mut tables: Vec<f64> = (1..=4096)
+            .map(|k| {
+                let e = k as f64 / 4096.0;
+                gonthier_damping(e) / e
+            })
+            .collect();
         for a in 0..n_mat {
             for b in 0..n_mat {
                 let (model, el) = w0.interactions.get(a as u16, b as u16);
-                let (f, u) = law_row(model, el).map_err(|what| GpuError::Unsupported {
+                let (f, u) = law_row_with_table(model, el, &mut tables).map_err(|what| GpuError::Unsupported {
                     world: 0,
                     what: format!(
                         "{what} (materials '{}' and '{}')",
@@ -593,10 +631,18 @@ impl GpuBatch {
         // The f64 and u32 tables (see dem.wgsl).
         let off_wall_f = world_f.len();
         let off_law_f = off_wall_f + wall_f.len();
-        let off_body = off_law_f + law_f.len() / 4;
+        let off_tables = off_law_f + law_f.len() / 4;
+        for (row, u) in law_f.chunks_mut(LAW_F).zip(&law_u) {
+            if u[0] == 2 {
+                row[14] += 4.0 * off_tables as f64;
+            }
+        }
+        tables.resize(tables.len().div_ceil(4) * 4, 0.0);
+        let off_body = off_tables + tables.len() / 4;
         let mut tab_f = world_f;
         tab_f.extend_from_slice(&wall_f);
         tab_f.extend(law_f.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]));
+        tab_f.extend(tables.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]));
         let off_wstep = off_body + 2 * CHUNK_STEPS * n_bodies;
         tab_f.resize(off_wstep + 2 * CHUNK_STEPS * worlds.len(), [0.0; 4]);
         let off_world_u = n;

@@ -149,6 +149,42 @@ fn store_w(k: u32, s: CState, normal: vec3<f64>) {
     w_st_out[4u * k + 3u] = vec4<f64>(normal, 0.0lf);
 }
 
+// element k of tab_f seen as a flat f64 array
+fn elem(k: u32) -> f64 {
+    return tab_f[k / 4u][k % 4u];
+}
+
+// d̄(ε)/ε [D Eq. 2.79] by linear interpolation in the table of 4 096 exact solutions at
+// ε = k/4096 that follows the law rows (the CPU engine's dense table; below ε = 1/4096 its first
+// node is used)
+fn gonthier_dense(e: f64) -> f64 {
+    let base = (P.off_law_f + 4u * P.n_mat * P.n_mat) * 4u;
+    let s = e * 4096.0lf;
+    if (s < 1.0lf) { return elem(base); }
+    let k = min(u32(floor(s)), 4095u);
+    let f = s - f64(k);
+    let lo = elem(base + k - 1u);
+    let hi = elem(base + k);
+    return lo + f * (hi - lo);
+}
+
+// ε(v₀) of a velocity-dependent restitution table (pairs at element lawf(li, 14), lawf(li, 15)
+// pairs): linear interpolation, constant outside (`interpolate_clamped` of the CPU engine)
+fn restitution_at(li: u32, v: f64) -> f64 {
+    let start = u32(lawf(li, 14u));
+    let cnt = u32(lawf(li, 15u));
+    if (v <= elem(start)) { return elem(start + 1u); }
+    if (v >= elem(start + 2u * (cnt - 1u))) { return elem(start + 2u * cnt - 1u); }
+    var k = 1u;
+    while (k < cnt - 1u && elem(start + 2u * k) <= v) { k++; }
+    let x0 = elem(start + 2u * (k - 1u));
+    let x1 = elem(start + 2u * k);
+    let y0 = elem(start + 2u * (k - 1u) + 1u);
+    let y1 = elem(start + 2u * k + 1u);
+    let t = (v - x0) / (x1 - x0);
+    return y0 + t * (y1 - y0);
+}
+
 // parameter k of contact law li
 fn lawf(li: u32, k: u32) -> f64 {
     return tab_f[P.off_law_f + 4u * li + k / 4u][k % 4u];
@@ -213,7 +249,7 @@ fn tanh_f64(x: f64) -> f64 {
 }
 
 // One contact law (`ContactModel::evaluate` of pdamp-dem) for overlap > 0: normal law
-// (0 Hertz D Eq. 2.69, 1 Gonthier D Eq. 2.78, 3 Lankarani–Nikravesh D Eq. 2.77, 4 linear
+// (0 Hertz D Eq. 2.69, 1 Gonthier D Eq. 2.78, 2 Gonthier with ε(v₀) from a table, 3 Lankarani–Nikravesh D Eq. 2.77, 4 linear
 // P Eq. 2–4, 5 LIGGGHTS Hertz–Mindlin), friction law (0 none, 1 regularised sliding D Eq. 2.85,
 // 2 Coulomb spring–dashpot P Eq. 5, 3 Mindlin / LIGGGHTS tangential history).
 fn contact_law(li: u32, r_eff: f64, m_eff: f64, delta: f64, rate: f64, n: vec3<f64>,
@@ -258,6 +294,8 @@ fn contact_law(li: u32, r_eff: f64, m_eff: f64, delta: f64, rate: f64, n: vec3<f
         var c = 0.0lf;
         if (kind == 1u) {
             c = el * lawf(li, 5u) / v0;
+        } else if (kind == 2u) {
+            c = el * gonthier_dense(restitution_at(li, v0)) / v0;
         } else if (kind == 3u) {
             c = el * lawf(li, 6u) / v0;
         }
@@ -266,7 +304,7 @@ fn contact_law(li: u32, r_eff: f64, m_eff: f64, delta: f64, rate: f64, n: vec3<f
         tangent_k = 1.5lf * kn * sd;
         damp = c;
         // stability cap of the impact-velocity-scaled dashpots (as the CPU engine)
-        if (dt > 0.0lf && (kind == 1u || kind == 3u)) {
+        if (dt > 0.0lf && (kind == 1u || kind == 2u || kind == 3u)) {
             let c_max = m_eff / dt;
             if (damp > c_max) {
                 damp = c_max;

@@ -85,8 +85,9 @@ fn hertz_impact_matches_closed_form() {
     assert!((eps - 1.0).abs() < 1e-4, "elastic restitution {eps}");
 }
 
-/// A sphere onto a fixed plane at 1 m/s: Gonthier's law returns ε exactly [D Eq. 2.78, 2.79]
-/// and the linear spring–dashpot too [P Eq. 2–4] (1 % each, the step's discretisation).
+/// A sphere onto a fixed plane at 1 m/s: Gonthier's law returns ε exactly [D Eq. 2.78, 2.79],
+/// with a constant ε or one interpolated in a velocity table, and the linear spring–dashpot
+/// too [P Eq. 2–4] (1 % each, the step's discretisation).
 #[test]
 fn damped_laws_return_their_restitution() {
     let Some(gpu) = device() else { return };
@@ -96,6 +97,16 @@ fn damped_laws_return_their_restitution() {
             "gonthier",
             NormalLaw::Gonthier {
                 restitution: 0.7,
+                min_impact_velocity_m_s: 1e-3,
+            },
+            0.7,
+        ),
+        (
+            // ε(v₀) from a table: 0.8 at 0.5 m/s, 0.5 at 2 m/s → 0.7 at 1 m/s
+            "gonthier-table",
+            NormalLaw::GonthierTable {
+                impact_velocities_m_s: vec![0.5, 2.0],
+                restitutions: vec![0.8, 0.5],
                 min_impact_velocity_m_s: 1e-3,
             },
             0.7,
