@@ -516,7 +516,18 @@ fn cmd_run(
 }
 
 fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device) -> Result<()> {
-    let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
+    let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
+    #[cfg(feature = "gpu")]
+    if device == Device::Gpu {
+        // Before any bed is prepared: what the GPU kernels lack is said at once.
+        pdamp_gpu::check_world(&world).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: cannot run on the GPU backend: {e}; run it without --device gpu",
+                scenario.display()
+            )
+        })?;
+    }
+    let _ = &world;
     if sc.fields.is_none() {
         bail!(
             "{}: `pdamp fields` needs a [fields] section (and [damper])",
@@ -655,6 +666,13 @@ fn cmd_check(scenario: &std::path::Path) -> Result<()> {
         "time_step_over_contact_time": sc.simulation.time_step_s / tc,
         "warnings": scenario_warnings(&sc),
     });
+    #[cfg(feature = "gpu")]
+    {
+        report["gpu_backend"] = match pdamp_gpu::check_world(&world) {
+            Ok(()) => serde_json::json!("supported (pdamp fields --device gpu)"),
+            Err(e) => serde_json::json!(format!("not supported: {e}")),
+        };
+    }
     for w in scenario_warnings(&sc) {
         eprintln!("warning: {w}");
     }

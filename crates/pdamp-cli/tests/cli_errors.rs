@@ -240,3 +240,51 @@ fn damper_point_from_the_command_line() {
     assert!(!dir.join("c").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pdamp fields --device gpu` on a scenario the GPU kernels cannot run (a mesh container) is
+/// refused before any bed is prepared or anything written, naming the wall; `pdamp check` says
+/// the same in its report. Needs no GPU: the check runs on the host.
+#[test]
+fn gpu_fields_refuse_unsupported_scenarios_up_front() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scn = root.join("examples/damper_ch8_single_cross.toml");
+    let out = std::env::temp_dir().join(format!("pdamp-cli-gpu-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let o = pdamp()
+        .args(["fields"])
+        .arg(&scn)
+        .arg("--out")
+        .arg(&out)
+        .args(["--device", "gpu"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("triangle-mesh wall")
+            && err.contains("cross1_arm_y")
+            && err.contains("--device gpu"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    let o = pdamp().arg("check").arg(&scn).output().unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        report["gpu_backend"]
+            .as_str()
+            .unwrap()
+            .starts_with("not supported: a triangle-mesh wall")
+    );
+    let o = pdamp()
+        .arg("check")
+        .arg(root.join("examples/damper_cylinder_small.toml"))
+        .output()
+        .unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        report["gpu_backend"]
+            .as_str()
+            .unwrap()
+            .starts_with("supported")
+    );
+}

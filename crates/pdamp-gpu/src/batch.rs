@@ -300,6 +300,46 @@ fn wall_rows(g: &Geometry) -> Result<(u32, [[f64; 4]; 3], u32), String> {
     })
 }
 
+/// Whether the GPU kernels can run `world` (integrator, walls, body motions, contact laws,
+/// external forces); the error says what they lack, naming the wall, body or materials. Cheap:
+/// call it before preparing a bed for the GPU.
+pub fn check_world(world: &World) -> Result<(), String> {
+    if !matches!(world.integrator, Integrator::VelocityVerlet) {
+        return Err("an integrator other than velocity Verlet".into());
+    }
+    if world
+        .particles
+        .external_force
+        .iter()
+        .any(|f| *f != Vec3::zeros())
+    {
+        return Err("external particle forces".into());
+    }
+    for b in &world.bodies {
+        if matches!(b.motion, Motion::Driven) {
+            return Err(format!("body '{}' driven from outside (coupling)", b.name));
+        }
+        for wall in &b.walls {
+            wall_rows(&wall.geometry)
+                .map_err(|e| format!("{e} ('{}' of body '{}')", wall.name, b.name))?;
+        }
+    }
+    let n = world.interactions.num_materials();
+    let mut tables = Vec::new();
+    for a in 0..n {
+        for b in 0..n {
+            let (model, el) = world.interactions.get(a as u16, b as u16);
+            law_row_with_table(model, el, &mut tables).map_err(|what| {
+                format!(
+                    "{what} (materials '{}' and '{}')",
+                    world.materials[a].name, world.materials[b].name
+                )
+            })?;
+        }
+    }
+    Ok(())
+}
+
 fn v4(a: &Vec3, w: f64) -> [f64; 4] {
     [a.x, a.y, a.z, w]
 }
@@ -321,11 +361,7 @@ impl GpuBatch {
         let (mut rmin, mut rmax) = (f64::INFINITY, 0.0f64);
         for (k, w) in worlds.iter().enumerate() {
             let unsupported = |what: String| GpuError::Unsupported { world: k, what };
-            if !matches!(w.integrator, Integrator::VelocityVerlet) {
-                return Err(unsupported(
-                    "an integrator other than velocity Verlet".into(),
-                ));
-            }
+            check_world(w).map_err(unsupported)?;
             if w.step_pending() {
                 return Err(unsupported(
                     "a world with a half kick pending (call complete_step)".into(),
@@ -345,26 +381,6 @@ impl GpuBatch {
                     what: "materials or contact laws".into(),
                 });
             }
-            if w.particles
-                .external_force
-                .iter()
-                .any(|f| *f != Vec3::zeros())
-            {
-                return Err(unsupported("external particle forces".into()));
-            }
-            for b in &w.bodies {
-                if matches!(b.motion, Motion::Driven) {
-                    return Err(unsupported(format!(
-                        "body '{}' driven from outside (coupling)",
-                        b.name
-                    )));
-                }
-                for wall in &b.walls {
-                    wall_rows(&wall.geometry).map_err(|e| {
-                        unsupported(format!("{e} ('{}' of body '{}')", wall.name, b.name))
-                    })?;
-                }
-            }
             skin = skin.max(w.skin_m());
             rmin = rmin.min(w.particles.min_radius());
             rmax = rmax.max(w.particles.max_radius());
@@ -382,12 +398,14 @@ impl GpuBatch {
         for a in 0..n_mat {
             for b in 0..n_mat {
                 let (model, el) = w0.interactions.get(a as u16, b as u16);
-                let (f, u) = law_row_with_table(model, el, &mut tables).map_err(|what| GpuError::Unsupported {
-                    world: 0,
-                    what: format!(
-                        "{what} (materials '{}' and '{}')",
-                        w0.materials[a].name, w0.materials[b].name
-                    ),
+                let (f, u) = law_row_with_table(model, el, &mut tables).map_err(|what| {
+                    GpuError::Unsupported {
+                        world: 0,
+                        what: format!(
+                            "{what} (materials '{}' and '{}')",
+                            w0.materials[a].name, w0.materials[b].name
+                        ),
+                    }
                 })?;
                 law_f.extend_from_slice(&f);
                 law_u.push(u);

@@ -26,6 +26,6 @@ mod batch;
 mod device;
 mod error;
 
-pub use batch::{GpuBatch, GpuSnapshot, MemoryEstimate};
+pub use batch::{GpuBatch, GpuSnapshot, MemoryEstimate, check_world};
 pub use device::GpuDevice;
 pub use error::GpuError;
