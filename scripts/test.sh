@@ -6,8 +6,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 have_vulkan() {
-  ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' &&
-    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json 2>/dev/null | grep -q .
+  # (no `grep -q` in a pipe: under pipefail its early exit fails the pipeline)
+  local libs icds
+  libs=$(ldconfig -p 2>/dev/null || true)
+  icds=$(ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json 2>/dev/null || true)
+  [[ "$libs" == *libvulkan.so.1* ]] && [ -n "$icds" ]
 }
 if ! have_vulkan; then
   if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
