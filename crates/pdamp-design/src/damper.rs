@@ -392,7 +392,33 @@ impl Damper {
         )
         .map_err(|e| format!("complex power at f = {frequency_hz} Hz, X = {amplitude_m} m: {e}"))?;
         let l0 = ledger0.expect("evaluated cycles");
-        let l1 = w.ledger;
+        Ok(PointResult::evaluate(
+            (frequency_hz, amplitude_m),
+            &cp,
+            (&l0, &w.ledger),
+            n_eval,
+            converged,
+            (w.dt_s, w.counters.steps),
+            start.elapsed().as_secs_f64(),
+        ))
+    }
+}
+
+impl PointResult {
+    /// The result of a point (frequency f in Hz, amplitude X in m) from its complex power
+    /// [D Eq. 3.13–3.17] and the energy ledger at the start and end of the `n_eval` evaluated
+    /// cycles (dissipation per cycle, its shares, the balance), with the time step and steps
+    /// taken. Shared by the CPU ([`Damper::run_point`]) and GPU paths.
+    pub(crate) fn evaluate(
+        (frequency_hz, amplitude_m): (f64, f64),
+        cp: &pdamp_signal::complex_power::ComplexPowerResult,
+        (l0, l1): (&pdamp_dem::EnergyLedger, &pdamp_dem::EnergyLedger),
+        n_eval: u32,
+        converged: Option<bool>,
+        (time_step_s, steps): (f64, u64),
+        wall_time_s: f64,
+    ) -> Self {
+        let omega = 2.0 * PI * frequency_hz;
         let n = n_eval as f64;
         let d_np = l1.dissipated_normal_pp_j - l0.dissipated_normal_pp_j;
         let d_nw = l1.dissipated_normal_pw_j - l0.dissipated_normal_pw_j;
@@ -405,7 +431,7 @@ impl Damper {
             + (l1.elastic_j - l0.elastic_j);
         let share = |x: f64| if d > 0.0 { x / d } else { 0.0 };
         let a = amplitude_m * omega * omega;
-        Ok(PointResult {
+        PointResult {
             frequency_hz,
             amplitude_m,
             acceleration_m_s2: a,
@@ -426,10 +452,10 @@ impl Damper {
             energy_closure_relative: (dw - de - d) / dw.abs().max(1e-300),
             cycles_evaluated: n_eval,
             converged,
-            time_step_s: w.dt_s,
-            steps: w.counters.steps,
-            wall_time_s: start.elapsed().as_secs_f64(),
-        })
+            time_step_s,
+            steps,
+            wall_time_s,
+        }
     }
 }
 

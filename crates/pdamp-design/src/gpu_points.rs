@@ -9,7 +9,6 @@
 use crate::damper::{Damper, PointResult, harmonic_amplitude};
 use pdamp_dem::{HarmonicTranslation, Motion, World};
 use pdamp_gpu::{GpuBatch, GpuDevice};
-use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
 use pdamp_signal::Complex64;
 use pdamp_signal::complex_power::complex_power;
 use std::f64::consts::PI;
@@ -139,43 +138,15 @@ pub fn run_points_gpu(
         .map_err(|e| format!("complex power at f = {frequency_hz} Hz, X = {amplitude_m} m: {e}"))?;
         let a = l0[k].expect("evaluated cycles");
         let b = batch.snapshot(k).map_err(|e| e.to_string())?.ledger;
-        let n = n_eval as f64;
-        let d_np = b.dissipated_normal_pp_j - a.dissipated_normal_pp_j;
-        let d_nw = b.dissipated_normal_pw_j - a.dissipated_normal_pw_j;
-        let d_tp = b.dissipated_tangential_pp_j - a.dissipated_tangential_pp_j;
-        let d_tw = b.dissipated_tangential_pw_j - a.dissipated_tangential_pw_j;
-        let d = d_np + d_nw + d_tp + d_tw;
-        let dw = b.wall_work_j - a.wall_work_j;
-        let de = (b.kinetic_j - a.kinetic_j)
-            + (b.potential_j - a.potential_j)
-            + (b.elastic_j - a.elastic_j);
-        let share = |x: f64| if d > 0.0 { x / d } else { 0.0 };
-        let acc = amplitude_m * omega * omega;
-        out.push(PointResult {
-            frequency_hz,
-            amplitude_m,
-            acceleration_m_s2: acc,
-            intensity: acc / STANDARD_GRAVITY_M_S2,
-            velocity_amplitude_m_s: amplitude_m * omega,
-            dissipated_energy_per_cycle_j: cp.dissipated_energy_per_cycle_j,
-            loss_factor: cp.loss_factor,
-            effective_loss_factor: cp.effective_loss_factor,
-            effective_mass_ratio: cp.effective_mass_ratio,
-            effective_moving_mass_re_kg: cp.effective_moving_mass_re_kg,
-            effective_moving_mass_im_kg: cp.effective_moving_mass_im_kg,
-            ledger_dissipated_per_cycle_j: d / n,
-            ledger_wall_work_per_cycle_j: dw / n,
-            share_normal_pp: share(d_np),
-            share_normal_pw: share(d_nw),
-            share_tangential_pp: share(d_tp),
-            share_tangential_pw: share(d_tw),
-            energy_closure_relative: (dw - de - d) / dw.abs().max(1e-300),
-            cycles_evaluated: n_eval,
-            converged: None,
-            time_step_s: batch.time_step_s(k),
-            steps: batch.steps(k),
-            wall_time_s: start.elapsed().as_secs_f64(),
-        });
+        out.push(PointResult::evaluate(
+            (frequency_hz, amplitude_m),
+            &cp,
+            (&a, &b),
+            n_eval,
+            None,
+            (batch.time_step_s(k), batch.steps(k)),
+            start.elapsed().as_secs_f64(),
+        ));
     }
     Ok(out)
 }
