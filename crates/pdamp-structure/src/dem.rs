@@ -313,6 +313,8 @@ fn coupled_run(
     let kin = resolve_kinematics(structure, damper, damper_point, &opts.kinematics)?;
     let out = structure.point(output_point)?.to_vec();
     let dt = damper.time_step_s;
+    crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
+        .map_err(|e| format!("{e} (the time step is the damper scenario's)"))?;
     let mut it = ModalIntegrator::new(structure, dt);
     it.q = q0;
     it.v = v0;
@@ -489,8 +491,14 @@ fn coupled_run(
         q_raw = q_new;
         it.verlet_kick(&(f_ex(t1) + &q_pd));
         if !q_pd.iter().all(|x| x.is_finite()) || !w.ledger.kinetic_j.is_finite() {
-            return Err(format!("DEM coupling became unstable at t = {t1:.6} s"));
+            return Err(format!(
+                "numerical failure at t = {t1:e} s: the DEM bed's load on the structure became \
+                 non-finite (bed kinetic energy {:e} J); likely cause: the damper scenario's \
+                 time step {dt:e} s against its contact stiffness (check it with `pdamp check`)",
+                w.ledger.kinetic_j
+            ));
         }
+        it.check_health(structure, step == n_steps)?;
         if step % every == 0 {
             push(&it, &mut hist);
         }

@@ -166,14 +166,52 @@ impl FieldColumn {
 impl FieldTable {
     /// Builds the table from `fields.csv` rows. Needs the columns `frequency_hz` and
     /// `amplitude_m`, `effective_mass_ratio`, and `effective_loss_factor` or
-    /// `dissipated_energy_per_cycle_j` (then η̄ = Ẽ/(π m_bed Ω² X²)). Rows with NaN values
-    /// (failed points) are skipped.
+    /// `dissipated_energy_per_cycle_j` (then η̄ = Ẽ/(π m_bed Ω² X²)). Rows whose η̄ or mass
+    /// ratio is NaN (failed points of `pdamp fields`) are skipped; see [`Self::from_rows_at`]
+    /// for what is refused (errors name the row as `row k`).
     ///
     /// # Errors
-    /// Missing columns, fewer than one usable point per frequency, non-positive bed mass.
+    /// See [`Self::from_rows_at`].
     pub fn from_rows(
         header: &[String],
         rows: &[Vec<f64>],
+        bed_mass_kg: f64,
+    ) -> Result<Self, String> {
+        Self::from_rows_at(header, rows, None, bed_mass_kg)
+    }
+
+    /// Parses `fields.csv` text ([`pdamp_io::csv::parse_csv_f64`]) into a table; errors name
+    /// the line of the file.
+    ///
+    /// # Errors
+    /// CSV errors and everything [`Self::from_rows_at`] refuses.
+    pub fn parse(text: &str, bed_mass_kg: f64) -> Result<Self, String> {
+        let (header, rows) = pdamp_io::csv::parse_csv_f64(text).map_err(|e| e.to_string())?;
+        // the lines parse_csv_f64 reads: not blank, not a '#' comment; the first is the header
+        let lines: Vec<usize> = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| {
+                let l = l.trim();
+                !l.is_empty() && !l.starts_with('#')
+            })
+            .map(|(i, _)| i + 1)
+            .skip(1)
+            .collect();
+        Self::from_rows_at(&header, &rows, Some(&lines), bed_mass_kg)
+    }
+
+    /// [`Self::from_rows`] with the file line of every row (`lines[k]` of `rows[k]`) for the
+    /// messages. Refused: a frequency or amplitude that is not a finite number > 0, an η̄ or
+    /// mass ratio that is ±∞ or negative (η̄ down to −1e-6 is taken as round-off and read as
+    /// 0), a table without usable points, a bed mass that is not finite and > 0.
+    ///
+    /// # Errors
+    /// A message naming the line (or row), the column, the value and the fix.
+    pub fn from_rows_at(
+        header: &[String],
+        rows: &[Vec<f64>],
+        lines: Option<&[usize]>,
         bed_mass_kg: f64,
     ) -> Result<Self, String> {
         if !(bed_mass_kg > 0.0 && bed_mass_kg.is_finite()) {
@@ -191,19 +229,51 @@ impl FieldTable {
             );
         }
         let mut pts: Vec<(f64, f64, f64, f64)> = Vec::new();
-        for r in rows {
+        let eta_col = if ei.is_some() {
+            "effective_loss_factor"
+        } else {
+            "dissipated_energy_per_cycle_j"
+        };
+        for (k, r) in rows.iter().enumerate() {
+            let at = match lines.and_then(|l| l.get(k)) {
+                Some(l) => format!("fields.csv line {l}"),
+                None => format!("fields.csv row {}", k + 1),
+            };
             let get = |i: usize| r.get(i).copied().unwrap_or(f64::NAN);
             let (f, x, m) = (get(fi), get(xi), get(mi));
-            let eta = match ei {
+            for (col, v) in [("frequency_hz", f), ("amplitude_m", x)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(format!(
+                        "{at}: column {col} = {v} must be a finite number > 0 (a grid point of \
+                         the effective field)"
+                    ));
+                }
+            }
+            let mut eta = match ei {
                 Some(i) => get(i),
                 None => {
                     let w = std::f64::consts::TAU * f;
                     get(di.unwrap_or(0)) / (std::f64::consts::PI * bed_mass_kg * w * w * x * x)
                 }
             };
-            if [f, x, m, eta].iter().all(|v| v.is_finite()) && f > 0.0 && x > 0.0 {
-                pts.push((f, x, eta, m));
+            if eta.is_nan() || m.is_nan() {
+                continue; // a failed point of `pdamp fields`
             }
+            if !eta.is_finite() || eta < -1e-6 {
+                return Err(format!(
+                    "{at}: column {eta_col} gives η̄ = {eta:e}; the effective loss factor must be \
+                     a finite number ≥ 0 (energy is dissipated, not created): recompute the \
+                     point or remove the row"
+                ));
+            }
+            eta = eta.max(0.0);
+            if !(m.is_finite() && m >= 0.0) {
+                return Err(format!(
+                    "{at}: column effective_mass_ratio = {m:e} must be a finite number ≥ 0 \
+                     (m̄_bed/m_bed): recompute the point or remove the row"
+                ));
+            }
+            pts.push((f, x, eta, m));
         }
         if pts.is_empty() {
             return Err("fields.csv: no usable (finite) points".into());
@@ -248,8 +318,8 @@ impl FieldTable {
     /// # Errors
     /// I/O and format errors, see [`Self::from_rows`].
     pub fn read(path: &Path, bed_mass_kg: f64) -> Result<Self, String> {
-        let (header, rows) = pdamp_io::csv::read_csv_f64(path).map_err(|e| e.to_string())?;
-        Self::from_rows(&header, &rows, bed_mass_kg).map_err(|e| format!("{}: {e}", path.display()))
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::parse(&text, bed_mass_kg).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Interpolated (η̄, m̄/m_bed) at (f, X).

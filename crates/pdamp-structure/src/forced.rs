@@ -65,10 +65,48 @@ impl Sweep {
         }
     }
 
-    /// Checks the parameters.
+    /// Checks the parameters: frequencies and duration finite and > 0.
+    ///
+    /// # Errors
+    /// A message naming the key and the fix.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.start_hz > 0.0 && self.end_hz > 0.0 && self.duration_s > 0.0) {
-            return Err("sweep: start_hz, end_hz and duration_s must be > 0".into());
+        for (key, v) in [
+            ("start_hz", self.start_hz),
+            ("end_hz", self.end_hz),
+            ("duration_s", self.duration_s),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("sweep: {key} = {v:e} must be a finite number > 0"));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl SweepSpec {
+    /// Checks the sweep, the force amplitude (finite) and the time step against the highest
+    /// excitation frequency (at least 8 steps per excitation period).
+    ///
+    /// # Errors
+    /// A message naming the key and the fix.
+    pub fn validate(&self) -> Result<(), String> {
+        self.sweep.validate()?;
+        if !self.force_amplitude_n.is_finite() {
+            return Err(format!(
+                "sweep: force amplitude {:e} N must be finite",
+                self.force_amplitude_n
+            ));
+        }
+        let f_max = self.sweep.start_hz.max(self.sweep.end_hz);
+        if self.time_step_s.is_finite() && self.time_step_s * f_max > 0.125 {
+            return Err(format!(
+                "sweep: time_step_s = {:e} s resolves the highest excitation frequency {f_max:e} \
+                 Hz with {:.2} steps per period; use at most {:e} s (8 steps per period, better \
+                 20)",
+                self.time_step_s,
+                1.0 / (self.time_step_s * f_max),
+                0.125 / f_max
+            ));
         }
         Ok(())
     }
@@ -102,7 +140,14 @@ pub fn run_sweep(
     spec: &SweepSpec,
 ) -> Result<TimeHistory, String> {
     structure.validate()?;
-    spec.sweep.validate()?;
+    spec.validate()?;
+    crate::integrate::validate_settings(
+        structure,
+        spec.time_step_s,
+        spec.sweep.duration_s,
+        spec.sample_every,
+        false,
+    )?;
     let ex = structure.point(&spec.excitation_point)?.to_vec();
     let out = structure.point(&spec.output_point)?.to_vec();
     let shapes: Vec<Vec<f64>> = dampers
@@ -167,6 +212,7 @@ pub fn run_sweep(
             it.set_attachments(&atts);
             it.make_consistent(&generalized_force(&ex, f(t1)));
         }
+        it.check_health(structure, step == n_steps)?;
         if step % every == 0 {
             push(&it, &mut hist);
         }

@@ -171,8 +171,18 @@ pub fn run_free_vibration(
             structure.modes.len()
         ));
     }
-    if !(spec.time_step_s > 0.0 && spec.duration_s > 0.0) {
-        return Err("duration_s and time_step_s must be > 0".into());
+    crate::integrate::validate_settings(
+        structure,
+        spec.time_step_s,
+        spec.duration_s,
+        spec.sample_every,
+        false,
+    )?;
+    if !(spec.initial_displacement_m.is_finite() && spec.initial_velocity_m_s.is_finite()) {
+        return Err(format!(
+            "initial_displacement_m = {:e}, initial_velocity_m_s = {:e}: must be finite",
+            spec.initial_displacement_m, spec.initial_velocity_m_s
+        ));
     }
     let init = structure.point(&spec.initial_point)?.to_vec();
     let out = structure.point(&spec.output_point)?.to_vec();
@@ -288,6 +298,7 @@ pub fn run_free_vibration(
             it.set_attachments(&atts);
             it.make_consistent(&zero);
         }
+        it.check_health(structure, step == n_steps)?;
         if step % every == 0 {
             push(&it, &mut hist);
         }

@@ -2,13 +2,20 @@
 //! ANSYS `HBMAT`/`*SMAT` or Abaqus `*MATRIX GENERATE` after conversion) with a node/dof map.
 //!
 //! Supported: `%%MatrixMarket matrix coordinate real|integer general|symmetric`, 1-based
-//! indices, `%` comments. For `symmetric` files only one triangle is stored and mirrored;
-//! entries given twice are summed (as the format prescribes for assembled contributions).
+//! indices, `%` comments. For `symmetric` files only one triangle is stored and mirrored.
+//! Refused with the line of the offending entry: non-finite values, an entry given twice
+//! (duplicate (i, j)), a `symmetric` file that stores both triangles (a_ij and a_ji), and a
+//! size line announcing more than [`MAX_DIMENSION`] rows or columns, more than
+//! [`MAX_ENTRIES`] entries or more entries than the file's bytes can hold (checked before
+//! anything is allocated). [`check_structural_pair`] adds the checks of a structural K and M:
+//! symmetry of `general` files, M positive definite, K positive semi-definite where this is
+//! cheap to see.
 //!
 //! The dof map is a text file with one line per matrix row: `row node dof` (whitespace or
 //! comma separated; `row` 1-based; `dof` one of `UX UY UZ ROTX ROTY ROTZ`, also `RX…`, `U1…`,
 //! `1`–`6`). Lines starting with `#`, `%` or `!` and a header line whose first field is not a
-//! number are skipped. Every reader returns an error on malformed input and never panics.
+//! number are skipped; a (node, dof) given for two rows is refused with both lines. Every reader
+//! returns an error on malformed input and never panics.
 
 use crate::fe::Dof;
 use nalgebra::DMatrix;
@@ -55,6 +62,9 @@ pub struct CooMatrix {
     pub ncols: usize,
     /// (row, column, value), 0-based, symmetric files already mirrored.
     pub entries: Vec<(usize, usize, f64)>,
+    /// 1-based line in the file of every entry (a mirrored entry carries its original's line);
+    /// empty for matrices not read from a file.
+    pub lines: Vec<usize>,
 }
 
 impl CooMatrix {
@@ -66,10 +76,67 @@ impl CooMatrix {
         }
         m
     }
+
+    /// Line of entry `k` in its file (0 when unknown).
+    fn line_of(&self, k: usize) -> usize {
+        self.lines.get(k).copied().unwrap_or(0)
+    }
+
+    /// Largest |a_ij|.
+    pub fn max_abs(&self) -> f64 {
+        self.entries.iter().map(|e| e.2.abs()).fold(0.0, f64::max)
+    }
+
+    /// Summed diagonal of a square matrix.
+    pub fn diagonal(&self) -> Vec<f64> {
+        let mut d = vec![0.0; self.nrows.min(self.ncols)];
+        for &(i, j, v) in &self.entries {
+            if i == j && i < d.len() {
+                d[i] += v;
+            }
+        }
+        d
+    }
+
+    /// The first pair (k, l) of entries with |a_ij − a_ji| > `rel_tol`·max|a| (entry k at
+    /// (i, j), l its mirror or `None` where a_ji is not stored), with a_ij and a_ji.
+    pub fn asymmetry(&self, rel_tol: f64) -> Option<(usize, Option<usize>, f64, f64)> {
+        let tol = rel_tol * self.max_abs();
+        let mut idx: Vec<usize> = (0..self.entries.len()).collect();
+        idx.sort_by_key(|&k| (self.entries[k].0, self.entries[k].1));
+        let find = |i: usize, j: usize| {
+            idx.binary_search_by_key(&(i, j), |&k| (self.entries[k].0, self.entries[k].1))
+                .ok()
+                .map(|p| idx[p])
+        };
+        for (k, &(i, j, v)) in self.entries.iter().enumerate() {
+            if i == j {
+                continue;
+            }
+            let (l, w) = match find(j, i) {
+                Some(l) => (Some(l), self.entries[l].2),
+                None => (None, 0.0),
+            };
+            if (v - w).abs() > tol {
+                return Some((k, l, v, w));
+            }
+        }
+        None
+    }
 }
 
 /// Largest dimension accepted (the dense modal solver is the limit anyway).
 pub const MAX_DIMENSION: usize = 200_000;
+
+/// Largest number of stored entries a size line may announce (2e8: 3.2 GB of triplets).
+pub const MAX_ENTRIES: usize = 200_000_000;
+
+/// Shortest possible entry line (`1 1 0` and a newline), bytes: a size line announcing more
+/// entries than the file's length allows is refused before allocating.
+const MIN_ENTRY_BYTES: usize = 6;
+
+/// Relative tolerance of the symmetry check of `general` files: |a_ij − a_ji| ≤ 1e-9·max|a|.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 
 /// Parses Matrix Market coordinate text.
 ///
@@ -77,8 +144,7 @@ pub const MAX_DIMENSION: usize = 200_000;
 /// Every malformed banner, size line or entry, out-of-range indices, wrong entry counts,
 /// non-finite values.
 pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
-    let mut lines = text.lines().enumerate();
-    let (_, banner) = lines.next().ok_or(MatrixMarketError::Header {
+    let banner = text.lines().next().ok_or(MatrixMarketError::Header {
         line: 1,
         reason: "empty file".into(),
     })?;
@@ -113,7 +179,8 @@ pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
     };
     let mut size: Option<(usize, usize, usize)> = None;
     let mut entries = Vec::new();
-    for (i, raw) in lines {
+    let mut lines = Vec::new();
+    for (i, raw) in text.lines().enumerate().skip(1) {
         let line = i + 1;
         let l = raw.trim();
         if l.is_empty() || l.starts_with('%') {
@@ -142,8 +209,22 @@ pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
                 if n > r.saturating_mul(c) {
                     return Err(bad(format!("{n} entries cannot fit a {r}×{c} matrix")));
                 }
+                if n > MAX_ENTRIES {
+                    return Err(bad(format!(
+                        "{n} entries announced, more than the {MAX_ENTRIES} accepted"
+                    )));
+                }
+                if n > text.len() / MIN_ENTRY_BYTES + 1 {
+                    return Err(bad(format!(
+                        "{n} entries announced, but the file ({} bytes) can hold at most {} \
+                         (truncated file or wrong size line)",
+                        text.len(),
+                        text.len() / MIN_ENTRY_BYTES + 1
+                    )));
+                }
                 size = Some((r, c, n));
-                entries.reserve(n.min(10_000_000) * if symmetric { 2 } else { 1 });
+                entries.reserve(n * if symmetric { 2 } else { 1 });
+                lines.reserve(n * if symmetric { 2 } else { 1 });
             }
             Some((r, c, _)) => {
                 if f.len() != 3 {
@@ -165,29 +246,78 @@ pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
                 if !v.is_finite() {
                     return Err(bad(format!("value '{}' is not finite", f[2])));
                 }
+                if entries.len() >= 2 * MAX_ENTRIES {
+                    return Err(bad(format!("more than {MAX_ENTRIES} entries")));
+                }
                 entries.push((ri, ci, v));
+                lines.push(line);
                 if symmetric && ri != ci {
                     entries.push((ci, ri, v));
+                    lines.push(line);
                 }
             }
         }
     }
     let (nrows, ncols, n) =
         size.ok_or(MatrixMarketError::Structure("no size line found".into()))?;
-    let stored = if symmetric {
-        entries.iter().filter(|e| e.0 >= e.1).count()
-    } else {
-        entries.len()
-    };
-    if stored != n {
+    // Stored entries (the mirrored copies of a symmetric file left out), keyed by position
+    // (a symmetric file's by its lower-triangle position): equal keys are duplicates or both
+    // triangles of a symmetric file.
+    let mut stored: Vec<((usize, usize), usize)> = Vec::with_capacity(n);
+    let mut k = 0;
+    while k < entries.len() {
+        let (i, j, _) = entries[k];
+        let key = if symmetric {
+            (i.max(j), i.min(j))
+        } else {
+            (i, j)
+        };
+        stored.push((key, k));
+        k += if symmetric && i != j { 2 } else { 1 };
+    }
+    if stored.len() != n {
         return Err(MatrixMarketError::Structure(format!(
-            "size line announces {n} entries, file has {stored}"
+            "size line announces {n} entries, file has {}",
+            stored.len()
         )));
+    }
+    stored.sort_unstable();
+    for w in stored.windows(2) {
+        if w[0].0 != w[1].0 {
+            continue;
+        }
+        let (a, b) = (w[0].1.min(w[1].1), w[0].1.max(w[1].1));
+        let (ea, eb) = (entries[a], entries[b]);
+        let reason = if (ea.0, ea.1) == (eb.0, eb.1) {
+            format!(
+                "entry ({}, {}) is given twice (also on line {}): duplicate entries are not \
+                 summed; give every (row, column) once",
+                eb.0 + 1,
+                eb.1 + 1,
+                lines[a]
+            )
+        } else {
+            format!(
+                "entry ({}, {}) of a symmetric file is also stored as ({}, {}) on line {}: a \
+                 'symmetric' file stores one triangle only; drop the other triangle or declare \
+                 the file 'general'",
+                eb.0 + 1,
+                eb.1 + 1,
+                ea.0 + 1,
+                ea.1 + 1,
+                lines[a]
+            )
+        };
+        return Err(MatrixMarketError::Entry {
+            line: lines[b],
+            reason,
+        });
     }
     Ok(CooMatrix {
         nrows,
         ncols,
         entries,
+        lines,
     })
 }
 
@@ -222,7 +352,14 @@ impl DofMap {
 /// # Errors
 /// Malformed lines, rows out of range, duplicate or missing rows.
 pub fn parse_dof_map(text: &str, n: usize) -> Result<DofMap, MatrixMarketError> {
+    if n > MAX_DIMENSION {
+        return Err(MatrixMarketError::Structure(format!(
+            "dof map for {n} rows: more than the {MAX_DIMENSION} accepted"
+        )));
+    }
     let mut rows: Vec<Option<(i64, Dof)>> = vec![None; n];
+    let mut seen: std::collections::HashMap<(i64, Dof), (usize, usize)> =
+        std::collections::HashMap::new();
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let l = raw.trim();
@@ -256,6 +393,12 @@ pub fn parse_dof_map(text: &str, n: usize) -> Result<DofMap, MatrixMarketError> 
         if rows[r - 1].is_some() {
             return Err(bad(format!("row {r} mapped twice")));
         }
+        if let Some((r0, l0)) = seen.insert((node, dof), (r, line)) {
+            return Err(bad(format!(
+                "node {node} dof {dof:?} is mapped to row {r} and already to row {r0} on line \
+                 {l0}: every (node, dof) must belong to one matrix row"
+            )));
+        }
         rows[r - 1] = Some((node, dof));
     }
     let missing: Vec<usize> = rows
@@ -285,6 +428,151 @@ pub fn read_dof_map(path: &Path, n: usize) -> Result<DofMap, MatrixMarketError> 
         message: e.to_string(),
     })?;
     parse_dof_map(&text, n)
+}
+
+/// Names row `i` (0-based) for messages: `row i+1 (node N UY)` with a dof map.
+fn row_name(i: usize, map: Option<&DofMap>) -> String {
+    match map.and_then(|m| m.rows.get(i)) {
+        Some((node, dof)) => format!("row {} (node {node} {dof:?})", i + 1),
+        None => format!("row {}", i + 1),
+    }
+}
+
+/// Where entry `k` of `a` is: `line L` or `not stored`.
+fn entry_at(a: &CooMatrix, k: Option<usize>) -> String {
+    match k.map(|k| a.line_of(k)) {
+        Some(0) | None => "not stored".into(),
+        Some(l) => format!("line {l}"),
+    }
+}
+
+/// Checks an imported structural stiffness `k` (file `k_file`) and mass `m` (file `m_file`)
+/// before the eigen solver sees them: both square of one size, symmetric within
+/// [`SYMMETRY_TOLERANCE`] (a `general` file may hold anything), M positive definite (positive
+/// diagonal, every 2×2 principal minor positive, and an LDLᵀ factorization with positive
+/// pivots), K positive semi-definite as far as cheaply visible (non-negative diagonal,
+/// k_ij² ≤ k_ii k_jj, and no eigenvalue of (K, M) below −1e-8·max k_ii/m_ii: the Sturm count
+/// of K + σM). `map` (the dof map, when read) names the node and dof of a bad row.
+///
+/// # Errors
+/// A message naming the file, the entry (row, column, line) and the fix.
+pub fn check_structural_pair(
+    k: &CooMatrix,
+    k_file: &str,
+    m: &CooMatrix,
+    m_file: &str,
+    map: Option<&DofMap>,
+) -> Result<(), String> {
+    if k.nrows != k.ncols || m.nrows != m.ncols || k.nrows != m.nrows {
+        return Err(format!(
+            "stiffness '{k_file}' is {}×{}, mass '{m_file}' is {}×{}: both must be square and \
+             of one size",
+            k.nrows, k.ncols, m.nrows, m.ncols
+        ));
+    }
+    let n = k.nrows;
+    for (a, file, what) in [(k, k_file, "stiffness"), (m, m_file, "mass")] {
+        if let Some((e, l, v, w)) = a.asymmetry(SYMMETRY_TOLERANCE) {
+            let (i, j, _) = a.entries[e];
+            return Err(format!(
+                "{what} '{file}', line {}: a({}, {}) = {v:e} but a({}, {}) = {w:e} ({}): a \
+                 structural matrix must be symmetric (|a_ij − a_ji| ≤ {SYMMETRY_TOLERANCE:e}·max|a| \
+                 = {:e}); export the symmetric matrix (or one triangle as 'symmetric')",
+                a.line_of(e),
+                i + 1,
+                j + 1,
+                j + 1,
+                i + 1,
+                entry_at(a, l),
+                SYMMETRY_TOLERANCE * a.max_abs()
+            ));
+        }
+    }
+    let (kd, md) = (k.diagonal(), m.diagonal());
+    let diag_line =
+        |a: &CooMatrix, i: usize| entry_at(a, a.entries.iter().position(|e| e.0 == i && e.1 == i));
+    for i in 0..n {
+        if md[i] <= 0.0 {
+            return Err(format!(
+                "mass '{m_file}': diagonal entry m({0}, {0}) of {1} is {2:e} ({3}): the mass \
+                 matrix must be positive definite; give every dof mass (rotary inertia for \
+                 rotations) or remove the dof from the export",
+                i + 1,
+                row_name(i, map),
+                md[i],
+                diag_line(m, i)
+            ));
+        }
+        if kd[i] < 0.0 {
+            return Err(format!(
+                "stiffness '{k_file}': diagonal entry k({0}, {0}) of {1} is {2:e} ({3}): the \
+                 stiffness matrix must be positive semi-definite (wrong sign or a stress-stiffened \
+                 export?)",
+                i + 1,
+                row_name(i, map),
+                kd[i],
+                diag_line(k, i)
+            ));
+        }
+    }
+    for (a, d, file, what, strict) in [
+        (m, &md, m_file, "mass", true),
+        (k, &kd, k_file, "stiffness", false),
+    ] {
+        for (e, &(i, j, v)) in a.entries.iter().enumerate() {
+            let bound = d[i] * d[j];
+            let bad = if strict {
+                v * v >= bound * (1.0 - 1e-12)
+            } else {
+                v * v > bound * (1.0 + 1e-9) + f64::MIN_POSITIVE
+            };
+            if i != j && bad {
+                return Err(format!(
+                    "{what} '{file}', line {}: a({}, {}) = {v:e} exceeds √(a_ii·a_jj) = {:e} \
+                     ({} and {}): the {what} matrix is not positive {}definite",
+                    a.line_of(e),
+                    i + 1,
+                    j + 1,
+                    bound.sqrt(),
+                    row_name(i, map),
+                    row_name(j, map),
+                    if strict { "" } else { "semi-" }
+                ));
+            }
+        }
+    }
+    let ms = crate::sparse::SparseSym::from_triplets(n, &m.entries, false)?;
+    let perm = crate::sparse::rcm_order(&ms);
+    let not_pd = || {
+        format!(
+            "mass '{m_file}': the mass matrix is not positive definite (its LDLᵀ factorization \
+             has a non-positive pivot): a dof without mass or a wrong sign; give every dof mass \
+             or remove it from the export"
+        )
+    };
+    let fac = crate::sparse::SkylineLdlt::factor(&ms, &perm).map_err(|_| not_pd())?;
+    if fac.negative_pivots() > 0 {
+        return Err(not_pd());
+    }
+    let ratio = kd.iter().zip(&md).map(|(a, b)| a / b).fold(0.0, f64::max);
+    if ratio > 0.0 && ratio.is_finite() {
+        let sigma = 1e-8 * ratio;
+        let ks = crate::sparse::SparseSym::from_triplets(n, &k.entries, false)?;
+        let shifted = ks.shifted(-sigma, &ms);
+        let perm = crate::sparse::rcm_order(&shifted);
+        let negative = match crate::sparse::SkylineLdlt::factor(&shifted, &perm) {
+            Ok(f) => f.negative_pivots(),
+            Err(_) => 0, // singular at the shift: an eigenvalue at −σ exactly, not decided here
+        };
+        if negative > 0 {
+            return Err(format!(
+                "stiffness '{k_file}': the stiffness matrix is not positive semi-definite: \
+                 {negative} eigenvalue(s) of (K, M) lie below −{sigma:e} (1/s²); check the sign \
+                 of the export and that K holds no stress-stiffening or follower terms"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Matrix Market text (`coordinate real symmetric`, lower triangle, 17 significant digits) of a

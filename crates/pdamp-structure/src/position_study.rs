@@ -90,6 +90,9 @@ pub struct PositionResult {
     pub converged: bool,
 }
 
+/// Most positions of one study.
+pub const MAX_POSITIONS: usize = 100_000;
+
 impl PositionStudySpec {
     /// The positions, validated.
     ///
@@ -98,15 +101,26 @@ impl PositionStudySpec {
     pub fn positions(&self) -> Result<Vec<f64>, String> {
         let v = match (&self.positions_m, self.start_m, self.end_m, self.count) {
             (Some(p), None, None, None) => p.clone(),
-            (None, Some(a), Some(b), Some(n)) if n >= 2 => (0..n)
+            (None, Some(a), Some(b), Some(n)) if (2..=MAX_POSITIONS).contains(&n) => (0..n)
                 .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
                 .collect(),
             _ => {
-                return Err("[study]: give positions_m, or start_m + end_m + count (≥ 2)".into());
+                return Err(format!(
+                    "study: give positions_m, or start_m + end_m + count (2 to {MAX_POSITIONS})"
+                ));
             }
         };
-        if v.is_empty() || v.iter().any(|x| !x.is_finite()) {
-            return Err("study.positions_m: needs finite positions".into());
+        if v.is_empty() || v.len() > MAX_POSITIONS {
+            return Err(format!(
+                "study.positions_m: give 1 to {MAX_POSITIONS} positions, got {}",
+                v.len()
+            ));
+        }
+        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+            return Err(format!(
+                "study.positions_m[{i}] must be a finite number, got {}",
+                v[i]
+            ));
         }
         Ok(v)
     }
@@ -127,6 +141,17 @@ pub fn position_study(
         .beam
         .as_ref()
         .ok_or("damper-position study: the scenario's structure must be a [structure.beam]")?;
+    let key = |i: usize| match (&spec.positions_m, i) {
+        (Some(_), _) => format!("study.positions_m[{i}]"),
+        (None, 0) => "study.start_m".to_string(),
+        (None, _) => "study.end_m".to_string(),
+    };
+    for (i, &x) in positions.iter().enumerate() {
+        crate::scenario::on_beam(&key(i), x, beam.length_m)?;
+    }
+    if let Some(x) = spec.move_mass_at_m {
+        crate::scenario::on_beam("study.move_mass_at_m", x, beam.length_m)?;
+    }
     let damper = match scn.dampers.as_slice() {
         [d] if !matches!(d, DamperSpec::Dem { .. }) => d,
         _ => {
@@ -266,7 +291,14 @@ pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Va
         &structure,
         scn_path.parent().unwrap_or(Path::new(".")),
         &f.study,
-    )?;
+    )
+    .map_err(|m| {
+        if m.starts_with("study") {
+            crate::scenario::locate(path, m)
+        } else {
+            m
+        }
+    })?;
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
     let rows: Vec<Vec<f64>> = res
         .iter()

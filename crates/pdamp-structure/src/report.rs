@@ -25,7 +25,10 @@ fn io<E: std::fmt::Display>(e: E) -> String {
 pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value, String> {
     let file = load_structure(structure_path)?;
     let base = structure_path.parent().unwrap_or(Path::new("."));
-    let built = file.structure.build(base)?;
+    let built = file
+        .structure
+        .build(base)
+        .map_err(|m| crate::scenario::locate(structure_path, m))?;
     std::fs::create_dir_all(out).map_err(io)?;
     let s = &built.modal;
     let names: Vec<String> = s
@@ -92,7 +95,10 @@ pub fn run_couple(
     let (scn, structure_spec) = CoupleScenario::load(path)?;
     let mut inputs = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let structure = structure_spec.build(base)?.modal;
+    let structure = structure_spec
+        .build(base)
+        .map_err(|m| crate::scenario::locate(&scn.structure_source(path), m))?
+        .modal;
     let dem_count = scn
         .dampers
         .iter()
@@ -147,8 +153,11 @@ pub fn run_couple(
         | AnalysisSpec::SteadyState { mode, .. } => mode.saturating_sub(1),
     };
     let mut dampers = Vec::new();
-    for d in &scn.dampers {
-        if let Some(m) = d.effective_model(base, &structure, analysis_mode)? {
+    for (i, d) in scn.dampers.iter().enumerate() {
+        if let Some(m) = d
+            .effective_model(base, &structure, analysis_mode)
+            .map_err(|e| crate::scenario::locate(path, format!("dampers[{i}]: {e}")))?
+        {
             dampers.push(CoupledDamper {
                 point: d.point().to_string(),
                 model: m,

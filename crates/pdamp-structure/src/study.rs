@@ -128,6 +128,77 @@ pub fn stroke_at(hist: &TimeHistory, t_s: f64, period_s: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Most designs (particle-number combinations) of one study.
+pub const MAX_DESIGNS: f64 = 1e6;
+
+impl LayerStudySpec {
+    /// Number of sorted combinations (multisets of `layers` values out of the particle
+    /// numbers), as f64 so that it cannot overflow.
+    pub fn design_count(&self) -> f64 {
+        let step = self.step.max(1);
+        let values = if self.max_particles_per_layer >= self.min_particles_per_layer {
+            ((self.max_particles_per_layer - self.min_particles_per_layer) / step + 1) as f64
+        } else {
+            0.0
+        };
+        // C(values + layers − 1, layers)
+        let mut c = 1.0;
+        for i in 0..self.layers.min(1000) {
+            c *= (values + i as f64) / (i as f64 + 1.0);
+        }
+        c
+    }
+
+    /// Checks the study keys (`study.*`): counts ≥ 1 and bounded, finite physical numbers,
+    /// at most [`MAX_DESIGNS`] combinations.
+    ///
+    /// # Errors
+    /// A message naming the key and the fix.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.layers == 0 || self.layers > 100 {
+            return Err(format!(
+                "study.layers must be in [1, 100], got {}",
+                self.layers
+            ));
+        }
+        if self.max_particles_per_layer == 0 || self.max_particles_per_layer > 1_000_000_000 {
+            return Err(format!(
+                "study.max_particles_per_layer must be in [1, 1e9], got {}",
+                self.max_particles_per_layer
+            ));
+        }
+        if self.min_particles_per_layer > self.max_particles_per_layer {
+            return Err(format!(
+                "study.min_particles_per_layer = {} exceeds max_particles_per_layer = {}",
+                self.min_particles_per_layer, self.max_particles_per_layer
+            ));
+        }
+        if self.step == 0 {
+            return Err("study.step must be ≥ 1, got 0".into());
+        }
+        for (key, v, hi) in [
+            ("particle_mass_kg", self.particle_mass_kg, 1e6),
+            ("container_length_m", self.container_length_m, 1e3),
+            ("evaluate_at_s", self.evaluate_at_s, 1e6),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= hi) {
+                return Err(format!(
+                    "study.{key} must be a finite number in (0, {hi:e}], got {v}"
+                ));
+            }
+        }
+        let n = self.design_count();
+        if n > MAX_DESIGNS {
+            return Err(format!(
+                "study.step: {n:.3e} designs (layers {}, particle numbers {}..={} in steps of {}), \
+                 more than the {MAX_DESIGNS:e} accepted; use a larger step or fewer layers",
+                self.layers, self.min_particles_per_layer, self.max_particles_per_layer, self.step
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// All sorted particle-number combinations of the study.
 pub fn combinations(spec: &LayerStudySpec) -> Vec<Vec<usize>> {
     let step = spec.step.max(1);
@@ -166,11 +237,7 @@ pub fn run_layer_study(
     free_spec: &FreeVibrationSpec,
     spec: &LayerStudySpec,
 ) -> Result<Vec<LayerDesign>, String> {
-    if spec.layers == 0 || spec.max_particles_per_layer == 0 || spec.particle_mass_kg <= 0.0 {
-        return Err(
-            "study: layers, max_particles_per_layer and particle_mass_kg must be > 0".into(),
-        );
-    }
+    spec.validate()?;
     if !(spec.evaluate_at_s > 0.0 && spec.evaluate_at_s <= free_spec.duration_s) {
         return Err("study: evaluate_at_s must lie in (0, analysis.duration_s]".into());
     }
@@ -219,8 +286,12 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
         base.join(&file.scenario)
     };
     let (scn, structure_spec) = CoupleScenario::load(&scn_path)?;
+    file.study
+        .validate()
+        .map_err(|m| crate::scenario::locate(path, m))?;
     let structure = structure_spec
-        .build(scn_path.parent().unwrap_or(Path::new(".")))?
+        .build(scn_path.parent().unwrap_or(Path::new(".")))
+        .map_err(|m| crate::scenario::locate(&scn.structure_source(&scn_path), m))?
         .modal;
     let fs = match &scn.analysis {
         AnalysisSpec::Free {
