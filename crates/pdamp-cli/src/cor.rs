@@ -51,7 +51,15 @@ pub struct CorArgs {
     /// Thornton limiting pressure p_y / σ_y (1.6 = first yield).
     #[arg(long, default_value_t = 1.6)]
     thornton_pressure_factor: f64,
+    /// Replace the results of an earlier run in --out (exactly the files it wrote).
+    #[arg(long)]
+    overwrite: bool,
 }
+
+/// Most impact velocities of one `pdamp cor`.
+const MAX_VELOCITIES: usize = 1000;
+/// Most repeated impacts per velocity.
+const MAX_REPEAT: usize = 100;
 
 #[derive(Clone, Copy, ValueEnum)]
 enum ModelArg {
@@ -85,12 +93,35 @@ pub fn run(a: CorArgs) -> Result<()> {
     } else {
         Partner::Wall(set.get(&a.wall)?)
     };
-    if !(a.sphere_radius_m > 0.0 && a.sphere_radius_m.is_finite()) {
-        bail!("--sphere-radius-m must be > 0, got {}", a.sphere_radius_m);
+    if !(a.sphere_radius_m > 0.0 && a.sphere_radius_m <= 1.0) {
+        bail!(
+            "--sphere-radius-m must lie in (0, 1] m, got {}; check the unit",
+            a.sphere_radius_m
+        );
     }
     let mut vs = a.velocities_m_s.clone();
-    if vs.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
-        bail!("--velocities-m-s must all be > 0");
+    if let Some(v) = vs.iter().find(|v| !(**v > 0.0 && **v <= 1000.0)) {
+        bail!(
+            "--velocities-m-s must all lie in (0, 1000] m/s (the models are quasi-static: far below the speed of sound), got {v}"
+        );
+    }
+    if vs.len() > MAX_VELOCITIES {
+        bail!(
+            "--velocities-m-s: {} velocities, at most {MAX_VELOCITIES}",
+            vs.len()
+        );
+    }
+    if !(1..=MAX_REPEAT).contains(&a.repeat) {
+        bail!("--repeat must lie in 1..={MAX_REPEAT}, got {}", a.repeat);
+    }
+    if !(a.thornton_pressure_factor.is_finite()
+        && a.thornton_pressure_factor >= 1.0
+        && a.thornton_pressure_factor <= 10.0)
+    {
+        bail!(
+            "--thornton-pressure-factor must lie in [1, 10] (p_y/σ_y; 1.6 = first yield), got {}",
+            a.thornton_pressure_factor
+        );
     }
     vs.sort_by(f64::total_cmp);
     vs.dedup();
@@ -107,9 +138,41 @@ pub fn run(a: CorArgs) -> Result<()> {
         },
         ModelArg::Viscoelastic => CorModel::Viscoelastic,
     };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let inputs: Vec<&std::path::Path> = a.materials.as_deref().into_iter().collect();
+    let mut dir = crate::open_out(
+        &a.out,
+        false,
+        a.overwrite,
+        None,
+        &[
+            "cor.csv",
+            "gonthier_table.toml",
+            "cor_all.csv",
+            "cor.png",
+            "cor.svg",
+            "provenance.json",
+            "input.toml",
+        ],
+        &inputs,
+    )?;
     let start = std::time::Instant::now();
     let pts = cor_curve(&sphere, &partner, a.sphere_radius_m, &vs, model, a.repeat);
+    // A model outside its range gives ε outside [0, 1] or no number: said, not written.
+    if let Some(p) = pts.iter().find(|p| {
+        !(p.restitution.is_finite()
+            && (0.0..=1.0 + 1e-9).contains(&p.restitution)
+            && p.contact_time_s.is_finite()
+            && p.max_force_n.is_finite())
+    }) {
+        bail!(
+            "the impact model gave ε = {}, contact time {} s, peak force {} N at v = {} m/s (impact {}): outside its range of validity for this sphere and these materials; check --sphere-radius-m, the velocities and the material data",
+            p.restitution,
+            p.contact_time_s,
+            p.max_force_n,
+            p.velocity_m_s,
+            p.impact
+        );
+    }
     let elapsed = start.elapsed().as_secs_f64();
 
     let first: Vec<_> = pts.iter().filter(|p| p.impact == 1).collect();
@@ -245,6 +308,8 @@ pub fn run(a: CorArgs) -> Result<()> {
     }
     line_plot(a.out.join("cor"), &plot)?;
     traced.write(&a.out)?;
+    dir.set_status(pdamp_io::output_dir::RunStatus::Finished);
+    dir.close()?;
     let fe_times: Vec<f64> = pts
         .iter()
         .filter_map(|p| p.fe.as_ref().map(|r| r.wall_time_s))

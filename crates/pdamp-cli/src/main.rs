@@ -26,6 +26,10 @@ struct Cli {
     /// Worker threads (default: all cores).
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Run even beyond the soft limits of the estimate (available memory, output size,
+    /// frames, rows, a month of run time); the limits of the machine stay.
+    #[arg(long, global = true)]
+    force: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -43,6 +47,9 @@ enum Command {
         /// Ctrl-C); the results equal those of an uninterrupted run.
         #[arg(long)]
         resume: bool,
+        /// Replace the results of an earlier run in DIR (exactly the files it wrote).
+        #[arg(long, conflicts_with = "resume")]
+        overwrite: bool,
         /// Wall-clock seconds between checkpoints (0 = only on Ctrl-C).
         #[arg(long, default_value_t = 60.0)]
         checkpoint_interval_s: f64,
@@ -61,6 +68,9 @@ enum Command {
         /// pending points as batches of worlds on the GPU backend; beds are prepared on the CPU).
         #[arg(long, value_enum, default_value_t = Device::Cpu)]
         device: Device,
+        /// Start again: remove the points and maps of an earlier run in DIR first.
+        #[arg(long)]
+        overwrite: bool,
     },
     /// Prepare the bed of a scenario (drop-down and settling) and save it: DIR/bed.pdbed (exact
     /// continuation, `placement = { method = "file", path = "DIR/bed.pdbed" }`), bed.csv,
@@ -74,6 +84,9 @@ enum Command {
         /// Packing index k of an ensemble (seed = simulation.seed + 1 000 003 k).
         #[arg(long, default_value_t = 0)]
         packing: usize,
+        /// Replace the results of an earlier run in DIR (exactly the files it wrote).
+        #[arg(long)]
+        overwrite: bool,
     },
     /// Load, validate and build a scenario without running it; prints what would run as JSON
     /// (particles, masses, shortest contact time, time-step ratio, damper grid).
@@ -288,7 +301,17 @@ fn main() -> std::process::ExitCode {
 
 fn run_cli() -> Result<()> {
     let cli = Cli::parse();
-    let threads = cli.threads.unwrap_or(0);
+    pdamp_io::estimate::set_force(cli.force);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = match cli.threads {
+        Some(0) => bail!("--threads must be >= 1 (leave it out to use all {cores} cores)"),
+        Some(t) if t > 4 * cores && t > 16 => bail!(
+            "--threads {t} is more than 4 × the {cores} cores of this machine; use at most {} (results do not depend on the thread count)",
+            (4 * cores).max(16)
+        ),
+        Some(t) => t,
+        None => 0,
+    };
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build_global()
@@ -305,32 +328,49 @@ fn dispatch(command: Command) -> Result<()> {
             scenario,
             out,
             resume,
+            overwrite,
             checkpoint_interval_s,
             point,
-        } => cmd_run(
-            &scenario,
-            &out,
-            pdamp_io::run::RunOptions {
-                checkpoint_interval_s,
-                resume,
-            },
-            point,
-        ),
+        } => {
+            if !(checkpoint_interval_s.is_finite() && checkpoint_interval_s >= 0.0) {
+                bail!(
+                    "--checkpoint-interval-s must be a finite number of seconds >= 0 (0 = only on Ctrl-C), got {checkpoint_interval_s}"
+                );
+            }
+            cmd_run(
+                &scenario,
+                &out,
+                pdamp_io::run::RunOptions {
+                    checkpoint_interval_s,
+                    resume,
+                },
+                overwrite,
+                point,
+            )
+        }
         Command::Fields {
             scenario,
             out,
             device,
-        } => cmd_fields(&scenario, &out, device),
+            overwrite,
+        } => cmd_fields(&scenario, &out, device, overwrite),
         Command::Check { scenario } => cmd_check(&scenario),
         Command::Settle {
             scenario,
             out,
             packing,
-        } => cmd_settle(&scenario, &out, packing),
+            overwrite,
+        } => cmd_settle(&scenario, &out, packing, overwrite),
         Command::Example {
             particles,
             duration_s,
         } => {
+            if !(1..=100_000_000).contains(&particles) {
+                bail!("--particles must lie in 1..=100000000, got {particles}");
+            }
+            if !(duration_s.is_finite() && duration_s >= 0.0) {
+                bail!("--duration-s must be a finite time >= 0 in seconds, got {duration_s}");
+            }
             print!(
                 "{}",
                 pdamp_io::examples::shaken_box(particles, duration_s).to_toml()
@@ -351,8 +391,19 @@ fn dispatch(command: Command) -> Result<()> {
             let material =
                 Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio);
             material.validate().map_err(anyhow::Error::msg)?;
-            if !(radius_m > 0.0 && velocity_m_s > 0.0) {
-                bail!("--radius-m and --velocity-m-s must be > 0");
+            if !(radius_m > 0.0 && radius_m <= 1.0) {
+                bail!("--radius-m must lie in (0, 1] m, got {radius_m}; check the unit");
+            }
+            if !(velocity_m_s > 0.0 && velocity_m_s <= 1000.0) {
+                bail!("--velocity-m-s must lie in (0, 1000] m/s, got {velocity_m_s}");
+            }
+            if !(restitution > 0.0 && restitution <= 1.0) {
+                bail!("--restitution must lie in (0, 1], got {restitution}");
+            }
+            if let Some(k) = stiffness_n_m
+                && !(k.is_finite() && k > 0.0)
+            {
+                bail!("--stiffness-n-m must be a finite stiffness > 0 N/m, got {k}");
             }
             let partner = match partner {
                 PartnerArg::Wall => Partner::Wall,
@@ -403,6 +454,24 @@ fn dispatch(command: Command) -> Result<()> {
                 velocity_m_s,
                 steps_per_contact: 2000.0,
             });
+            let v = serde_json::to_value(&r)?;
+            if let Some(bad) = v.as_object().and_then(|o| {
+                o.iter()
+                    .find(|(_, x)| x.is_null() || x.as_f64().is_some_and(|x| !x.is_finite()))
+            }) {
+                bail!(
+                    "the impact gave {} = {}: no contact was resolved for these inputs; check the radius, the material data and the velocity",
+                    bad.0,
+                    bad.1
+                );
+            }
+            if let Some(e) = v.get("restitution").and_then(|e| e.as_f64())
+                && !(0.0..=1.0 + 1e-6).contains(&e)
+            {
+                bail!(
+                    "the impact gave ε = {e}, outside [0, 1]: the contact was not resolved (time step or stiffness out of range for these inputs)"
+                );
+            }
             println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }
@@ -441,6 +510,7 @@ fn dispatch(command: Command) -> Result<()> {
             if batch != 1 {
                 bail!("--batch needs --device gpu");
             }
+            bench_limits(particles, steps)?;
             if !peer && settled.is_none() && export_liggghts.is_none() {
                 let r = pdamp_io::bench::shaken_box_bench(particles, steps)
                     .map_err(anyhow::Error::msg)?;
@@ -471,10 +541,108 @@ fn dispatch(command: Command) -> Result<()> {
     }
 }
 
+/// Files and folders the DEM commands write into their output directory (checked for
+/// symbolic links and for inputs they would replace before anything is written).
+const RUN_OUTPUTS: [&str; 14] = [
+    "scenario.toml",
+    "provenance.json",
+    "summary.json",
+    "energy.csv",
+    "particles.pvd",
+    "vtk",
+    "checkpoint.bin",
+    "bed_statistics.json",
+    "failure.json",
+    "velocity_fields.csv",
+    "trajectories.csv",
+    "packings",
+    "points",
+    "fields.csv",
+];
+
+/// Opens the output directory of a command (see [`pdamp_io::output_dir`]): `resume` continues
+/// an earlier run that left `checkpoint` in it (with nothing to continue in an empty
+/// directory the run starts, with a note; a directory with results but no checkpoint is
+/// refused), `overwrite` replaces an earlier run, neither refuses a directory with results.
+pub(crate) fn open_out(
+    out: &std::path::Path,
+    resume: bool,
+    overwrite: bool,
+    checkpoint: Option<&str>,
+    outputs: &[&str],
+    inputs: &[&std::path::Path],
+) -> Result<pdamp_io::output_dir::OutputDir> {
+    use pdamp_io::output_dir::{OutputDir, OutputMode};
+    let mode = match (resume, overwrite) {
+        (true, true) => bail!("--resume and --overwrite exclude each other"),
+        (false, true) => OutputMode::Overwrite,
+        (false, false) => OutputMode::Fresh,
+        (true, false) => {
+            let has_checkpoint = checkpoint.is_some_and(|c| out.join(c).is_file());
+            if has_checkpoint {
+                OutputMode::Continue
+            } else {
+                // Refused below if there are results; otherwise nothing was started yet.
+                match OutputDir::open(out, OutputMode::Fresh, outputs, inputs) {
+                    Ok(d) => {
+                        eprintln!(
+                            "note: nothing to resume in {} (no checkpoint): starting the run",
+                            out.display()
+                        );
+                        return Ok(d);
+                    }
+                    Err(pdamp_io::output_dir::OutputDirError::HasResults { what, .. }) => {
+                        bail!(
+                            "--resume: {} holds results ({what}) but no {}: the run was killed before its first checkpoint or cannot be continued; nothing to resume. Use --overwrite to start it again",
+                            out.display(),
+                            checkpoint.unwrap_or("checkpoint")
+                        )
+                    }
+                    Err(e) => return Err(e.into()),
+                }
+            }
+        }
+    };
+    Ok(OutputDir::open(out, mode, outputs, inputs)?)
+}
+
+/// The scenario file and the files it reads (meshes, beds): inputs no output may replace.
+fn scenario_inputs(
+    scenario: &std::path::Path,
+    sc: &pdamp_io::scenario::Scenario,
+) -> Vec<std::path::PathBuf> {
+    let base = scenario
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default();
+    std::iter::once(scenario.to_path_buf())
+        .chain(sc.referenced_files().into_iter().map(|f| base.join(f)))
+        .collect()
+}
+
+/// `pdamp bench`: the shaken box's size and length within the machine (see
+/// [`pdamp_io::estimate`]).
+fn bench_limits(particles: usize, steps: u64) -> Result<()> {
+    if particles == 0 || steps == 0 {
+        bail!("--particles and --steps must be >= 1");
+    }
+    let mut sc = pdamp_io::examples::shaken_box(particles.min(1000), 0.0);
+    if let Some(g) = sc.particles.first_mut() {
+        g.count = Some(particles);
+    }
+    sc.simulation.duration_s = steps as f64 * sc.simulation.time_step_s;
+    sc.output.vtk_interval_s = 0.0;
+    sc.output.energy_interval_s = sc.simulation.duration_s.max(1e-12);
+    pdamp_io::estimate::Estimate::of(&sc, 1, rayon::current_num_threads())
+        .check()
+        .map_err(|e| anyhow::anyhow!("--particles/--steps: {e}"))
+}
+
 fn cmd_run(
     scenario: &str,
     out: &std::path::Path,
     options: pdamp_io::run::RunOptions,
+    overwrite: bool,
     point: PointArgs,
 ) -> Result<()> {
     let (mut sc, base) = if scenario == "builtin:shaken-box" {
@@ -490,6 +658,25 @@ fn cmd_run(
         (sc, base)
     };
     point.apply(&mut sc)?;
+    let inputs = if scenario == "builtin:shaken-box" {
+        Vec::new()
+    } else {
+        scenario_inputs(std::path::Path::new(scenario), &sc)
+    };
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    if sc.damper.is_some() && options.resume {
+        bail!(
+            "--resume: a damper point (`run` with [damper]) is not checkpointed; rerun it with --overwrite (it takes as long as before)"
+        );
+    }
+    let mut dir = open_out(
+        out,
+        options.resume,
+        overwrite,
+        Some(pdamp_io::checkpoint::CHECKPOINT_FILE),
+        &RUN_OUTPUTS,
+        &inputs,
+    )?;
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template(
@@ -502,20 +689,26 @@ fn cmd_run(
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
     };
     let json = if sc.damper.is_some() {
-        let s = pdamp_design::report::run_damper_scenario(&sc, &base, out, tick)
-            .map_err(anyhow::Error::msg)?;
-        serde_json::to_string_pretty(&s)?
+        let s = pdamp_design::report::run_damper_scenario(&sc, &base, out, tick);
+        dir.set_outcome(&s);
+        serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {
-        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
-            .map_err(anyhow::Error::msg)?;
-        serde_json::to_string_pretty(&s)?
+        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick);
+        dir.set_outcome(&s);
+        serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     };
+    dir.close()?;
     bar.finish_and_clear();
     println!("{json}");
     Ok(())
 }
 
-fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device) -> Result<()> {
+fn cmd_fields(
+    scenario: &std::path::Path,
+    out: &std::path::Path,
+    device: Device,
+    overwrite: bool,
+) -> Result<()> {
     let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     #[cfg(feature = "gpu")]
     if device == Device::Gpu {
@@ -528,12 +721,19 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device)
         })?;
     }
     let _ = &world;
-    if sc.fields.is_none() {
+    let Some(spec) = &sc.fields else {
         bail!(
             "{}: `pdamp fields` needs a [fields] section (and [damper])",
             scenario.display()
         );
-    }
+    };
+    let grid = pdamp_design::FieldGrid::from_spec(spec).map_err(anyhow::Error::msg)?;
+    let points = grid.frequencies_hz.len() * grid.amplitude_values.len();
+    pdamp_io::estimate::Estimate::of(&sc, points, rayon::current_num_threads())
+        .check()
+        .map_err(|e| {
+            anyhow::anyhow!("{}: the field of {points} points: {e}", scenario.display())
+        })?;
     let base = scenario
         .parent()
         .map(|p| p.to_path_buf())
@@ -560,6 +760,19 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device)
         Device::Gpu => bail!("this pdamp was built without the `gpu` feature"),
         Device::Cpu => pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
     };
+    // Fields continue point by point (finished points of the same physics are reused).
+    let inputs = scenario_inputs(scenario, &sc);
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let mut dir = pdamp_io::output_dir::OutputDir::open(
+        out,
+        if overwrite {
+            pdamp_io::output_dir::OutputMode::Overwrite
+        } else {
+            pdamp_io::output_dir::OutputMode::Continue
+        },
+        &RUN_OUTPUTS,
+        &inputs,
+    )?;
     bar.set_message("settling");
     let start = std::time::Instant::now();
     let outcome = pdamp_design::report::run_fields_scenario_on(
@@ -573,8 +786,10 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device)
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         },
-    )
-    .map_err(anyhow::Error::msg)?;
+    );
+    dir.set_outcome(&outcome);
+    dir.close()?;
+    let outcome = outcome.map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
     for (f, x, e) in &outcome.failed {
         eprintln!(
@@ -598,9 +813,32 @@ fn cmd_fields(scenario: &std::path::Path, out: &std::path::Path, device: Device)
     Ok(())
 }
 
-fn cmd_settle(scenario: &std::path::Path, out: &std::path::Path, packing: usize) -> Result<()> {
+fn cmd_settle(
+    scenario: &std::path::Path,
+    out: &std::path::Path,
+    packing: usize,
+    overwrite: bool,
+) -> Result<()> {
     let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     let sc = pdamp_io::prepare::scenario_for_packing(&sc, packing);
+    let inputs = scenario_inputs(scenario, &sc);
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let mut dir = open_out(
+        out,
+        false,
+        overwrite,
+        None,
+        &[
+            "scenario.toml",
+            "provenance.json",
+            "bed.pdbed",
+            "bed.csv",
+            "bed.data",
+            "bed.vtp",
+            "summary.json",
+        ],
+        &inputs,
+    )?;
     let base = scenario
         .parent()
         .map(|p| p.to_path_buf())
@@ -615,8 +853,10 @@ fn cmd_settle(scenario: &std::path::Path, out: &std::path::Path, packing: usize)
     let s = pdamp_io::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| {
         bar.set_message(phase.to_string());
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-    })
-    .map_err(anyhow::Error::msg)?;
+    });
+    dir.set_outcome(&s);
+    dir.close()?;
+    let s = s.map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
     println!("{}", serde_json::to_string_pretty(&s)?);
     Ok(())
@@ -664,6 +904,14 @@ fn cmd_check(scenario: &std::path::Path) -> Result<()> {
         "time_step_s": sc.simulation.time_step_s,
         "shortest_contact_time_s": tc,
         "time_step_over_contact_time": sc.simulation.time_step_s / tc,
+        "estimate": pdamp_io::estimate::Estimate::of(
+            &sc,
+            sc.fields
+                .as_ref()
+                .and_then(|f| pdamp_design::FieldGrid::from_spec(f).ok())
+                .map_or(1, |g| g.frequencies_hz.len() * g.amplitude_values.len()),
+            rayon::current_num_threads(),
+        ),
         "warnings": scenario_warnings(&sc),
     });
     #[cfg(feature = "gpu")]

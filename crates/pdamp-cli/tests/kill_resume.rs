@@ -62,7 +62,10 @@ fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
             let name = p.strip_prefix(dir).unwrap().to_string_lossy().to_string();
             // provenance.json and input.toml record the command, not its results (a study's
             // case directory has neither).
+            // manifest.json records the command line too; .pdamp.lock is the directory's lock.
             if name == "checkpoint.bin"
+                || name == "manifest.json"
+                || name == ".pdamp.lock"
                 || name == "provenance.json"
                 || name == "input.toml"
                 || name.contains(".tmp-")
@@ -187,6 +190,135 @@ fn sigkill_at_random_moments_then_resume_gives_identical_outputs() {
     assert!(st.success());
     assert_same(&reference, &out);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 31, severe defect 2: a rerun without `--resume` used to truncate `energy.csv` at once
+/// while the old "finished" checkpoint stayed until the new run's first checkpoint; killed in
+/// between, a following `--resume` printed the old summary and exited 0 with a fraction of the
+/// energy rows. Now the rerun is refused, `--overwrite` removes the old checkpoint with the
+/// other files, and `--resume` after a kill before the first checkpoint says there is nothing
+/// to resume (status 1). Outputs cut behind the checkpoint's back are refused on `--resume`.
+#[test]
+fn rerun_over_results_is_refused_and_resume_never_reports_a_truncated_run() {
+    let d = scratch("rerun");
+    let scn = scenario(&d);
+    let out = d.join("out");
+    let st = run(&scn, &out, "2", &[]).status().unwrap();
+    assert!(st.success());
+    let energy = std::fs::read(out.join("energy.csv")).unwrap();
+    // A plain rerun is refused and touches nothing.
+    let o = run(&scn, &out, "2", &[]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("already holds the results") && err.contains("--overwrite"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(out.join("energy.csv")).unwrap(), energy);
+    // --overwrite killed before its first checkpoint (interval 0: none until the end).
+    let mut child = run(
+        &scn,
+        &out,
+        "1",
+        &["--overwrite", "--checkpoint-interval-s", "0"],
+    )
+    .spawn()
+    .unwrap();
+    let t0 = Instant::now();
+    // The new run has taken the directory (manifest "running") and opened its energy.csv.
+    let started = || {
+        std::fs::read_to_string(out.join("manifest.json")).is_ok_and(|m| m.contains("running"))
+            && out.join("energy.csv").exists()
+    };
+    while !started() && t0.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !out.join("checkpoint.bin").exists(),
+        "the old run's checkpoint must be gone once the new run writes"
+    );
+    let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("nothing to resume"), "{err}");
+    // A complete run, interrupted by a checkpoint, whose energy.csv is then cut and refilled
+    // to the same length by hand: --resume refuses it (rows, not only bytes).
+    let st = run(&scn, &out, "2", &["--overwrite"]).status().unwrap();
+    assert!(st.success());
+    let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
+    assert!(o.status.success(), "a finished run resumes to its summary");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["status"], "finished");
+    assert!(
+        manifest["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "energy.csv"),
+        "{manifest}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn resume_refuses_outputs_that_do_not_match_the_checkpoint() {
+    let d = scratch("mismatch");
+    let scn = scenario(&d);
+    // Long enough (3 s simulated) to be stopped in the main run.
+    let text = std::fs::read_to_string(&scn).unwrap();
+    let long = text.replace("duration_s = 0.03", "duration_s = 3.0");
+    assert_ne!(long, text);
+    std::fs::write(&scn, long).unwrap();
+    let out = d.join("out");
+    // SIGINT in the main run: a checkpoint with energy rows behind it.
+    let mut child = run(&scn, &out, "1", &[])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while std::fs::metadata(out.join("energy.csv")).map_or(0, |m| m.len()) < 2000
+        && t0.elapsed() < Duration::from_secs(120)
+    {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    sigint(child.id());
+    let st = child.wait().unwrap();
+    assert_eq!(st.code(), Some(130));
+    // Same length, fewer rows: two rows merged into one line.
+    let text = std::fs::read_to_string(out.join("energy.csv")).unwrap();
+    let cut = text.replacen("\n", " ", 2).replacen(' ', "\n", 1);
+    assert_eq!(cut.len(), text.len());
+    std::fs::write(out.join("energy.csv"), cut).unwrap();
+    let o = run(&scn, &out, "1", &["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("do not match the checkpoint"), "{err}");
+    // A missing VTK frame listed in the checkpoint is refused too.
+    std::fs::write(out.join("energy.csv"), &text).unwrap();
+    let frame = std::fs::read_dir(out.join("vtk"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    std::fs::remove_file(&frame).unwrap();
+    let o = run(&scn, &out, "1", &["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("missing"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Sends SIGINT to a process.
+fn sigint(pid: u32) {
+    let st = Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
 }
 
 #[test]

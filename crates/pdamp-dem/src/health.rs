@@ -2,6 +2,7 @@
 //! energy balance are found early and reported with the particle, time, position and the likely
 //! cause, instead of running on with garbage.
 
+use crate::walls::Geometry;
 use crate::world::World;
 
 /// Largest particle–particle or particle–wall overlap, relative to the (smaller) radius, that
@@ -12,6 +13,11 @@ pub const MAX_RELATIVE_OVERLAP: f64 = 0.25;
 /// Relative energy-balance residual |W − ΔE − D| / scale beyond which the run has blown up
 /// (healthy runs close to 1e-4 or better; Gear runs to their error tolerance).
 pub const MAX_CLOSURE_ERROR: f64 = 0.5;
+
+/// A cumulative dissipation term below −`NEGATIVE_DISSIPATION` × the energy turnover means a
+/// contact creates energy (dissipation is never negative; the trapezoidal bookkeeping of a
+/// healthy run stays above −1e-9 of the turnover).
+pub const NEGATIVE_DISSIPATION: f64 = 1e-3;
 
 /// What went wrong.
 #[derive(Debug, Clone, PartialEq)]
@@ -149,14 +155,57 @@ impl World {
         let scale = l
             .turnover_j()
             .max(l.initial_kinetic_j.abs() + l.initial_elastic_j.abs());
+        // Dissipation is never negative: energy created by a contact.
+        let terms = [
+            (
+                l.dissipated_normal_pw_j,
+                "normal dissipation of particle–wall contacts",
+                true,
+            ),
+            (
+                l.dissipated_tangential_pw_j,
+                "tangential dissipation of particle–wall contacts",
+                true,
+            ),
+            (
+                l.dissipated_normal_pp_j,
+                "normal dissipation of particle–particle contacts",
+                false,
+            ),
+            (
+                l.dissipated_tangential_pp_j,
+                "tangential dissipation of particle–particle contacts",
+                false,
+            ),
+        ];
+        if let Some(&(d, what, wall)) = terms
+            .iter()
+            .find(|(d, _, _)| *d < -NEGATIVE_DISSIPATION * scale && *d < -1e-15)
+        {
+            let i = fastest(p);
+            let why = if wall {
+                "likely cause: a wall whose normal points out of the particle region (a reversed \
+                 mesh, or flip_normals set on a mesh that was right) lets particles be pushed \
+                 through it; check the wall's orientation"
+                    .to_string()
+            } else {
+                cause(self)
+            };
+            return Err(err(
+                i,
+                format!(
+                    "energy is being created: the {what} is {d:.3e} J (negative, against \
+                     {scale:.3e} J of energy turnover); fastest particle shown; {why}"
+                ),
+            ));
+        }
+        if let Some(e) = self.escaped_particle() {
+            return Err(err(Some(e.0), e.1));
+        }
         let closure = l.closure_error_j();
         if !closure.is_finite() || (scale > 0.0 && closure.abs() > MAX_CLOSURE_ERROR * scale) {
             // Blame the fastest particle.
-            let i = (0..p.len()).max_by(|&a, &b| {
-                p.velocity[a]
-                    .norm_squared()
-                    .total_cmp(&p.velocity[b].norm_squared())
-            });
+            let i = fastest(p);
             return Err(err(
                 i,
                 format!(
@@ -170,6 +219,83 @@ impl World {
         }
         Ok(())
     }
+
+    /// The first particle that has left every closed container of the world (a box or
+    /// cylinder container, a closed mesh whose normals point inwards, or an open mesh, which
+    /// can only hold a bed inside its bounding box): its centre lies outside the bounding boxes
+    /// of all of them (in each body's frame), by more than a particle diameter. `None` when
+    /// the world has no container or every particle is in one. O(N × containers).
+    fn escaped_particle(&self) -> Option<(usize, String)> {
+        let p = &self.particles;
+        let mut boxes = Vec::new();
+        for (b, body) in self.bodies.iter().enumerate() {
+            for (w, wall) in body.walls.iter().enumerate() {
+                let confines = match &wall.geometry {
+                    Geometry::BoxInside(_) | Geometry::CylinderInside(_) => true,
+                    Geometry::Mesh(m) => !m.is_closed() || m.enclosed_volume_m3() < 0.0,
+                    Geometry::Plane(_) | Geometry::CylinderOutside(_) => false,
+                };
+                if confines && let Some(bb) = wall.geometry.bounding_box() {
+                    boxes.push((b, w, bb));
+                }
+            }
+        }
+        if boxes.is_empty() {
+            return None;
+        }
+        for i in 0..p.len() {
+            let margin = 2.0 * p.radius[i];
+            let mut nearest = (f64::INFINITY, 0, 0);
+            for &(b, w, (lo, hi)) in &boxes {
+                let x = self.bodies[b].state.to_body(&p.position[i]);
+                let d = (0..3)
+                    .map(|k| (lo[k] - x[k]).max(x[k] - hi[k]).max(0.0))
+                    .fold(0.0, f64::max);
+                if d <= margin {
+                    nearest = (0.0, b, w);
+                    break;
+                }
+                if d < nearest.0 {
+                    nearest = (d, b, w);
+                }
+            }
+            if nearest.0 > 0.0 {
+                let (d, b, w) = nearest;
+                let body = &self.bodies[b];
+                let wall = &body.walls[w];
+                let open = match &wall.geometry {
+                    Geometry::Mesh(m) if !m.is_closed() => {
+                        " The mesh is not closed (it has edges used by one triangle only): \
+                         close it, or add the walls that close it."
+                    }
+                    _ => "",
+                };
+                return Some((
+                    i,
+                    format!(
+                        "particle {i} (id {}) has left its container: it is {d:.3e} m outside \
+                         the bounding box of wall '{}' of body '{}'.{open} Likely cause: a \
+                         gap in the container's walls, or particles pushed through a wall \
+                         ({})",
+                        p.id[i],
+                        wall.name,
+                        body.name,
+                        cause(self)
+                    ),
+                ));
+            }
+        }
+        None
+    }
+}
+
+/// Index of the fastest particle (the one a broken balance is shown with).
+fn fastest(p: &crate::particles::ParticleSet) -> Option<usize> {
+    (0..p.len()).max_by(|&a, &b| {
+        p.velocity[a]
+            .norm_squared()
+            .total_cmp(&p.velocity[b].norm_squared())
+    })
 }
 
 #[cfg(test)]
@@ -223,6 +349,61 @@ mod tests {
         assert!(e.particle.is_some() && e.position_m.is_some(), "{text}");
         assert!(text.contains("time step"), "{text}");
         assert!(text.contains("simulation.time_step_s"), "{text}");
+    }
+
+    /// A 10 mm box container with one particle inside.
+    fn boxed() -> World {
+        use crate::body::{BodyState, Motion, RigidBody};
+        use crate::walls::{BoxInside, Geometry};
+        let mut w = pair(1e-7, 0.0);
+        w.particles.position[1] = Vec3::new(1.05e-3, 3e-3, 0.0);
+        w.add_body(
+            RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+                "container",
+                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(5e-3, 5e-3, 5e-3))),
+                0,
+            ),
+        );
+        w.initialize();
+        w
+    }
+
+    #[test]
+    fn a_particle_outside_every_container_is_named() {
+        let mut w = boxed();
+        w.check_health().unwrap();
+        // Moved 62 m away (the reversed-facet defect of issue 31 ended like this).
+        w.particles.position[1] = Vec3::new(0.0, 0.0, -62.0);
+        let e = w.check_health().unwrap_err();
+        assert_eq!(e.particle, Some(1));
+        let text = e.to_string();
+        assert!(text.contains("has left its container"), "{text}");
+        assert!(text.contains("'container' of body 'box'"), "{text}");
+        // Just outside by less than a diameter: a contact, not an escape.
+        w.particles.position[1] = Vec3::new(0.0, 0.0, 5.5e-3);
+        assert!(
+            !w.check_health()
+                .is_err_and(|e| e.to_string().contains("left its container"))
+        );
+    }
+
+    #[test]
+    fn negative_dissipation_is_energy_created() {
+        let mut w = boxed();
+        w.ledger.wall_work_j = 0.2;
+        w.ledger.kinetic_j += 0.2;
+        w.ledger.dissipated_normal_pw_j = -0.2;
+        let e = w.check_health().unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains("energy is being created"), "{text}");
+        assert!(text.contains("wall's orientation"), "{text}");
+        // Round-off below the threshold is not a failure.
+        w.ledger.dissipated_normal_pw_j = -1e-7;
+        w.ledger.wall_work_j = 0.2 - 1e-7;
+        assert!(
+            !w.check_health()
+                .is_err_and(|e| e.to_string().contains("energy is being created")),
+        );
     }
 
     #[test]

@@ -440,7 +440,8 @@ pub fn run_fields_scenario_on(
         d.intensity = None;
         d.motion_output = Default::default();
     }
-    let fingerprint = physics.to_toml();
+    // The content of meshes and bed files counts, not only their paths.
+    let fingerprint = physics.to_toml() + &pdamp_io::run::referenced_files_digest(sc, base_dir);
     let fp_path = out.join("points").join("scenario_physics.toml");
     std::fs::create_dir_all(out.join("points")).map_err(io)?;
     match std::fs::read_to_string(&fp_path) {

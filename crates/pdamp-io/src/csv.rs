@@ -136,6 +136,21 @@ impl CsvWriter<BufWriter<File>> {
                 "header differs from the expected columns",
             )));
         }
+        // The rows up to the checkpoint must be the checkpoint's rows (a file of the same
+        // length from another run, or one cut and refilled, is not continued).
+        file.seek(SeekFrom::Start(0)).map_err(io)?;
+        let mut kept = Vec::new();
+        (&mut file).take(bytes).read_to_end(&mut kept).map_err(io)?;
+        let lines = kept.iter().filter(|&&b| b == b'\n').count();
+        if lines != rows + 1 || kept.last() != Some(&b'\n') {
+            return Err(io(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "the first {bytes} bytes hold {} rows, the checkpoint expects {rows}: the outputs do not match the checkpoint; rerun with --overwrite",
+                    lines.saturating_sub(1)
+                ),
+            )));
+        }
         file.set_len(bytes).map_err(io)?;
         file.seek(SeekFrom::End(0)).map_err(io)?;
         Ok(CsvWriter {

@@ -459,6 +459,32 @@ pub fn scenario_digest(scenario: &Scenario) -> String {
     crate::checkpoint::digest(scenario.to_toml().as_bytes())
 }
 
+/// The content of every file the scenario reads ([`Scenario::referenced_files`], relative to
+/// `base_dir`) as TOML comment lines `# file <path>: <digest of its bytes>` (`unreadable`
+/// where it cannot be read), so that a checkpoint or a stored result is never continued with
+/// a changed mesh or bed behind an unchanged path.
+pub fn referenced_files_digest(scenario: &Scenario, base_dir: &Path) -> String {
+    let mut s = String::new();
+    for f in scenario.referenced_files() {
+        let d = std::fs::read(base_dir.join(&f)).map_or_else(
+            |_| "unreadable".to_string(),
+            |b| crate::checkpoint::digest(&b),
+        );
+        s.push_str(&format!("# file {}: {d}\n", f.display()));
+    }
+    s
+}
+
+/// Digest of a scenario together with the content of the files it reads (checkpoints and
+/// stored results of runs are keyed by it).
+pub fn scenario_content_digest(scenario: &Scenario, base_dir: &Path) -> String {
+    let files = referenced_files_digest(scenario, base_dir);
+    if files.is_empty() {
+        return scenario_digest(scenario);
+    }
+    crate::checkpoint::digest((scenario.to_toml() + &files).as_bytes())
+}
+
 /// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
 /// `progress(phase, fraction)` is called regularly. Checkpoints every
 /// `options.checkpoint_interval_s` of wall-clock time and on a stop request
@@ -475,7 +501,7 @@ pub fn run_scenario(
     use crate::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
     let io = |e: std::io::Error| format!("output: {e}");
     let mut world = scenario.build_world(base_dir)?;
-    let digest = scenario_digest(scenario);
+    let digest = scenario_content_digest(scenario, base_dir);
     let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
     let header = CheckpointHeader::new(RUN_KIND, &digest);
     let resumed: Option<RunCheckpoint> = if options.resume {

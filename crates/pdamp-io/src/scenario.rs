@@ -211,6 +211,17 @@ fn default_packings() -> usize {
 /// Most packings of an ensemble.
 pub const MAX_PACKINGS: usize = 1000;
 
+/// Most excitation cycles of a damper point.
+pub const MAX_DAMPER_CYCLES: u32 = 100_000;
+/// Most phases per cycle of the velocity fields.
+pub const MAX_PHASES_PER_CYCLE: u32 = 360;
+/// Most cells of the velocity fields along an axis.
+pub const MAX_FIELD_CELLS: u32 = 200;
+/// Most VTK frames per cycle of a damper point.
+pub const MAX_VTK_FRAMES_PER_CYCLE: u32 = 1000;
+/// Most particles with a written trajectory.
+pub const MAX_TRAJECTORIES: usize = 10_000;
+
 fn default_cycles() -> u32 {
     20
 }
@@ -668,6 +679,45 @@ pub struct ParticleGroupSpec {
     pub initial_velocity_m_s: [f64; 3],
 }
 
+/// Refuses an array of the file that is longer than the one it was read into (a vector
+/// `[x, y, z, w]` read as `[x, y, z]`): walks the tables of both, `key` is the path so far.
+fn check_array_lengths(
+    original: &toml::Table,
+    canonical: &toml::Table,
+    key: &str,
+) -> Result<(), String> {
+    for (k, v) in original {
+        let Some(c) = canonical.get(k) else { continue };
+        let path = if key.is_empty() {
+            k.clone()
+        } else {
+            format!("{key}.{k}")
+        };
+        check_value_lengths(v, c, &path)?;
+    }
+    Ok(())
+}
+
+fn check_value_lengths(v: &toml::Value, c: &toml::Value, path: &str) -> Result<(), String> {
+    match (v, c) {
+        (toml::Value::Table(a), toml::Value::Table(b)) => check_array_lengths(a, b, path),
+        (toml::Value::Array(a), toml::Value::Array(b)) => {
+            if a.len() != b.len() && a.iter().all(|x| x.is_float() || x.is_integer()) {
+                return Err(format!(
+                    "{path} has {} components, {} expected (e.g. [x, y, z])",
+                    a.len(),
+                    b.len()
+                ));
+            }
+            for (k, (x, y)) in a.iter().zip(b).enumerate() {
+                check_value_lengths(x, y, &format!("{path}[{k}]"))?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Particle number from the container's capacity $n_p^{max}$: either a filling ratio
 /// $n_p/n_p^{max}$ or a clearance h to the lid, $n_p = n_p^{max}(1 - h/L)$ [D Eq. 8.1].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -879,6 +929,15 @@ impl Scenario {
         })?;
         s.validate()
             .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
+        // Vectors are read into fixed-size arrays, which ignore extra components: compare
+        // every array of the file with the scenario as read.
+        if let (Ok(original), Ok(canonical)) = (
+            text.parse::<toml::Table>(),
+            s.to_toml().parse::<toml::Table>(),
+        ) {
+            check_array_lengths(&original, &canonical, "")
+                .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
+        }
         Ok(s)
     }
 
@@ -889,6 +948,13 @@ impl Scenario {
     /// the container (right for counts, masses and the time-step check, not for a run).
     pub fn load_and_build(path: &Path) -> Result<(Self, World), ScenarioError> {
         let s = Self::load(path)?;
+        // Work and memory before anything is allocated (one run or one damper point).
+        crate::estimate::Estimate::of(&s, 1, rayon::current_num_threads())
+            .check()
+            .map_err(|m| {
+                let text = std::fs::read_to_string(path).ok();
+                ScenarioError::invalid(path, text.as_deref(), m)
+            })?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         let world = s
             .build_world_with(&base, Preparation::Check, &mut |_, _| {})
@@ -921,6 +987,83 @@ impl Scenario {
     /// Serialises to TOML.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Files the scenario reads besides itself (STL walls, bed files), as written in it
+    /// (relative to the scenario file). Restitution tables are inlined by [`Self::to_toml`].
+    pub fn referenced_files(&self) -> Vec<PathBuf> {
+        let walls = self.bodies.iter().flat_map(|b| &b.walls);
+        let stl = walls.filter_map(|w| match &w.geometry {
+            GeometrySpec::Stl(s) => Some(s.path.clone()),
+            _ => None,
+        });
+        let beds = self
+            .particles
+            .iter()
+            .filter_map(|g| g.placement.path.clone());
+        stl.chain(beds).collect()
+    }
+
+    /// Checks `damper.motion_output`: sizes that fit a cycle and the bed.
+    fn validate_motion_output(&self, d: &DamperSpec) -> Result<(), String> {
+        let m = &d.motion_output;
+        if m.phases_per_cycle > MAX_PHASES_PER_CYCLE {
+            return Err(format!(
+                "damper.motion_output.phases_per_cycle must lie in 0..={MAX_PHASES_PER_CYCLE} (0 = no velocity fields), got {}; 4 gives the phases 0, 90, 180 and 270°",
+                m.phases_per_cycle
+            ));
+        }
+        if !(1..=MAX_FIELD_CELLS).contains(&m.field_cells) {
+            return Err(format!(
+                "damper.motion_output.field_cells must lie in 1..={MAX_FIELD_CELLS}, got {}; e.g. 12",
+                m.field_cells
+            ));
+        }
+        if m.vtk_frames_per_cycle > MAX_VTK_FRAMES_PER_CYCLE {
+            return Err(format!(
+                "damper.motion_output.vtk_frames_per_cycle must be at most {MAX_VTK_FRAMES_PER_CYCLE}, got {}; e.g. 8",
+                m.vtk_frames_per_cycle
+            ));
+        }
+        if let Some(f) = d.frequency_hz {
+            let steps_per_cycle = 1.0 / (f * self.simulation.time_step_s);
+            for (k, n) in [
+                ("phases_per_cycle", m.phases_per_cycle),
+                ("vtk_frames_per_cycle", m.vtk_frames_per_cycle),
+            ] {
+                if f64::from(n) > steps_per_cycle {
+                    return Err(format!(
+                        "damper.motion_output.{k} ({n}) exceeds the {steps_per_cycle:.0} time steps of a cycle at {f} Hz; use at most {}",
+                        steps_per_cycle.floor().max(1.0)
+                    ));
+                }
+            }
+        }
+        let n: Option<usize> = self
+            .particles
+            .iter()
+            .map(|g| g.resolved_count().ok())
+            .try_fold(0usize, |a, c| c.map(|c| a.saturating_add(c)))
+            .filter(|_| {
+                self.particles
+                    .iter()
+                    .all(|g| g.placement.method != PlacementMethod::File)
+            });
+        if let Some(n) = n
+            && let Some(&i) = m.trajectory_particles.iter().find(|&&i| i >= n)
+        {
+            return Err(format!(
+                "damper.motion_output.trajectory_particles: particle {i} does not exist (the bed has {n} particles, indices 0..={})",
+                n.saturating_sub(1)
+            ));
+        }
+        if m.trajectory_particles.len() > MAX_TRAJECTORIES {
+            return Err(format!(
+                "damper.motion_output.trajectory_particles lists {} particles, at most {MAX_TRAJECTORIES}",
+                m.trajectory_particles.len()
+            ));
+        }
+        Ok(())
     }
 
     /// Checks the placement of group `g` (keys as `particles[g].placement.…`).
@@ -1061,6 +1204,10 @@ impl Scenario {
                 s.time_step_s, s.duration_s
             ));
         }
+        if let Integrator::Gear(g) = &s.integrator {
+            g.validate(s.time_step_s)
+                .map_err(|e| format!("simulation.integrator.{e}"))?;
+        }
         if s.gravity_m_s2.iter().any(|g| !g.is_finite()) {
             return Err(format!(
                 "simulation.gravity_m_s2 must be finite, got {:?}; e.g. [0.0, 0.0, -9.81]",
@@ -1176,10 +1323,22 @@ impl Scenario {
                         h.frequency_hz
                     ));
                 }
-                if !(h.amplitude_m.is_finite() && h.amplitude_m >= 0.0) {
+                if !(h.amplitude_m.is_finite() && h.amplitude_m >= 0.0 && h.amplitude_m <= 1.0) {
                     return Err(format!(
-                        "bodies[{b}].motion.amplitude_m must be >= 0 (metres), got {}",
+                        "bodies[{b}].motion.amplitude_m must lie in [0, 1] m, got {}; check the unit",
                         h.amplitude_m
+                    ));
+                }
+                if h.frequency_hz > 1e5 {
+                    return Err(format!(
+                        "bodies[{b}].motion.frequency_hz must be at most 1e5 Hz, got {}",
+                        h.frequency_hz
+                    ));
+                }
+                if !h.phase_rad.is_finite() {
+                    return Err(format!(
+                        "bodies[{b}].motion.phase_rad must be finite (radians), got {}",
+                        h.phase_rad
                     ));
                 }
             }
@@ -1199,9 +1358,12 @@ impl Scenario {
                     d.packings
                 ));
             }
-            if !(d.container_mass_kg.is_finite() && d.container_mass_kg >= 0.0) {
+            if !(d.container_mass_kg.is_finite()
+                && d.container_mass_kg >= 0.0
+                && d.container_mass_kg <= 1e6)
+            {
                 return Err(format!(
-                    "damper.container_mass_kg must be >= 0 (kg), got {}",
+                    "damper.container_mass_kg must lie in [0, 1e6] kg, got {}; check the unit",
                     d.container_mass_kg
                 ));
             }
@@ -1248,6 +1410,28 @@ impl Scenario {
             if self.fields.is_none() && d.frequency_hz.is_none() {
                 return Err("damper.frequency_hz is needed (or a [fields] grid)".into());
             }
+            // Physical ranges (a finite but absurd number gives finite nonsense downstream).
+            for (k, v, max, unit) in [
+                ("amplitude_m", d.amplitude_m, 1.0, "m"),
+                ("acceleration_m_s2", d.acceleration_m_s2, 1e6, "m/s²"),
+                ("intensity", d.intensity, 1e5, "(A/g)"),
+                ("frequency_hz", d.frequency_hz, 1e5, "Hz"),
+            ] {
+                if let Some(v) = v
+                    && !(finite_pos(v) && v <= max)
+                {
+                    return Err(format!(
+                        "damper.{k} must lie in (0, {max:e}] {unit}, got {v}; check the unit"
+                    ));
+                }
+            }
+            if d.cycles > MAX_DAMPER_CYCLES {
+                return Err(format!(
+                    "damper.cycles must be at most {MAX_DAMPER_CYCLES}, got {}; use [damper.convergence] to stop when the result has settled",
+                    d.cycles
+                ));
+            }
+            self.validate_motion_output(d)?;
             if d.cycles <= d.transient_cycles {
                 return Err(format!(
                     "damper.cycles ({}) must exceed damper.transient_cycles ({}); e.g. cycles = {}",

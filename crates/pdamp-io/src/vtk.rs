@@ -414,7 +414,19 @@ impl PvdSeries {
     }
 
     /// A series that continues with the frames `entries` (from a checkpoint); rewrites the file.
+    /// Every frame of `entries` must still exist next to the `.pvd` (a resumed run would
+    /// otherwise list frames that are gone).
     pub fn resume(path: impl AsRef<Path>, entries: Vec<(f64, String)>) -> Result<Self, VtkError> {
+        let dir = path.as_ref().parent().unwrap_or(Path::new(""));
+        if let Some((t, f)) = entries.iter().find(|(_, f)| !dir.join(f).is_file()) {
+            return Err(VtkError::Io(std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!(
+                    "the checkpoint lists the frame {} (t = {t} s) but it is missing: the outputs do not match the checkpoint; rerun with --overwrite",
+                    dir.join(f).display()
+                ),
+            )));
+        }
         let s = PvdSeries {
             path: path.as_ref().to_path_buf(),
             entries,
