@@ -667,6 +667,24 @@ fn corpus() -> Vec<Case> {
             v.push(c);
         }
     }
+    // An open mesh (one bottom facet missing) lets the bed fall out: the run stops, naming the
+    // particle and the open mesh, instead of ending with exit 0.
+    let mut c = case(
+        "run: STL container with a hole",
+        &["run", "{dir}/s.toml", "--out", "{dir}/out"],
+        vec![
+            (
+                "s.toml",
+                stl.replace("duration_s = 0.002", "duration_s = 0.08")
+                    .replace("energy_interval_s = 0.001", "energy_interval_s = 0.01"),
+            ),
+            ("box.stl", box_stl(None, Some(0), None)),
+        ],
+        1,
+        &["has left its container", "not closed", "failure.json"],
+    );
+    c.no_out = false;
+    v.push(c);
     v.push(case(
         "check: missing STL",
         &["check", "{dir}/s.toml"],

@@ -312,6 +312,33 @@ fn resume_refuses_outputs_that_do_not_match_the_checkpoint() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// Two runs into one directory at once: the second is refused while the first holds it (it
+/// used to end with both exiting 0 and a mixed energy.csv); the first ends normally.
+#[test]
+fn a_second_run_into_a_busy_directory_is_refused() {
+    let d = scratch("busy");
+    let scn = scenario(&d);
+    let text = std::fs::read_to_string(&scn).unwrap();
+    std::fs::write(&scn, text.replace("duration_s = 0.03", "duration_s = 0.5")).unwrap();
+    let out = d.join("out");
+    let mut first = run(&scn, &out, "1", &[]).stderr(Stdio::null()).spawn().unwrap();
+    let t0 = Instant::now();
+    while !out.join("manifest.json").exists() && t0.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let o = run(&scn, &out, "1", &["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("in use by another pdamp run")
+            && err.contains(&format!("process {}", first.id())),
+        "{err}"
+    );
+    sigint(first.id());
+    assert_eq!(first.wait().unwrap().code(), Some(130));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Sends SIGINT to a process.
 fn sigint(pid: u32) {
     let st = Command::new("kill")

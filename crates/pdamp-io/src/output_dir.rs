@@ -150,6 +150,8 @@ fn io_err(path: &Path) -> impl FnOnce(io::Error) -> OutputDirError + '_ {
 #[derive(Debug)]
 pub struct OutputDir {
     path: PathBuf,
+    /// Whether `open` created the directory (a failed command that wrote nothing removes it).
+    created: bool,
     lock: Option<File>,
     manifest: Manifest,
     status: RunStatus,
@@ -177,8 +179,18 @@ impl OutputDir {
                 ),
             });
         }
+        let created = !path.exists();
         fs::create_dir_all(path).map_err(io_err(path))?;
-        let lock = Self::lock(path)?;
+        let lock = match Self::lock(path) {
+            Ok(l) => l,
+            Err(e) => {
+                if created {
+                    let _ = fs::remove_file(path.join(LOCK_FILE));
+                    let _ = fs::remove_dir(path);
+                }
+                return Err(e);
+            }
+        };
         // Inputs that an output would replace.
         for name in outputs.iter().copied().chain([MANIFEST_FILE]) {
             let out = path.join(name);
@@ -251,6 +263,7 @@ impl OutputDir {
         };
         let dir = Self {
             path: path.to_path_buf(),
+            created,
             lock: Some(lock),
             manifest,
             status: RunStatus::Failed,
@@ -342,6 +355,14 @@ impl OutputDir {
             .into_iter()
             .filter(|f| !before.contains(f) && f != MANIFEST_FILE)
             .collect();
+        // A command that failed before writing anything leaves no directory it created.
+        if self.status == RunStatus::Failed && self.created && files.is_empty() {
+            self.lock = None;
+            let _ = fs::remove_file(self.path.join(MANIFEST_FILE));
+            let _ = fs::remove_file(self.path.join(LOCK_FILE));
+            let _ = fs::remove_dir(&self.path);
+            return Ok(());
+        }
         self.manifest.files = files;
         self.manifest.status = self.status;
         let r = self.write_manifest();
@@ -561,6 +582,20 @@ mod tests {
             matches!(e, OutputDirError::WouldOverwriteInput { .. }),
             "{e}"
         );
+        let _ = fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_failed_command_that_wrote_nothing_leaves_no_directory() {
+        let d = tmp("failed");
+        let o = OutputDir::open(&d, OutputMode::Fresh, &["energy.csv"], &[]).unwrap();
+        drop(o); // status Failed by default
+        assert!(!d.exists());
+        // One that wrote something keeps it, with the manifest.
+        let o = OutputDir::open(&d, OutputMode::Fresh, &["energy.csv"], &[]).unwrap();
+        fs::write(d.join("energy.csv"), "t\n").unwrap();
+        drop(o);
+        assert_eq!(read_manifest(&d).unwrap().status, RunStatus::Failed);
         let _ = fs::remove_dir_all(&d);
     }
 
