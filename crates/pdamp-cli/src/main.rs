@@ -579,8 +579,20 @@ pub(crate) fn open_out(
         (false, false) => OutputMode::Fresh,
         (true, false) => {
             let has_checkpoint = checkpoint.is_some_and(|c| out.join(c).is_file());
+            let killed_same = pdamp_io::output_dir::read_manifest(out).is_some_and(|m| {
+                m.status == pdamp_io::output_dir::RunStatus::Running
+                    && same_command(&m.command, &std::env::args().collect::<Vec<_>>())
+            });
             if has_checkpoint {
                 OutputMode::Continue
+            } else if killed_same {
+                // The same command was killed before its first checkpoint: nothing to continue,
+                // its partial outputs are replaced by a new run.
+                eprintln!(
+                    "note: nothing to resume in {} (the run was killed before its first checkpoint): starting it again",
+                    out.display()
+                );
+                OutputMode::Overwrite
             } else {
                 // Refused below if there are results; otherwise nothing was started yet.
                 match OutputDir::open(out, OutputMode::Fresh, outputs, inputs) {
@@ -604,6 +616,27 @@ pub(crate) fn open_out(
         }
     };
     Ok(OutputDir::open(out, mode, outputs, inputs)?)
+}
+
+/// Whether two command lines run the same command on the same input (the subcommand and the
+/// argument after it), whatever their options.
+fn same_command(a: &[String], b: &[String]) -> bool {
+    const COMMANDS: [&str; 8] = [
+        "run",
+        "fields",
+        "settle",
+        "couple",
+        "powder",
+        "structure",
+        "cor",
+        "bench",
+    ];
+    let key = |c: &[String]| {
+        c.iter()
+            .position(|t| COMMANDS.contains(&t.as_str()))
+            .map(|k| (c[k].clone(), c.get(k + 1).cloned()))
+    };
+    key(a).is_some() && key(a) == key(b)
 }
 
 /// The scenario file and the files it reads (meshes, beds): inputs no output may replace.
@@ -664,11 +697,6 @@ fn cmd_run(
         scenario_inputs(std::path::Path::new(scenario), &sc)
     };
     let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
-    if sc.damper.is_some() && options.resume {
-        bail!(
-            "--resume: a damper point (`run` with [damper]) is not checkpointed; rerun it with --overwrite (it takes as long as before)"
-        );
-    }
     let mut dir = open_out(
         out,
         options.resume,
@@ -689,7 +717,16 @@ fn cmd_run(
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
     };
     let json = if sc.damper.is_some() {
-        let s = pdamp_design::report::run_damper_scenario(&sc, &base, out, tick);
+        if options.resume
+            && let Some(text) = pdamp_design::report::finished_damper_summary(&sc, &base, out)
+                .map_err(anyhow::Error::msg)?
+        {
+            dir.set_status(pdamp_io::output_dir::RunStatus::Finished);
+            dir.close()?;
+            println!("{text}");
+            return Ok(());
+        }
+        let s = pdamp_design::report::run_damper_scenario_with(&sc, &base, out, options, tick);
         dir.set_outcome(&s);
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {

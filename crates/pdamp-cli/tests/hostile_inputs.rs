@@ -1223,11 +1223,17 @@ fn corpus() -> Vec<Case> {
         &["checkpoint"],
     ));
     v.push(case(
-        "run: --resume of a damper point",
+        "run: --resume of a damper point with another scenario's checkpoint",
         &["run", "{dir}/s.toml", "--out", "{dir}/out", "--resume"],
-        vec![("s.toml", damper())],
+        vec![
+            ("s.toml", damper()),
+            (
+                "out/checkpoint.bin",
+                "PDAMPCK\u{0}0123456789abcdef0123456789".to_string(),
+            ),
+        ],
         1,
-        &["not checkpointed"],
+        &["checkpoint"],
     ));
     v.push(case(
         "fields: a scenario without [fields]",

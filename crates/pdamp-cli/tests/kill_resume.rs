@@ -239,12 +239,27 @@ fn rerun_over_results_is_refused_and_resume_never_reports_a_truncated_run() {
         !out.join("checkpoint.bin").exists(),
         "the old run's checkpoint must be gone once the new run writes"
     );
+    // Nothing to resume: said, and the run starts again (complete outputs, never the old
+    // summary over a truncated energy.csv).
+    let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("nothing to resume"), "{err}");
+    assert_eq!(std::fs::read(out.join("energy.csv")).unwrap(), energy);
+    // A directory with results of another command and no checkpoint is refused.
+    std::fs::remove_file(out.join("checkpoint.bin")).unwrap();
+    let o = run(&scn, &d.join("elsewhere"), "2", &[]).output().unwrap();
+    assert!(o.status.success());
+    let mut m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    m["command"] = serde_json::json!(["pdamp", "fields", "other.toml"]);
+    std::fs::write(out.join("manifest.json"), m.to_string()).unwrap();
     let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("nothing to resume"), "{err}");
-    // A complete run, interrupted by a checkpoint, whose energy.csv is then cut and refilled
-    // to the same length by hand: --resume refuses it (rows, not only bytes).
+    // --overwrite runs it again; a finished run resumes to its summary; the manifest lists
+    // what the run wrote.
     let st = run(&scn, &out, "2", &["--overwrite"]).status().unwrap();
     assert!(st.success());
     let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
@@ -312,6 +327,111 @@ fn resume_refuses_outputs_that_do_not_match_the_checkpoint() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// A small damper point (20 spheres in a shaken box, 8 cycles at 30 Hz) with velocity fields,
+/// trajectories, VTK frames and two packings.
+const DAMPER_POINT: &str = r#"title = "damper point resume"
+
+[simulation]
+duration_s = 0.0
+time_step_s = 2e-6
+seed = 5
+
+[[materials]]
+name = "steel"
+density_kg_m3 = 7800.0
+youngs_modulus_pa = 2e9
+poisson_ratio = 0.3
+
+[contact]
+normal = { law = "hertz-mindlin", restitution = 0.6 }
+friction = { law = "mindlin", friction_coefficient = 0.3 }
+
+[[bodies]]
+name = "box"
+
+[[bodies.walls]]
+name = "container"
+material = "steel"
+geometry = { type = "box_inside", center_m = [0.0, 0.0, 0.01], half_extents_m = [0.01, 0.01, 0.01] }
+
+[[particles]]
+material = "steel"
+count = 20
+size = { type = "monodisperse", radius_m = 0.001 }
+placement = { method = "random", region = { type = "box", min_m = [-0.009, -0.009, 0.001], max_m = [0.009, 0.009, 0.019] } }
+
+[settle]
+max_duration_s = 0.01
+
+[damper]
+container_body = "box"
+container_mass_kg = 0.05
+direction = [1.0, 0.0, 0.0]
+frequency_hz = 30.0
+amplitude_m = 0.002
+cycles = 8
+transient_cycles = 2
+packings = 2
+motion_output = { phases_per_cycle = 4, field_cells = 6, trajectory_particles = [0, 7], vtk_frames_per_cycle = 4 }
+"#;
+
+/// Issue 31 item 6: a damper point (`run` with [damper]) checkpoints and resumes like a plain
+/// run: SIGKILL at random moments after a checkpoint, then SIGINT, then --resume, ends with
+/// outputs identical to an uninterrupted run.
+#[test]
+fn damper_point_killed_and_resumed_gives_identical_outputs() {
+    let d = scratch("damper");
+    let scn = d.join("damper.toml");
+    std::fs::write(&scn, DAMPER_POINT).unwrap();
+    let reference = d.join("reference");
+    let t0 = Instant::now();
+    let o = run(&scn, &reference, "2", &[]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let full = t0.elapsed();
+    let out = d.join("interrupted");
+    let ckpt = out.join("checkpoint.bin");
+    let mut state = 0x9e37_79b9_7f4a_7c15 ^ u64::from(std::process::id());
+    let mut kills = 0;
+    let mut resume = false;
+    for _ in 0..6 {
+        let extra: &[&str] = if resume {
+            &["--resume", "--checkpoint-interval-s", "0.05"]
+        } else {
+            &["--checkpoint-interval-s", "0.05"]
+        };
+        let mut child = run(&scn, &out, "2", extra).spawn().unwrap();
+        let before = checkpoint_stamp(&ckpt);
+        let wait = full.mul_f64(0.1 + 0.3 * next(&mut state));
+        if !kill_after_checkpoint(&mut child, &ckpt, before, wait, false) {
+            break;
+        }
+        kills += 1;
+        resume = true;
+    }
+    let o = run(&scn, &out, "2", &["--resume"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        kills >= 1,
+        "the point was never interrupted (it ran in {full:?})"
+    );
+    let files = outputs(&reference);
+    let names: Vec<&str> = files.iter().map(|f| f.0.as_str()).collect();
+    for f in [
+        "summary.json",
+        "velocity_fields.csv",
+        "trajectories.csv",
+        "particles.pvd",
+    ] {
+        assert!(names.contains(&f), "{f} missing in {names:?}");
+    }
+    let got: Vec<String> = outputs(&out).into_iter().map(|f| f.0).collect();
+    assert_eq!(got, names, "files after {kills} kills");
+    for ((n, x), (_, y)) in files.iter().zip(&outputs(&out)) {
+        assert!(x == y, "{n} differs after {kills} kills");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Two runs into one directory at once: the second is refused while the first holds it (it
 /// used to end with both exiting 0 and a mixed energy.csv); the first ends normally.
 #[test]
@@ -321,7 +441,10 @@ fn a_second_run_into_a_busy_directory_is_refused() {
     let text = std::fs::read_to_string(&scn).unwrap();
     std::fs::write(&scn, text.replace("duration_s = 0.03", "duration_s = 0.5")).unwrap();
     let out = d.join("out");
-    let mut first = run(&scn, &out, "1", &[]).stderr(Stdio::null()).spawn().unwrap();
+    let mut first = run(&scn, &out, "1", &[])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
     let t0 = Instant::now();
     while !out.join("manifest.json").exists() && t0.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(5));

@@ -20,7 +20,7 @@
 pub use pdamp_io::scenario::ConvergenceSpec;
 
 /// Running estimate after a number of evaluated cycles.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RunningEstimate {
     /// Effective loss factor η̄ [D Eq. 3.15] (Ẽ per cycle / (π m_bed V²)).
     pub effective_loss_factor: f64,

@@ -107,6 +107,64 @@ pub trait PointObserver {
     fn reads_particles(&self) -> bool {
         true
     }
+
+    /// What the observer has gathered, for a checkpoint of the point (nothing by default).
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        Ok(Vec::new())
+    }
+
+    /// Continues from what [`Self::save_state`] wrote.
+    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// Checkpointing of one point inside its run (`pdamp run` of a damper scenario): the state
+/// is written to `path` every `interval_s` of wall-clock time and on a stop request
+/// (Ctrl-C/SIGTERM); with `resume` the point continues from it and ends with the result of an
+/// uninterrupted run.
+pub struct PointCheckpointing {
+    /// The checkpoint file.
+    pub path: std::path::PathBuf,
+    /// Digest of the scenario (and the files it reads) the point belongs to.
+    pub scenario_digest: String,
+    /// Wall-clock seconds between checkpoints (≤ 0: only on a stop request).
+    pub interval_s: f64,
+    /// Continue from `path` if it holds a point in progress.
+    pub resume: bool,
+}
+
+/// Kind tag of damper-point checkpoints.
+pub const POINT_KIND: &str = "damper-point";
+
+/// A damper point in progress (see [`PointCheckpointing`]).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct PointProgress {
+    frequency_hz: f64,
+    amplitude_m: f64,
+    /// Cycle in progress (from 0).
+    cycle: u32,
+    world: pdamp_dem::state::WorldState,
+    times: Vec<f64>,
+    force: Vec<f64>,
+    velocity: Vec<f64>,
+    ledger0: Option<pdamp_dem::EnergyLedger>,
+    cycle_start_sample: usize,
+    f_sum: (f64, f64),
+    v_sum: (f64, f64),
+    history: Vec<RunningEstimate>,
+    per_cycle: Vec<RunningEstimate>,
+    observer: Vec<u8>,
+    wall_time_s: f64,
+}
+
+/// A damper point's checkpoint: in progress, or finished (outputs written).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum PointCheckpoint {
+    /// The point is running.
+    Running(Box<PointProgress>),
+    /// The point and its outputs are complete.
+    Finished,
 }
 
 impl PointObserver for () {
@@ -243,6 +301,19 @@ impl Damper {
         amplitude_m: f64,
         observer: &mut dyn PointObserver,
     ) -> Result<PointResult, String> {
+        self.run_point_checkpointed(frequency_hz, amplitude_m, observer, None)
+    }
+
+    /// [`Self::run_point`] with checkpoints inside the point (see [`PointCheckpointing`]); a
+    /// resumed point gives the result of an uninterrupted one (its wall time aside).
+    pub fn run_point_checkpointed(
+        &self,
+        frequency_hz: f64,
+        amplitude_m: f64,
+        observer: &mut dyn PointObserver,
+        checkpointing: Option<&PointCheckpointing>,
+    ) -> Result<PointResult, String> {
+        use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
         let start = std::time::Instant::now();
         let omega = 2.0 * PI * frequency_hz;
         let period = 1.0 / frequency_hz;
@@ -273,6 +344,49 @@ impl Damper {
         let mut n_eval = n_eval;
         let m_con = self.container_mass_kg;
         let container = self.container;
+        // A point in progress to continue.
+        let mut first_cycle = 0;
+        let mut wall_before = 0.0;
+        let resumed = match checkpointing {
+            Some(c) if c.resume => {
+                match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)? {
+                    Some(PointCheckpoint::Running(p)) => Some(p),
+                    Some(PointCheckpoint::Finished) => {
+                        return Err(format!(
+                            "checkpoint {}: the point is finished already",
+                            c.path.display()
+                        ));
+                    }
+                    None => None,
+                }
+            }
+            _ => None,
+        };
+        if let Some(p) = resumed {
+            if p.frequency_hz != frequency_hz || p.amplitude_m != amplitude_m {
+                return Err(format!(
+                    "checkpoint: written for f = {} Hz, X = {} m, not this point",
+                    p.frequency_hz, p.amplitude_m
+                ));
+            }
+            let p = *p;
+            w.restore_state(p.world)?;
+            times = p.times;
+            force = p.force;
+            velocity = p.velocity;
+            ledger0 = p.ledger0;
+            cycle_start_sample = p.cycle_start_sample;
+            f_sum = p.f_sum;
+            v_sum = p.v_sum;
+            history = p.history;
+            per_cycle = p.per_cycle;
+            observer.restore_state(&p.observer)?;
+            first_cycle = p.cycle;
+            wall_before = p.wall_time_s;
+        }
+        let resumed_in = (first_cycle > 0 || w.time_s > 0.0).then_some(first_cycle);
+        let header = checkpointing.map(|c| CheckpointHeader::new(POINT_KIND, &c.scenario_digest));
+        let mut timer = CheckpointTimer::new(checkpointing.map_or(0.0, |c| c.interval_s));
         let sample = |w: &World, times: &mut Vec<f64>, force: &mut Vec<f64>, vel: &mut Vec<f64>| {
             let t = w.time_s;
             let (s, c) = (omega * t).sin_cos();
@@ -283,9 +397,11 @@ impl Damper {
             force.push(m_con * a_c - f_p);
             vel.push(amplitude_m * omega * c);
         };
-        for cycle in 0..self.cycles {
+        let mut save_error = None;
+        for cycle in first_cycle..self.cycles {
             let t_end = (cycle + 1) as f64 * period;
-            if cycle == self.transient_cycles {
+            // (A point resumed inside this cycle has done its start already.)
+            if cycle == self.transient_cycles && resumed_in != Some(cycle) {
                 ledger0 = Some(w.ledger);
                 cycle_start_sample = times.len();
                 sample(&w, &mut times, &mut force, &mut velocity);
@@ -314,11 +430,44 @@ impl Damper {
                         return std::ops::ControlFlow::Break(());
                     }
                 }
-                if pdamp_io::checkpoint::stop_requested() {
+                let stop = pdamp_io::checkpoint::stop_requested();
+                if let (Some(c), Some(h)) = (checkpointing, &header)
+                    && (stop || timer.due())
+                {
+                    w.complete_step();
+                    let r = observer.save_state().and_then(|obs| {
+                        let p = PointProgress {
+                            frequency_hz,
+                            amplitude_m,
+                            cycle,
+                            world: w.save_state(),
+                            times: times.clone(),
+                            force: force.clone(),
+                            velocity: velocity.clone(),
+                            ledger0,
+                            cycle_start_sample,
+                            f_sum,
+                            v_sum,
+                            history: history.clone(),
+                            per_cycle: per_cycle.clone(),
+                            observer: obs,
+                            wall_time_s: wall_before + start.elapsed().as_secs_f64(),
+                        };
+                        ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
+                    });
+                    if let Err(e) = r {
+                        save_error = Some(e);
+                        return std::ops::ControlFlow::Break(());
+                    }
+                }
+                if stop {
                     return std::ops::ControlFlow::Break(());
                 }
                 std::ops::ControlFlow::Continue(())
             });
+            if let Some(e) = save_error.take() {
+                return Err(e);
+            }
             if let Some(h) = health {
                 return Err(format!(
                     "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m, cycle {}: {h}",
@@ -399,7 +548,7 @@ impl Damper {
             n_eval,
             converged,
             (w.dt_s, w.counters.steps),
-            start.elapsed().as_secs_f64(),
+            wall_before + start.elapsed().as_secs_f64(),
         ))
     }
 }

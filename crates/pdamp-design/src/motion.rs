@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 /// One phase-averaged velocity field on a grid in the plane (excitation direction, up).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct PhaseField {
     /// Phase Ωt of the field, rad.
     pub phase_rad: f64,
@@ -185,7 +185,51 @@ impl MotionRecorder {
     }
 }
 
+/// What a [`MotionRecorder`] has gathered so far (kept in a damper point's checkpoint).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct RecorderState {
+    fields: Vec<PhaseField>,
+    trajectories: Vec<[f64; 5]>,
+    vtk_frames: Vec<(f64, String)>,
+    error: Option<String>,
+    prev_phase: f64,
+    prev_theta: f64,
+    vtk_cycle: u32,
+}
+
 impl PointObserver for MotionRecorder {
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        pdamp_io::checkpoint::encode_part(&RecorderState {
+            fields: self.fields.clone(),
+            trajectories: self.trajectories.clone(),
+            vtk_frames: self.vtk_frames.clone(),
+            error: self.error.clone(),
+            prev_phase: self.prev_phase,
+            prev_theta: self.prev_theta,
+            vtk_cycle: self.vtk_cycle,
+        })
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let s: RecorderState = pdamp_io::checkpoint::decode_part(bytes)?;
+        if s.fields.len() != self.fields.len()
+            || s.fields
+                .iter()
+                .zip(&self.fields)
+                .any(|(a, b)| a.count.len() != b.count.len())
+        {
+            return Err("checkpoint: the velocity-field grid differs from the scenario's".into());
+        }
+        self.fields = s.fields;
+        self.trajectories = s.trajectories;
+        self.vtk_frames = s.vtk_frames;
+        self.error = s.error;
+        self.prev_phase = s.prev_phase;
+        self.prev_theta = s.prev_theta;
+        self.vtk_cycle = s.vtk_cycle;
+        Ok(())
+    }
+
     fn on_step(&mut self, w: &World, cycle: u32, phase: f64, damper: &Damper) {
         let prev = self.prev_phase;
         self.prev_phase = phase;

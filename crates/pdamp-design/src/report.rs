@@ -70,7 +70,7 @@ pub struct DamperRunSummary {
 }
 
 /// One member of an ensemble.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct PackingResult {
     /// Packing index k.
     pub packing: usize,
@@ -174,6 +174,7 @@ pub fn run_other_packings(
     frequency_hz: f64,
     amplitude_m: f64,
     packings: usize,
+    reuse: bool,
     on_done: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<PackingResult>, String> {
     use rayon::prelude::*;
@@ -187,6 +188,17 @@ pub fn run_other_packings(
         .into_par_iter()
         .map(|k| {
             let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
+            // A resumed run reuses the packings finished before (same scenario: the
+            // checkpoint's digest was checked; same seed).
+            if reuse
+                && let Ok(text) = std::fs::read_to_string(dir.join(format!("packing_{k:03}.json")))
+                && let Ok(m) = serde_json::from_str::<PackingResult>(&text)
+                && m.seed == sk.simulation.seed
+                && m.error.is_none()
+            {
+                on_done(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+                return Ok(m);
+            }
             let r = Damper::from_scenario(&sk, base_dir, |_| {}).and_then(|d| {
                 let p = d.run_point(frequency_hz, amplitude_m, &mut ())?;
                 Ok((p, d.bed_statistics(), d.clearance_m()))
@@ -216,8 +228,58 @@ pub fn run_damper_scenario(
     sc: &Scenario,
     base_dir: &Path,
     out: &Path,
+    progress: impl FnMut(&str, f64),
+) -> Result<DamperRunSummary, String> {
+    let options = pdamp_io::run::RunOptions {
+        checkpoint_interval_s: 0.0,
+        resume: false,
+    };
+    run_damper_scenario_with(sc, base_dir, out, options, progress)
+}
+
+/// The `summary.json` text of a damper run in `out` whose checkpoint says it finished (for the
+/// same scenario and files), `None` when there is no such checkpoint: a resumed finished run
+/// only reprints its summary.
+pub fn finished_damper_summary(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+) -> Result<Option<String>, String> {
+    use crate::damper::{POINT_KIND, PointCheckpoint};
+    use pdamp_io::checkpoint as ck;
+    let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
+    match ck::load::<PointCheckpoint>(&out.join(ck::CHECKPOINT_FILE), POINT_KIND, &digest)? {
+        Some(PointCheckpoint::Finished) => std::fs::read_to_string(out.join("summary.json"))
+            .map(Some)
+            .map_err(|e| format!("output: {}: {e}", out.join("summary.json").display())),
+        _ => Ok(None),
+    }
+}
+
+/// [`run_damper_scenario`] with checkpoints (`DIR/checkpoint.bin` every
+/// `options.checkpoint_interval_s` of wall-clock time and on Ctrl-C/SIGTERM, see
+/// [`crate::damper::PointCheckpointing`]) and `options.resume`: the point continues where it
+/// stopped (the bed is prepared again, deterministically), finished packings of an ensemble
+/// are reused, and the outputs equal those of an uninterrupted run (timing fields aside); see
+/// [`finished_damper_summary`] for a finished run.
+pub fn run_damper_scenario_with(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    options: pdamp_io::run::RunOptions,
     mut progress: impl FnMut(&str, f64),
 ) -> Result<DamperRunSummary, String> {
+    use crate::damper::{POINT_KIND, PointCheckpoint, PointCheckpointing};
+    use pdamp_io::checkpoint as ck;
+    let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
+    let ck_path = out.join(ck::CHECKPOINT_FILE);
+    let checkpointing = PointCheckpointing {
+        path: ck_path.clone(),
+        scenario_digest: digest.clone(),
+        interval_s: options.checkpoint_interval_s,
+        resume: options.resume,
+    };
+    let _stoppable = ck::StoppableSection::enter();
     let spec = sc
         .damper
         .as_ref()
@@ -257,7 +319,7 @@ pub fn run_damper_scenario(
         cycles,
         last: u32::MAX,
     };
-    let p = damper.run_point(f, x, &mut wrapped)?;
+    let p = damper.run_point_checkpointed(f, x, &mut wrapped, Some(&checkpointing))?;
     if let Some(e) = &rec.error {
         return Err(format!("output: {e}"));
     }
@@ -294,6 +356,7 @@ pub fn run_damper_scenario(
             f,
             x,
             packings,
+            options.resume,
             &|_| {},
         )?);
         Some(EnsembleSummary::of(members))
@@ -336,6 +399,11 @@ pub fn run_damper_scenario(
     };
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     pdamp_io::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
+    ck::save(
+        &ck_path,
+        &ck::CheckpointHeader::new(POINT_KIND, &digest),
+        &PointCheckpoint::Finished,
+    )?;
     Ok(summary)
 }
 
@@ -359,6 +427,14 @@ impl<P: FnMut(&str, f64)> crate::damper::PointObserver for ProgressObserver<'_, 
 
     fn reads_particles(&self) -> bool {
         self.inner.reads_particles()
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        self.inner.save_state()
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        self.inner.restore_state(bytes)
     }
 }
 

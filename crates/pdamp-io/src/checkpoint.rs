@@ -212,6 +212,26 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
     Ok(f.body)
 }
 
+/// Encodes a value exactly (bincode, fixed-width integers) for embedding in a checkpoint body,
+/// e.g. the state of an observer behind a trait object.
+pub fn encode_part<T: Serialize>(value: &T) -> Result<Vec<u8>, String> {
+    use bincode::Options;
+    bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .serialize(value)
+        .map_err(|e| format!("checkpoint: {e}"))
+}
+
+/// Decodes what [`encode_part`] wrote (never allocates more than the input suggests).
+pub fn decode_part<T: for<'de> Deserialize<'de>>(bytes: &[u8]) -> Result<T, String> {
+    use bincode::Options;
+    bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .with_limit(bytes.len() as u64)
+        .deserialize(bytes)
+        .map_err(|e| format!("checkpoint: unreadable part ({e})"))
+}
+
 /// Decides when to write the next checkpoint: every `interval` of wall-clock time (checked
 /// every 64 calls, so the clock is not read every step).
 #[derive(Debug)]

@@ -500,8 +500,19 @@ fn remove_temporaries(dir: &Path) -> Result<(), OutputDirError> {
     Ok(())
 }
 
-/// Whether `name` is a temporary file of the atomic writer: `<name>.tmp-<digits>-<digits>`.
+/// Whether `name` is a temporary file of an atomic writer: `<name>.tmp-<pid>-<n>`
+/// ([`crate::atomic`]) or `.<name>.<pid>-<n>.tmp.<ext>` (the plots of `pdamp-plot`).
 fn is_temporary(name: &str) -> bool {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|c| c.is_ascii_digit());
+    if let Some(rest) = name.strip_prefix('.')
+        && let Some(i) = rest.rfind(".tmp.")
+        && let Some(j) = rest[..i].rfind('.')
+        && let Some((pid, n)) = rest[j + 1..i].split_once('-')
+        && digits(pid)
+        && digits(n)
+    {
+        return true;
+    }
     let Some(i) = name.rfind(".tmp-") else {
         return false;
     };
@@ -555,6 +566,7 @@ mod tests {
     #[test]
     fn a_second_holder_is_refused_and_links_and_inputs_are_protected() {
         let d = tmp("lock");
+        fs::create_dir_all(&d).unwrap();
         let o = OutputDir::open(&d, OutputMode::Fresh, &["energy.csv"], &[]).unwrap();
         let e = OutputDir::open(&d, OutputMode::Continue, &["energy.csv"], &[]).unwrap_err();
         assert!(matches!(e, OutputDirError::Locked { .. }), "{e}");
@@ -605,5 +617,7 @@ mod tests {
         assert!(!is_temporary("energy.csv"));
         assert!(!is_temporary("a.tmp-12"));
         assert!(!is_temporary("a.tmp-x-1"));
+        assert!(is_temporary(".velocity_field_phase2.png.14789-5.tmp.png"));
+        assert!(!is_temporary(".hidden.png"));
     }
 }
