@@ -166,13 +166,13 @@ fn packing_result(
 }
 
 /// Runs the point (f, X) of `sc` on packings `1..packings` (packing 0 is the caller's), in
-/// parallel, each on its own freshly prepared bed; writes `out/packings/packing_KKK.json`.
+/// parallel, each on its own freshly prepared bed; writes `out/packings/packing_KKK.json`
+/// (with `reuse`, those already there for the same seed are taken instead of run again).
 pub fn run_other_packings(
     sc: &Scenario,
     base_dir: &Path,
     out: &Path,
-    frequency_hz: f64,
-    amplitude_m: f64,
+    (frequency_hz, amplitude_m): (f64, f64),
     packings: usize,
     reuse: bool,
     on_done: &(dyn Fn(usize) + Sync),
@@ -353,8 +353,7 @@ pub fn run_damper_scenario_with(
             sc,
             base_dir,
             out,
-            f,
-            x,
+            (f, x),
             packings,
             options.resume,
             &|_| {},
