@@ -157,6 +157,17 @@ pub fn run(a: CorArgs) -> Result<()> {
     )?;
     let start = std::time::Instant::now();
     let pts = cor_curve(&sphere, &partner, a.sphere_radius_m, &vs, model, a.repeat);
+    if let Some((p, why)) = pts.iter().find_map(|p| {
+        p.fe.as_ref()
+            .and_then(|r| r.failure.as_ref())
+            .map(|w| (p, w))
+    }) {
+        bail!(
+            "FE impact at v = {} m/s (impact {}) failed: {why}",
+            p.velocity_m_s,
+            p.impact
+        );
+    }
     // A model outside its range gives ε outside [0, 1] or no number: said, not written.
     if let Some(p) = pts.iter().find(|p| {
         !(p.restitution.is_finite()

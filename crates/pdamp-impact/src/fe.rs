@@ -133,7 +133,14 @@ pub struct ImpactResult {
     pub steps: usize,
     /// Wall-clock time of the run, s.
     pub wall_time_s: f64,
+    /// Numerical failure found by the health check (non-finite state, energy created), with
+    /// the time, the node and the likely cause; `None` for a healthy run.
+    pub failure: Option<String>,
 }
+
+/// Relative energy-balance error of an FE impact beyond which the run is reported as failed
+/// (healthy runs close to below 1 %).
+pub const MAX_BALANCE_ERROR: f64 = 0.05;
 
 /// Geometry of one Gauss point: dN/dr, dN/dz, N/r (4 each) and weight 2πr·detJ.
 #[derive(Debug, Clone, Copy)]
@@ -673,6 +680,7 @@ impl FeImpact {
         let mut dmax = 0.0f64;
         let mut completed = false;
         let dt = self.dt;
+        let mut failure = None;
         while t < t_max {
             // central differences: v^{n+1/2} = v^{n-1/2} + dt a^n; u^{n+1} = u^n + dt v^{n+1/2}
             for i in 0..n {
@@ -697,6 +705,19 @@ impl FeImpact {
             }
             t += dt;
             step += 1;
+            // Health: every node's displacement finite (every 64 steps).
+            if step % 64 == 0
+                && let Some(i) =
+                    (0..n).find(|&i| !(self.ur[i].is_finite() && self.uz[i].is_finite()))
+            {
+                failure = Some(format!(
+                    "non-finite displacement at t = {t:.6e} s, node {i} at (r, z) = ({:.4e}, {:.4e}) m; \
+                     likely cause: the explicit step {dt:.3e} s above the critical step of the mesh \
+                     (contact element size {:.3e} m), or material data out of range",
+                    self.mesh.r[i], self.mesh.z[i], self.mesh.h_contact
+                ));
+                break;
+            }
             if fc > 0.0 {
                 if t_first.is_nan() {
                     t_first = t;
@@ -775,7 +796,23 @@ impl FeImpact {
                 + en.plastic_wall_j
                 + en.viscous_sphere_j
                 + en.viscous_wall_j);
+        if failure.is_none() && en.balance_error_j.abs() > MAX_BALANCE_ERROR * e0.abs() {
+            failure = Some(format!(
+                "energy balance broken: {:.3e} J of {:.3e} J ({:.1} %){}; likely cause: the \
+                 explicit step {dt:.3e} s too close to the critical step, or a penalty stiffness \
+                 out of range",
+                en.balance_error_j,
+                e0,
+                100.0 * en.balance_error_j / e0,
+                if en.balance_error_j < 0.0 {
+                    ", energy created"
+                } else {
+                    ""
+                }
+            ));
+        }
         ImpactResult {
+            failure,
             velocity_m_s: v,
             restitution: v_cm / v_s,
             contact_time_s: if t_first.is_nan() {

@@ -39,6 +39,7 @@ fn elastic_impact_matches_hertz() {
     let r = simulate_impact(&steel, &partner, R, v, &test_options());
     let h: HertzPair = hertz_pair(&steel, &partner, R);
     assert!(r.completed);
+    assert_eq!(r.failure, None, "a healthy run passes the health check");
     let (et, ef, ed) = (
         rel(r.contact_time_s, h.contact_time(v)),
         rel(r.max_force_n, h.max_force(v)),
@@ -160,4 +161,21 @@ fn saa_impact_energy_balance() {
     );
     assert!(e.balance_error_j.abs() < 1e-2 * e.initial_j);
     assert!(e.viscous_wall_j / (e.viscous_wall_j + e.plastic_sphere_j) > 0.99);
+}
+
+/// Issue 31: the FE impact has a health check. An explicit step 4 × the critical one blows up;
+/// the run stops with a diagnosis (node, time, likely cause) instead of returning numbers.
+#[test]
+fn unstable_time_step_is_diagnosed() {
+    let steel = Material::s235().as_elastic();
+    let mut o = test_options();
+    o.dt_safety = 4.0;
+    o.max_time_over_contact_time = 1.5;
+    let r = simulate_impact(&steel, &Partner::Wall(steel.clone()), R, 0.5, &o);
+    let why = r.failure.expect("the blow-up is found");
+    assert!(
+        why.contains("non-finite displacement") || why.contains("energy balance broken"),
+        "{why}"
+    );
+    assert!(why.contains("critical step"), "{why}");
 }
