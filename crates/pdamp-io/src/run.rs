@@ -761,3 +761,32 @@ pub fn run_scenario(
     ck::save(&ck_path, &header, &done)?;
     Ok(summary)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 31: the digest of a scenario covers the content of the files it reads, so a
+    /// checkpoint is not continued with another mesh behind the same path.
+    #[test]
+    fn content_digest_follows_the_mesh_bytes() {
+        let dir = std::env::temp_dir().join(format!("pdamp-digest-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut sc = crate::examples::shaken_box(10, 0.01);
+        sc.bodies[0].walls[0].geometry =
+            crate::scenario::GeometrySpec::Stl(crate::scenario::StlSpec {
+                path: "box.stl".into(),
+                scale: 1.0,
+                translation_m: [0.0; 3],
+                flip_normals: false,
+            });
+        std::fs::write(dir.join("box.stl"), "solid a\nendsolid a\n").unwrap();
+        let a = scenario_content_digest(&sc, &dir);
+        assert_eq!(a, scenario_content_digest(&sc, &dir));
+        std::fs::write(dir.join("box.stl"), "solid b\nendsolid b\n").unwrap();
+        let b = scenario_content_digest(&sc, &dir);
+        assert_ne!(a, b, "same path, other bytes: another digest");
+        assert_eq!(scenario_digest(&sc), scenario_digest(&sc));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
