@@ -1177,6 +1177,21 @@ fn corpus() -> Vec<Case> {
         c.no_out = true;
         v.push(c);
     }
+    v.push(case(
+        "bench --settled over a file of the user",
+        &[
+            "bench",
+            "--particles",
+            "100",
+            "--steps",
+            "1",
+            "--settled",
+            "{dir}/notes.txt",
+        ],
+        vec![("notes.txt", "my notes".to_string())],
+        1,
+        &["not a settled bed"],
+    ));
     // Output directories that are files, hold links or are the input's folder.
     v.push(case(
         "run: --out is a file",

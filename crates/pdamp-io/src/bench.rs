@@ -61,6 +61,21 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Strin
     let digest = crate::checkpoint::digest(format!("{sc:?}").as_bytes());
     // The settled bed is a cache: one written for another scenario or by another version of
     // the bench (e.g. another particle numbering) is settled again and overwritten.
+    // A file that is not a settled bed of the bench is the user's: never overwritten.
+    if let Some(path) = cache
+        && let Ok(bytes) = std::fs::read(path)
+    {
+        let head = &bytes[..bytes.len().min(256)];
+        let ours =
+            head.starts_with(b"PDAMPCK\0") && head.windows(14).any(|w| w == b"bench-settled-");
+        if !ours {
+            return Err(format!(
+                "--settled {}: the file exists and is not a settled bed of `pdamp bench`; it is \
+                 left as it is: choose another path",
+                path.display()
+            ));
+        }
+    }
     let cached = match cache.map(|path| crate::checkpoint::load::<WorldState>(path, &kind, &digest))
     {
         Some(Ok(state)) => state,
