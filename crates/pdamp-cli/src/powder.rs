@@ -81,8 +81,11 @@ struct CheckpointArgs {
 
 impl CheckpointArgs {
     fn options(self) -> Result<cantilever::RunOptions> {
-        if self.checkpoint_interval_s.is_nan() || self.checkpoint_interval_s < 0.0 {
-            return Err(anyhow!("--checkpoint-interval-s must be ≥ 0"));
+        if !(self.checkpoint_interval_s >= 0.0 && self.checkpoint_interval_s.is_finite()) {
+            return Err(anyhow!(
+                "--checkpoint-interval-s must be finite and ≥ 0 (0 = only on Ctrl-C/SIGTERM), got {}",
+                self.checkpoint_interval_s
+            ));
         }
         Ok(cantilever::RunOptions {
             checkpoint_interval_s: self.checkpoint_interval_s,

@@ -117,27 +117,40 @@ impl BeamSpec {
         )
     }
     fn validate(&self) -> Result<(), String> {
-        let pos = |v: f64, k: &str| {
-            if v > 0.0 && v.is_finite() {
+        let len = |v: f64, k: &str| {
+            if v > 0.0 && v <= MAX_LENGTH_M {
                 Ok(())
             } else {
-                Err(format!("beam.{k}: must be positive"))
+                Err(format!(
+                    "beam.{k}: must be a finite length in (0, {MAX_LENGTH_M}] m, got {v}"
+                ))
             }
         };
-        pos(self.length_m, "length_m")?;
-        pos(self.width_m, "width_m")?;
-        pos(self.wall_thickness_m, "wall_thickness_m")?;
-        pos(self.cavity_length_m, "cavity_length_m")?;
-        pos(self.wall_element_m, "wall_element_m")?;
-        pos(self.core_element_m, "core_element_m")?;
-        pos(self.length_element_m, "length_element_m")?;
-        pos(
-            self.material.youngs_modulus_pa,
-            "material.youngs_modulus_pa",
-        )?;
-        pos(self.material.density_kg_m3, "material.density_kg_m3")?;
-        if !(-1.0..0.5).contains(&self.material.poisson_ratio) {
-            return Err("beam.material.poisson_ratio: must be in [-1, 0.5)".into());
+        len(self.length_m, "length_m")?;
+        len(self.width_m, "width_m")?;
+        len(self.wall_thickness_m, "wall_thickness_m")?;
+        len(self.cavity_length_m, "cavity_length_m")?;
+        len(self.wall_element_m, "wall_element_m")?;
+        len(self.core_element_m, "core_element_m")?;
+        len(self.length_element_m, "length_element_m")?;
+        let m = &self.material;
+        if !(m.youngs_modulus_pa > 0.0 && m.youngs_modulus_pa <= 1e13) {
+            return Err(format!(
+                "beam.material.youngs_modulus_pa: must be a finite modulus in (0, 1e13] Pa (Table A.3: 175e9), got {}",
+                m.youngs_modulus_pa
+            ));
+        }
+        if !(m.density_kg_m3 > 0.0 && m.density_kg_m3 <= 1e5) {
+            return Err(format!(
+                "beam.material.density_kg_m3: must be in (0, 1e5] kg/m³ (Table A.3: 8000), got {}",
+                m.density_kg_m3
+            ));
+        }
+        if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+            return Err(format!(
+                "beam.material.poisson_ratio: must be in (-1, 0.5), got {}",
+                m.poisson_ratio
+            ));
         }
         if 2.0 * self.wall_thickness_m >= self.width_m {
             return Err("beam.wall_thickness_m: must be less than half of width_m".into());
@@ -145,12 +158,107 @@ impl BeamSpec {
         if !(self.cavity_offset_m > 0.0
             && self.cavity_offset_m + self.cavity_length_m < self.length_m)
         {
-            return Err("beam.cavity_offset_m: cavity must lie strictly inside the beam (0 < offset, offset + cavity_length_m < length_m)".into());
+            return Err(format!(
+                "beam.cavity_offset_m: cavity must lie strictly inside the beam (0 < offset, offset + cavity_length_m < length_m), got {}",
+                self.cavity_offset_m
+            ));
         }
         if !(0.0..=1.0).contains(&self.rho_inf) {
-            return Err("beam.rho_inf: must be in [0, 1]".into());
+            return Err(format!(
+                "beam.rho_inf: must be in [0, 1], got {}",
+                self.rho_inf
+            ));
+        }
+        for (k, v) in [
+            ("mass_coeff_per_s", self.rayleigh.mass_coeff_per_s),
+            ("stiffness_coeff_s", self.rayleigh.stiffness_coeff_s),
+        ] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(format!(
+                    "beam.rayleigh.{k}: must be finite and ≥ 0, got {v}"
+                ));
+            }
+        }
+        let (elements, nodes) = self.mesh_size();
+        if elements > MAX_ELEMENTS as f64 {
+            return Err(format!(
+                "beam.wall_element_m / core_element_m / length_element_m: the mesh would have ≈ {elements:.3e} elements and {nodes:.3e} nodes (≈ {:.1} GB for the element data and matrices, before the factorization's fill-in), more than {MAX_ELEMENTS}; use larger element sizes",
+                elements * BYTES_PER_ELEMENT / 1e9
+            ));
         }
         Ok(())
+    }
+
+    /// Element and node counts of [`BeamSpec::mesh`] (upper bounds, as f64 so that absurd
+    /// sizes do not overflow), computed without building the mesh.
+    pub fn mesh_size(&self) -> (f64, f64) {
+        let div = |len: f64, h: f64| (len / h).round().max(1.0);
+        let t = self.wall_thickness_m;
+        let across =
+            div(t, self.wall_element_m) * 2.0 + div(self.width_m - 2.0 * t, self.core_element_m);
+        let top = self.length_m - self.cavity_offset_m - self.cavity_length_m;
+        let along = div(self.cavity_offset_m, self.wall_element_m)
+            + div(self.cavity_length_m, self.length_element_m)
+            + div(top, self.length_element_m.min(self.core_element_m));
+        (
+            across * across * along,
+            (across + 1.0) * (across + 1.0) * (along + 1.0),
+        )
+    }
+}
+
+/// Longest accepted beam dimension [m].
+pub const MAX_LENGTH_M: f64 = 100.0;
+/// Most structural elements a scenario may ask for.
+pub const MAX_ELEMENTS: usize = 1_000_000;
+/// Most particles a scenario may ask for.
+pub const MAX_PARTICLES: usize = 10_000_000;
+/// Most time steps (preparation or coupled run).
+pub const MAX_STEPS: f64 = 1e8;
+/// Most samples of tip.csv.
+pub const MAX_SAMPLES: f64 = 1e7;
+/// Memory per structural element, estimated (Gauss data, mass and stiffness matrices) [B].
+const BYTES_PER_ELEMENT: f64 = 10e3;
+/// Memory per particle, estimated (state, pair list, wall contacts, checkpoint copy) [B].
+const BYTES_PER_PARTICLE: f64 = 2e3;
+/// CPU time per particle and step, measured on the paper runs (≈ 1/3 of 56–140 ms per step
+/// for 32 000 particles) [s].
+const CPU_S_PER_PARTICLE_STEP: f64 = 1e-6;
+/// CPU time per structural dof and coupled step (≈ 2/3 of a step for 19 008 dofs) [s].
+const CPU_S_PER_DOF_STEP: f64 = 3e-6;
+
+/// What a scenario will cost, estimated before anything is allocated
+/// ([`CantileverScenario::estimate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CostEstimate {
+    /// Particles (mean particle volume of the truncated distribution).
+    pub particles: f64,
+    /// Structural elements (upper bound).
+    pub elements: f64,
+    /// Structural dofs (upper bound).
+    pub dofs: f64,
+    /// Coupled steps.
+    pub steps: f64,
+    /// Preparation steps (upper bound: settling and relaxation limits).
+    pub prep_steps: f64,
+    /// Memory [B].
+    pub memory_bytes: f64,
+    /// CPU time [s] (one core).
+    pub cpu_s: f64,
+}
+
+impl std::fmt::Display for CostEstimate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "≈ {:.3e} particles, {:.3e} elements, {:.3e} coupled steps and ≤ {:.3e} preparation steps: ≈ {:.2} GB of memory and ≈ {:.1} h of one core",
+            self.particles,
+            self.elements,
+            self.steps,
+            self.prep_steps,
+            self.memory_bytes / 1e9,
+            self.cpu_s / 3600.0
+        )
     }
 }
 
@@ -259,59 +367,206 @@ impl CantileverScenario {
         Ok(s)
     }
 
-    /// Checks value ranges; the error names the key.
+    /// Checks that every number is finite and in its physical range, and that the run fits
+    /// the size limits ([`MAX_PARTICLES`], [`MAX_ELEMENTS`], [`MAX_STEPS`], [`MAX_SAMPLES`];
+    /// the message carries the [`CostEstimate`]); nothing is allocated before. The error
+    /// names the key, the value and the fix.
     pub fn validate(&self) -> Result<(), String> {
         self.beam.validate()?;
-        if !(self.load.pressure_pa.is_finite()) {
-            return Err("load.pressure_pa: must be finite".into());
+        let (l, r) = (&self.load, &self.run);
+        let e = self.beam.material.youngs_modulus_pa;
+        if !(l.pressure_pa.is_finite() && l.pressure_pa.abs() <= 1e-3 * e) {
+            return Err(format!(
+                "load.pressure_pa: must be finite with |q| ≤ 1e-3 of beam.material.youngs_modulus_pa ({:.3e} Pa; larger loads bend the beam beyond the elastic range), got {}",
+                1e-3 * e,
+                l.pressure_pa
+            ));
         }
-        if !(self.load.rise_s > 0.0) {
-            return Err("load.rise_s: must be positive".into());
+        if !(l.rise_s > 0.0 && l.rise_s <= 1e3) {
+            return Err(format!(
+                "load.rise_s: must be in (0, 1000] s, got {}",
+                l.rise_s
+            ));
         }
-        if !(self.load.hold_s >= 0.0) {
-            return Err("load.hold_s: must be ≥ 0".into());
+        if !(l.hold_s >= 0.0 && l.hold_s <= 1e3) {
+            return Err(format!(
+                "load.hold_s: must be in [0, 1000] s, got {}",
+                l.hold_s
+            ));
         }
-        if !(self.run.duration_s > 0.0) {
-            return Err("run.duration_s: must be positive".into());
+        if !(r.duration_s > 0.0 && r.duration_s <= 1e3) {
+            return Err(format!(
+                "run.duration_s: must be in (0, 1000] s, got {}",
+                r.duration_s
+            ));
         }
-        if !(self.run.time_step_s > 0.0 && self.run.time_step_s < self.run.duration_s) {
-            return Err("run.time_step_s: must be positive and below duration_s".into());
+        if !(r.time_step_s > 0.0 && r.time_step_s < r.duration_s) {
+            return Err(format!(
+                "run.time_step_s: must be positive and below duration_s, got {}",
+                r.time_step_s
+            ));
         }
-        if !(self.run.coupling.tolerance > 0.0) {
-            return Err("run.coupling.tolerance: must be positive".into());
+        let g = r.gravity_m_s2;
+        if !(g.iter().all(|x| x.is_finite()) && g.iter().map(|x| x * x).sum::<f64>() <= 1e6) {
+            return Err(format!(
+                "run.gravity_m_s2: must be finite with |g| ≤ 1000 m/s², got {g:?}"
+            ));
         }
-        if self.run.coupling.max_iterations == 0 {
-            return Err("run.coupling.max_iterations: must be ≥ 1".into());
+        if !(r.output_interval_s >= 0.0 && r.output_interval_s <= r.duration_s) {
+            return Err(format!(
+                "run.output_interval_s: must be in [0, duration_s] (0 = every step), got {}",
+                r.output_interval_s
+            ));
+        }
+        let c = &r.coupling;
+        if !(c.tolerance > 0.0 && c.tolerance.is_finite()) {
+            return Err(format!(
+                "run.coupling.tolerance: must be finite and positive (eq. 16: 1e-3 m/s), got {}",
+                c.tolerance
+            ));
+        }
+        if !(1..=10_000).contains(&c.max_iterations) {
+            return Err(format!(
+                "run.coupling.max_iterations: must be in [1, 10000], got {}",
+                c.max_iterations
+            ));
+        }
+        if !(c.initial_relaxation > 0.0 && c.initial_relaxation <= 2.0) {
+            return Err(format!(
+                "run.coupling.initial_relaxation: must be in (0, 2], got {}",
+                c.initial_relaxation
+            ));
         }
         if let Some(p) = &self.powder {
             p.law.validate("powder.law.")?;
             p.psd().validate("powder.")?;
-            if !(p.density_kg_m3 > 0.0) {
-                return Err("powder.density_kg_m3: must be positive".into());
+            if !(p.density_kg_m3 > 0.0 && p.density_kg_m3 <= 1e5) {
+                return Err(format!(
+                    "powder.density_kg_m3: must be in (0, 1e5] kg/m³, got {}",
+                    p.density_kg_m3
+                ));
             }
-            if !(p.reference_d50_m > 0.0) {
-                return Err("powder.reference_d50_m: must be positive".into());
+            let f = p.d50_m / p.reference_d50_m;
+            if !(p.reference_d50_m > 0.0 && (1e-3..=1e3).contains(&f)) {
+                return Err(format!(
+                    "powder.reference_d50_m: must be positive with d50_m / reference_d50_m in [1e-3, 1e3], got {}",
+                    p.reference_d50_m
+                ));
             }
-            if !(p.prep.packing_density > 0.0 && p.prep.packing_density < 0.74) {
-                return Err("powder.prep.packing_density: must be in (0, 0.74)".into());
+            let s = &p.prep;
+            if !(s.packing_density > 0.0 && s.packing_density < 0.74) {
+                return Err(format!(
+                    "powder.prep.packing_density: must be in (0, 0.74), got {}",
+                    s.packing_density
+                ));
             }
-            if !(p.prep.settling_gravity_factor >= 1.0) {
-                return Err("powder.prep.settling_gravity_factor: must be ≥ 1".into());
+            if !(s.settling_gravity_factor >= 1.0 && s.settling_gravity_factor <= 1e4) {
+                return Err(format!(
+                    "powder.prep.settling_gravity_factor: must be in [1, 1e4], got {}",
+                    s.settling_gravity_factor
+                ));
             }
-            if !(p.prep.plate_speed_m_s > 0.0) {
-                return Err("powder.prep.plate_speed_m_s: must be positive".into());
+            if !(s.plate_speed_m_s > 0.0 && s.plate_speed_m_s <= 100.0) {
+                return Err(format!(
+                    "powder.prep.plate_speed_m_s: must be in (0, 100] m/s, got {}",
+                    s.plate_speed_m_s
+                ));
             }
-            if !(p.prep.relax_time_s >= 0.0 && p.prep.max_settling_time_s > 0.0) {
-                return Err(
-                    "powder.prep.relax_time_s / max_settling_time_s: must be ≥ 0 / positive".into(),
-                );
+            if !(s.relax_time_s >= 0.0 && s.relax_time_s <= 1e3) {
+                return Err(format!(
+                    "powder.prep.relax_time_s: must be in [0, 1000] s, got {}",
+                    s.relax_time_s
+                ));
+            }
+            if !(s.max_settling_time_s > 0.0 && s.max_settling_time_s <= 1e3) {
+                return Err(format!(
+                    "powder.prep.max_settling_time_s: must be in (0, 1000] s, got {}",
+                    s.max_settling_time_s
+                ));
             }
             let gap = self.beam.width_m - 2.0 * self.beam.wall_thickness_m;
-            if p.psd().d_max_m * 1.02 > gap {
-                return Err("powder.d50_m: particles larger than the cavity".into());
+            if p.psd().d_max_m * 1.02 > gap.min(self.beam.cavity_length_m) {
+                return Err(format!(
+                    "powder.d50_m: the largest particles ({:.3e} m) do not fit the cavity ({gap:.3e} m across); use a smaller d50_m",
+                    p.psd().d_max_m
+                ));
             }
         }
+        let est = self.estimate();
+        if est.particles > MAX_PARTICLES as f64 {
+            return Err(format!(
+                "powder.d50_m / powder.prep.packing_density: {est}; more than {MAX_PARTICLES} particles; use a larger d50_m (coarse-graining with reference_d50_m)"
+            ));
+        }
+        if est.steps > MAX_STEPS {
+            return Err(format!(
+                "run.duration_s / run.time_step_s: {est}; more than {MAX_STEPS:e} steps; shorten duration_s or lengthen time_step_s"
+            ));
+        }
+        if est.prep_steps > MAX_STEPS {
+            return Err(format!(
+                "powder.prep.max_settling_time_s / relax_time_s: {est}; more than {MAX_STEPS:e} preparation steps at run.time_step_s; shorten them"
+            ));
+        }
+        if let Some(p) = &self.powder {
+            // the stiffest contact: two of the smallest particles, coarse-grained stiffness
+            let law = p.scaled_law();
+            let dmin = p.psd().d_min_m;
+            let m = p.density_kg_m3 * std::f64::consts::PI / 6.0 * dmin.powi(3);
+            let tc = std::f64::consts::PI * (0.5 * m / law.normal_stiffness_n_m).sqrt();
+            let ratio = r.time_step_s / tc;
+            if !(ratio <= crate::health::MAX_STEP_RATIO) {
+                return Err(format!(
+                    "run.time_step_s = {:.3e} s is {ratio:.2} of the shortest contact time {tc:.3e} s (particles of {dmin:.3e} m, k = {:.4e} N/m after coarse-graining); velocity Verlet needs less than {}: use at most {:.3e} s (1/10 of the contact time)",
+                    r.time_step_s,
+                    law.normal_stiffness_n_m,
+                    crate::health::MAX_STEP_RATIO,
+                    0.1 * tc
+                ));
+            }
+        }
+        let every = (r.output_interval_s / r.time_step_s).round().max(1.0);
+        if est.steps / every > MAX_SAMPLES {
+            return Err(format!(
+                "run.output_interval_s: {:.3e} samples of tip.csv, more than {MAX_SAMPLES:e}; use a larger output_interval_s",
+                est.steps / every
+            ));
+        }
         Ok(())
+    }
+
+    /// Work and memory of the scenario, estimated without allocating anything (f64 so that
+    /// absurd inputs do not overflow).
+    pub fn estimate(&self) -> CostEstimate {
+        let (elements, nodes) = self.beam.mesh_size();
+        let dt = self.run.time_step_s;
+        let steps = (self.run.duration_s / dt).round();
+        let (particles, prep_steps) = match &self.powder {
+            Some(p) => {
+                let n =
+                    p.prep.packing_density * self.beam.cavity().volume() / p.psd().mean_volume_m3();
+                let s = &p.prep;
+                // settling ≤ max_settling_time_s, relaxation ≤ relax + max_settling, holding;
+                // compression: the bed top is at most the cavity's length above the top
+                let comp = self.beam.cavity_length_m / (s.plate_speed_m_s * dt);
+                (
+                    n,
+                    (2.0 * s.max_settling_time_s + 2.0 * s.relax_time_s) / dt + comp,
+                )
+            }
+            None => (0.0, 0.0),
+        };
+        let dofs = 3.0 * nodes;
+        CostEstimate {
+            particles,
+            elements,
+            dofs,
+            steps,
+            prep_steps,
+            memory_bytes: elements * BYTES_PER_ELEMENT + particles * BYTES_PER_PARTICLE,
+            cpu_s: steps * (particles * CPU_S_PER_PARTICLE_STEP + dofs * CPU_S_PER_DOF_STEP)
+                + prep_steps * particles * CPU_S_PER_PARTICLE_STEP,
+        }
     }
 }
 
@@ -458,6 +713,18 @@ pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), String> {
     })
 }
 
+/// Decodes a `pdamp powder run` checkpoint of any scenario that holds a preparation in
+/// progress and checks its consistency (for fuzzing; never panics).
+pub fn decode_preparation(bytes: &[u8]) -> Result<Preparation, String> {
+    match ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)? {
+        Phase::Preparing(p) => {
+            p.check_consistency()?;
+            Ok(*p)
+        }
+        _ => Err("not a preparation".into()),
+    }
+}
+
 /// Runs the scenario (preparation + coupled run) without files. `progress(stage, fraction)`.
 pub fn run(
     sc: &CantileverScenario,
@@ -482,6 +749,12 @@ pub fn run_in_dir(
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<CantileverResult, String> {
     sc.validate()?;
+    if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
+        return Err(format!(
+            "--checkpoint-interval-s: must be finite and ≥ 0 (0 = only on Ctrl-C), got {}",
+            options.checkpoint_interval_s
+        ));
+    }
     let digest = scenario_digest(sc)?;
     let c = Checkpointing {
         path: dir.join(ck::CHECKPOINT_FILE),
@@ -560,6 +833,7 @@ fn run_core(
                 }
                 ControlFlow::Continue(())
             });
+            let flow = flow.map_err(|e| e.to_string())?;
             if let Some(e) = err {
                 return Err(e);
             }
@@ -618,7 +892,8 @@ fn run_core(
     };
     let (mut c, mut res, first) = match (running, prepared) {
         (Some(st), _) => {
-            let c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)?;
+            let mut c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)?;
+            c.container = sc.powder.is_some().then_some(cavity);
             let res = CantileverResult {
                 time_s: st.time_s,
                 tip_m: st.tip_m,
@@ -632,7 +907,8 @@ fn run_core(
         }
         (None, Some((mut powder, prep))) => {
             powder.gravity = sc.run.gravity_m_s2;
-            let c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling);
+            let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling);
+            c.container = sc.powder.is_some().then_some(cavity);
             let res = result(&c, prep);
             (c, res, 1)
         }
@@ -678,7 +954,9 @@ fn run_core(
             res.iterations.push(it as f64);
         }
         if q % e_every == 0 || q == 1 {
-            res.energy.push((t, c.energy()));
+            let e = c.energy();
+            res.energy.push((t, e));
+            check_energy_health(&c, &res.energy)?;
         }
         if q % 200 == 0 {
             progress("coupled run", q as f64 / nsteps as f64);
@@ -716,6 +994,30 @@ fn run_core(
         .fold(0.0, f64::max)
         / emax;
     Ok(res)
+}
+
+/// The energy health check of the coupled run ([`crate::health::check_energy`]): the
+/// cumulative dissipation must not be negative beyond a tenth of the largest energy so far,
+/// and the balance must not grow by more than half of it (from its value after step 1, when
+/// the wall springs are known).
+fn check_energy_health(c: &Coupled, energy: &[(f64, CoupledEnergy)]) -> Result<(), String> {
+    let Some((_, e)) = energy.last() else {
+        return Ok(());
+    };
+    let b0 = energy[1.min(energy.len() - 1)].1.balance_j;
+    let scale = energy
+        .iter()
+        .map(|(_, e)| {
+            e.structure_kinetic_j
+                + e.structure_strain_j
+                + e.particle_kinetic_j
+                + e.contact_elastic_j
+        })
+        .chain(std::iter::once(e.load_work_j.abs()))
+        .fold(0.0, f64::max);
+    crate::health::check_energy(e.dissipated_j, e.balance_j - b0, scale).map_err(|s| {
+        crate::health::HealthError::new(c.powder.t, "coupled run", s, &c.powder).to_string()
+    })
 }
 
 /// Writes tip.csv, envelope.csv, energy.csv, the tip plot and (last) summary.json into `dir`.
@@ -788,7 +1090,12 @@ pub fn write_outputs(
     plot.series.push(pdamp_plot::Series::new("", ms, mm));
     pdamp_plot::line_plot(dir.join("tip"), &plot).map_err(|e| e.to_string())?;
     // last: a run directory with summary.json is complete (the study skips it)
-    let summary = serde_json::json!({ "result": r, "scenario": sc });
+    // the digest lets a study reuse this run only for the same scenario (study::run_study)
+    let summary = serde_json::json!({
+        "result": r,
+        "scenario": sc,
+        "scenario_digest": scenario_digest(sc)?,
+    });
     pdamp_io::atomic::write_atomic(
         dir.join("summary.json"),
         serde_json::to_string_pretty(&summary)

@@ -24,7 +24,12 @@ use rayon::prelude::*;
 
 use crate::dem::Powder;
 use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
-use crate::fe::{Dynamics, DynamicsError, DynamicsState, Face, Structure};
+use crate::fe::{Aabb, Dynamics, DynamicsError, DynamicsState, Face, Structure};
+use crate::health::{self, HealthError, Symptom};
+
+/// Steps between the overlap checks of the coupled run (positions, velocities and the
+/// container are checked every step).
+pub const OVERLAP_CHECK_EVERY: u64 = 100;
 
 /// The interface $\Gamma^{ps}$: boundary faces of the structure in contact with the powder.
 #[derive(Debug, Clone)]
@@ -160,6 +165,10 @@ pub enum CoupleError {
     /// Structural solve failed.
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
+    /// A health check failed (non-finite state, a particle outside the cavity, a runaway
+    /// overlap), see [`crate::health`].
+    #[error(transparent)]
+    Health(#[from] Box<HealthError>),
     /// Fixed point did not converge.
     #[error(
         "coupling did not converge at t = {t_s} s: eq. 16 measure {measure:e} after {iterations} iterations"
@@ -250,6 +259,11 @@ pub struct Coupled {
     pub elastic_pw_j: f64,
     /// Work of the interface forces on the structure [J].
     pub interface_work_j: f64,
+    /// The closed container of the particles in the reference configuration (the cavity);
+    /// when set, a particle centre outside it (enlarged by the largest interface displacement)
+    /// stops the run with [`Symptom::Escaped`]. `None` (default): open interfaces such as a
+    /// plate.
+    pub container: Option<Aabb>,
     hist: Vec<WallSlots>,
     results: Vec<WallResult>,
     cand_start: Vec<usize>,
@@ -291,6 +305,7 @@ impl Coupled {
             f_ps: vec![0.0; ndof],
             elastic_pw_j: 0.0,
             interface_work_j: 0.0,
+            container: None,
             hist: vec![EMPTY_SLOTS; n],
             results: vec![WallResult::default(); n],
             cand_start: Vec::new(),
@@ -446,14 +461,27 @@ impl Coupled {
                 hmax = hmax.max(hi[k] - lo[k]);
             }
         }
-        let cell = (hmax + 2.0 * reach).max(1e-9);
-        let nc: Vec<usize> = (0..3)
-            .map(|k| (((ghi[k] - glo[k]) / cell).ceil() as usize).clamp(1, 512))
+        let cell0 = (hmax + 2.0 * reach).max(1e-9);
+        let mut nc: Vec<usize> = (0..3)
+            .map(|k| (((ghi[k] - glo[k]) / cell0).ceil() as usize).clamp(1, 512))
+            .collect();
+        // at most 8 cells per face (a structure blown apart must not allocate 512³ cells);
+        // cells grow instead, per axis, so that they still cover the whole range
+        let limit = (8 * faces.len()).max(4096);
+        while nc[0] * nc[1] * nc[2] > limit {
+            let k = (0..3).max_by_key(|&k| nc[k]).unwrap_or(0);
+            nc[k] = nc[k].div_ceil(2);
+        }
+        let cellk: Vec<f64> = (0..3)
+            .map(|k| {
+                let c = cell0.max((ghi[k] - glo[k]) / nc[k] as f64);
+                if c.is_finite() { c } else { f64::MAX }
+            })
             .collect();
         let idx = |p: [f64; 3]| -> Option<usize> {
             let mut c = [0usize; 3];
             for k in 0..3 {
-                let f = (p[k] - glo[k]) / cell;
+                let f = (p[k] - glo[k]) / cellk[k];
                 if f < 0.0 || f >= nc[k] as f64 {
                     return None;
                 }
@@ -465,10 +493,10 @@ impl Coupled {
         let mut cell_faces: Vec<Vec<u32>> = vec![Vec::new(); ncell];
         for (fi, (lo, hi)) in boxes.iter().enumerate() {
             let c0: Vec<usize> = (0..3)
-                .map(|k| (((lo[k] - reach - glo[k]) / cell).max(0.0) as usize).min(nc[k] - 1))
+                .map(|k| (((lo[k] - reach - glo[k]) / cellk[k]).max(0.0) as usize).min(nc[k] - 1))
                 .collect();
             let c1: Vec<usize> = (0..3)
-                .map(|k| (((hi[k] + reach - glo[k]) / cell).max(0.0) as usize).min(nc[k] - 1))
+                .map(|k| (((hi[k] + reach - glo[k]) / cellk[k]).max(0.0) as usize).min(nc[k] - 1))
                 .collect();
             for z in c0[2]..=c1[2] {
                 for y in c0[1]..=c1[1] {
@@ -658,7 +686,13 @@ impl Coupled {
     /// One coupled time step (Algorithm 1); returns the number of fixed-point iterations.
     pub fn step(&mut self) -> Result<usize, CoupleError> {
         self.powder.predict();
+        self.check_particles()?;
         self.powder.pair_forces();
+        if self.steps.is_multiple_of(OVERLAP_CHECK_EVERY) {
+            let p = &self.powder;
+            health::check_overlaps(p)
+                .map_err(|s| Box::new(HealthError::new(p.t, "coupled run", s, p)))?;
+        }
         let dt = self.dynamics.dt;
         let nps = self.interface.n_dof();
         // predictor of the interface displacements
@@ -677,8 +711,18 @@ impl Coupled {
         let mut k = 0;
         loop {
             self.particle_operator();
-            self.dynamics
-                .solve(&mut self.structure, Some(&self.f_trial), k == 0)?;
+            if let Err(e) = self
+                .dynamics
+                .solve(&mut self.structure, Some(&self.f_trial), k == 0)
+            {
+                // a diverged structure (or particles) is a health failure, not a solver one
+                if self.dynamics.d1.iter().any(|x| !x.is_finite())
+                    || self.f_trial.iter().any(|x| !x.is_finite())
+                {
+                    return Err(self.structure_failure().into());
+                }
+                return Err(e.into());
+            }
             k += 1;
             let mut norm2 = 0.0;
             for (q, &a) in self.interface.nodes.iter().enumerate() {
@@ -690,6 +734,9 @@ impl Coupled {
                 }
             }
             let measure = norm2.sqrt() / (dt * (nps.max(1) as f64).sqrt());
+            if !measure.is_finite() {
+                return Err(self.structure_failure().into());
+            }
             if measure < self.settings.tolerance {
                 break;
             }
@@ -750,6 +797,54 @@ impl Coupled {
         self.max_iterations_seen = self.max_iterations_seen.max(k);
         self.steps += 1;
         Ok(k)
+    }
+
+    /// Health of the particles after the drift of a step: finite states and centres inside
+    /// the container (if set); the overlaps are checked after the force pass, every
+    /// [`OVERLAP_CHECK_EVERY`] steps.
+    fn check_particles(&self) -> Result<(), Box<HealthError>> {
+        let p = &self.powder;
+        let fail = |symptom| Box::new(HealthError::new(p.t, "coupled run", symptom, p));
+        let margin = self.container.map(|b| {
+            let dmax = self
+                .interface
+                .nodes
+                .iter()
+                .flat_map(|&a| (0..3).map(move |k| 3 * a + k))
+                .map(|g| self.dynamics.d[g].abs())
+                .fold(0.0, f64::max);
+            let size = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max);
+            (b, dmax + 1e-9 * size)
+        });
+        health::check_particles(p, margin.as_ref().map(|(b, m)| (b, *m)))
+            .map_err(|(_, s)| fail(s))?;
+        Ok(())
+    }
+
+    /// The health error of a non-finite structural state (first non-finite trial dof).
+    fn structure_failure(&self) -> Box<HealthError> {
+        let p = &self.powder;
+        if let Err((_, s)) = health::check_particles(p, None) {
+            return Box::new(HealthError::new(p.t, "coupled run", s, p));
+        }
+        let node = self
+            .dynamics
+            .d1
+            .iter()
+            .position(|x| !x.is_finite())
+            .map_or(0, |g| g / 3);
+        let element = self
+            .structure
+            .mesh
+            .elements
+            .iter()
+            .position(|el| el.contains(&node));
+        Box::new(HealthError::new(
+            p.t,
+            "coupled run",
+            Symptom::NonFiniteStructure { node, element },
+            p,
+        ))
     }
 
     /// Energies of the committed state.

@@ -11,7 +11,8 @@ pub fn zeta_from_decrement(delta: f64) -> f64 {
 
 /// Indices of strict local minima (x[i-1] > x[i] ≤ x[i+1]) with t ≥ `t_start`.
 pub fn local_minima(t: &[f64], x: &[f64], t_start: f64) -> Vec<usize> {
-    (1..x.len().saturating_sub(1))
+    // series of different lengths (a damaged tip.csv): the common part
+    (1..x.len().min(t.len()).saturating_sub(1))
         .filter(|&i| t[i] >= t_start && x[i - 1] > x[i] && x[i] <= x[i + 1])
         .collect()
 }
@@ -19,7 +20,7 @@ pub fn local_minima(t: &[f64], x: &[f64], t_start: f64) -> Vec<usize> {
 /// Indices of local extrema of x (maxima and minima) with t ≥ `t_start`: the peaks whose
 /// absolute values form the outer envelope (paper Fig. 2b).
 pub fn local_extrema(t: &[f64], x: &[f64], t_start: f64) -> Vec<usize> {
-    (1..x.len().saturating_sub(1))
+    (1..x.len().min(t.len()).saturating_sub(1))
         .filter(|&i| {
             t[i] >= t_start
                 && ((x[i - 1] > x[i] && x[i] <= x[i + 1]) || (x[i - 1] < x[i] && x[i] >= x[i + 1]))
@@ -59,6 +60,15 @@ pub fn table_one(t: &[f64], x: &[f64], t_release: f64) -> TableOneRatios {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn series_of_different_lengths_and_nan_do_not_panic() {
+        let t = [0.0, 1.0, 2.0];
+        let x = [1.0, -1.0, 1.0, -1.0, f64::NAN, 2.0];
+        assert_eq!(local_minima(&t, &x, 0.0), vec![1]);
+        let r = table_one(&x, &t, 0.0);
+        assert!(r.zeta_1.is_none());
+    }
 
     #[test]
     fn recovers_zeta_of_a_damped_oscillator() {

@@ -12,6 +12,8 @@
 //! - [`prep`]: powder preparation (grid, settling, plate compression to a packing density).
 //! - [`couple`]: Dirichlet–Neumann coupling with Aitken relaxation (Sect. 2.3, Algorithm 1).
 //! - [`cantilever`]: the cantilever study of Sect. 2.4, damping ratios as in Table 1.
+//! - [`health`]: health checks of the DEM and the coupled run (typed errors, likely cause).
+//! - [`fuzz`]: fuzz entry points of the mesh readers and the checkpoint decoder.
 //! - [`analytic`]: the first-order shear and bending models of Sect. 4 (eq. 17–26).
 //!
 //! Details and measured results: `docs/powder.md`.
@@ -26,5 +28,7 @@ pub mod couple;
 pub mod damping;
 pub mod dem;
 pub mod fe;
+pub mod fuzz;
+pub mod health;
 pub mod prep;
 pub mod study;

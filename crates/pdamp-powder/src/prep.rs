@@ -15,6 +15,7 @@ use std::time::Instant;
 use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
 use crate::dem::{LogNormal, PlaneWall, Powder, PowderLaw, Rng};
 use crate::fe::Aabb;
+use crate::health::{self, HealthError};
 
 /// Preparation settings.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -216,12 +217,68 @@ impl Preparation {
         self.powder.t
     }
 
-    /// Checks that a deserialized preparation is self-consistent.
+    /// Checks that a deserialized preparation is self-consistent (array lengths, finite and
+    /// positive time step and cavity, finite walls and reference energies).
     pub fn check_consistency(&self) -> Result<(), String> {
         self.powder.check_consistency()?;
         if self.hist.len() != self.powder.len() || self.planes.len() != 6 {
             return Err("preparation state: wall history does not match the particles".into());
         }
+        let c = &self.cavity;
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let ok = self.powder.dt > 0.0
+            && self.powder.dt.is_finite()
+            && finite(&c.min)
+            && finite(&c.max)
+            && (0..3).all(|k| c.min[k] < c.max[k])
+            && self
+                .planes
+                .iter()
+                .all(|w| finite(&w.point) && finite(&w.normal) && finite(&w.velocity))
+            && finite(&[self.e_ref, self.e_ref_1g, self.bed_top, self.settled]);
+        if !ok {
+            return Err(
+                "preparation state: time step, cavity, walls or reference energies not finite"
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// Name of the current stage (for messages).
+    fn stage_name(&self) -> &'static str {
+        match self.stage {
+            Stage::Settling { .. } => "preparation: settling",
+            Stage::Relaxing { .. } => "preparation: relaxing under 1 g",
+            Stage::Compressing { .. } => "preparation: plate compression",
+            Stage::Holding { .. } => "preparation: relaxing with the plate held",
+            Stage::Done => "preparation: done",
+        }
+    }
+
+    /// Health of the bed (see [`crate::health`]): finite states, particle centres inside the
+    /// box walls and below the plate, no runaway overlap, no negative dissipation beyond a
+    /// tenth of the bed's potential-energy scale M·g·H.
+    pub fn check_health(&self) -> Result<(), Box<HealthError>> {
+        let p = &self.powder;
+        let fail = |s| Box::new(HealthError::new(p.t, self.stage_name(), s, p));
+        let c = self.cavity;
+        let top = self.planes[5].point[2].max(c.max[2]);
+        let bx = Aabb {
+            min: c.min,
+            max: [c.max[0], c.max[1], top],
+        };
+        let size = (0..3).map(|k| bx.max[k] - bx.min[k]).fold(0.0, f64::max);
+        health::check_particles(p, Some((&bx, 1e-9 * size))).map_err(|(_, s)| fail(s))?;
+        health::check_overlaps(p).map_err(fail)?;
+        let g = (0..3)
+            .map(|k| p.gravity[k] * p.gravity[k])
+            .sum::<f64>()
+            .sqrt()
+            .max(9.81);
+        let scale = p.mass.iter().sum::<f64>() * g * size;
+        let diss = p.ledger.dissipated_pp_j + p.ledger.dissipated_pw_j;
+        health::check_energy(diss, 0.0, scale).map_err(fail)?;
         Ok(())
     }
 
@@ -242,13 +299,17 @@ impl Preparation {
         }
     }
 
-    fn step(&mut self) {
+    fn step(&mut self) -> Result<(), Box<HealthError>> {
         let p = &mut self.powder;
         p.predict();
         p.pair_forces();
         wall::plane_forces(p, &self.planes, &mut self.hist, &mut self.on_wall);
         p.finish();
         self.steps += 1;
+        if self.steps.is_multiple_of(SETTLE_CHUNK as u64) {
+            self.check_health()?;
+        }
+        Ok(())
     }
 
     fn end_settling(&mut self) {
@@ -293,15 +354,15 @@ impl Preparation {
     }
 
     /// One step (or one change of stage); false once finished.
-    fn advance(&mut self, progress: &mut dyn FnMut(&str, f64)) -> bool {
+    fn advance(&mut self, progress: &mut dyn FnMut(&str, f64)) -> Result<bool, Box<HealthError>> {
         match self.stage {
             Stage::Settling { chunk } => {
                 let t_end = self.settings.max_settling_time_s;
                 if chunk == 0 && self.powder.t >= t_end {
                     self.end_settling();
-                    return true;
+                    return Ok(true);
                 }
-                self.step();
+                self.step()?;
                 self.stage = Stage::Settling {
                     chunk: (chunk + 1) % SETTLE_CHUNK,
                 };
@@ -333,9 +394,9 @@ impl Preparation {
                     })
                 {
                     self.start_compression();
-                    return true;
+                    return Ok(true);
                 }
-                self.step();
+                self.step()?;
                 let mut moved = moved;
                 if (done + 1) % chunk == 0 {
                     let ke = self.powder.kinetic_energy();
@@ -352,7 +413,7 @@ impl Preparation {
             Stage::Compressing { q, nsteps, dz } => {
                 if q < nsteps {
                     self.planes[5].point[2] = self.bed_top - dz * (q + 1) as f64;
-                    self.step();
+                    self.step()?;
                     if q % 500 == 0 {
                         progress("compressing", q as f64 / nsteps as f64);
                     }
@@ -367,7 +428,7 @@ impl Preparation {
             }
             Stage::Holding { q } => {
                 if q < self.relax_steps {
-                    self.step();
+                    self.step()?;
                     self.plate_force = self.on_wall[5][2];
                     if q % 500 == 0 {
                         progress("relaxing", q as f64 / self.relax_steps as f64);
@@ -377,26 +438,28 @@ impl Preparation {
                     self.stage = Stage::Done;
                 }
             }
-            Stage::Done => return false,
+            Stage::Done => return Ok(false),
         }
-        true
+        Ok(true)
     }
 
     /// Runs the preparation to its end; `hook` is called after every step (with the state at
     /// a point where [`Preparation::snapshot`] can be taken) and stops the run at once when it
-    /// returns `Break` (then the result is `Break`; calling `run` again continues).
+    /// returns `Break` (then the result is `Break`; calling `run` again continues). A failed
+    /// health check (every 200 steps, [`Preparation::check_health`]) ends it with the error.
     pub fn run(
         &mut self,
         progress: &mut dyn FnMut(&str, f64),
         hook: &mut dyn FnMut(&Preparation) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
+    ) -> Result<ControlFlow<()>, Box<HealthError>> {
         self.segment_start = Some(Instant::now());
-        while self.advance(progress) {
+        while self.advance(progress)? {
             if hook(self).is_break() {
-                return ControlFlow::Break(());
+                return Ok(ControlFlow::Break(()));
             }
         }
-        ControlFlow::Continue(())
+        self.check_health()?;
+        Ok(ControlFlow::Continue(()))
     }
 
     /// The prepared powder (at rest, clock and ledger reset) and the report; call after
@@ -430,7 +493,8 @@ impl Preparation {
     }
 }
 
-/// Prepares the powder in `cavity` (gravity along −z during preparation, as in the paper).
+/// Prepares the powder in `cavity` (gravity along −z during preparation, as in the paper);
+/// fails with the health check's error ([`Preparation::check_health`]).
 pub fn prepare(
     cavity: Aabb,
     psd: &LogNormal,
@@ -439,8 +503,8 @@ pub fn prepare(
     dt: f64,
     s: &PrepSettings,
     progress: &mut dyn FnMut(&str, f64),
-) -> (Powder, PrepReport) {
+) -> Result<(Powder, PrepReport), Box<HealthError>> {
     let mut prep = Preparation::new(cavity, psd, law, density_kg_m3, dt, s);
-    let _ = prep.run(progress, &mut |_| ControlFlow::Continue(()));
-    prep.finish()
+    let _ = prep.run(progress, &mut |_| ControlFlow::Continue(()))?;
+    Ok(prep.finish())
 }

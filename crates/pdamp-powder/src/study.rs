@@ -2,12 +2,15 @@
 //! parameter, each written to its own sub-directory, plus a combined decay plot, an envelope
 //! plot and a Table-1-like `table.csv` (ζ1, ζ2, ζ̄5 per value, with the period, the
 //! preparation's settled and final packing density, whether the plate compressed the bed, the
-//! energy closure and the wall times). Finished runs
-//! (`<dir>/summary.json` present) are skipped, so a study can be resumed; each run
+//! energy closure and the wall times). Finished runs (`<dir>/summary.json` present) are
+//! reused, so a study can be resumed — but only if they belong to the same scenario: every
+//! `summary.json` stores the digest of its run's canonical scenario (the study's scenario with
+//! the parameter applied), and a run directory holding results or a checkpoint of a different
+//! scenario is refused before anything runs ([`StudyError::ForeignRun`]). Each run
 //! checkpoints into `<dir>/checkpoint.bin` and, with `resume`, an interrupted run continues
 //! from its checkpoint ([`cantilever::run_in_dir`]).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::cantilever::{self, CantileverScenario};
 use crate::damping;
@@ -45,8 +48,20 @@ impl StudyParameter {
         }
     }
 
-    /// The scenario with the parameter set to `v`.
+    /// The scenario with the parameter set to `v` (validated; the error names the value).
     pub fn apply(&self, base: &CantileverScenario, v: f64) -> Result<CantileverScenario, String> {
+        self.apply_unnamed(base, v)
+            .map_err(|e| format!("--values: {} = {v}: {e}", self.name()))
+    }
+
+    fn apply_unnamed(
+        &self,
+        base: &CantileverScenario,
+        v: f64,
+    ) -> Result<CantileverScenario, String> {
+        if !v.is_finite() {
+            return Err("values must be finite numbers".into());
+        }
         let mut s = base.clone();
         let p = s
             .powder
@@ -54,20 +69,28 @@ impl StudyParameter {
             .ok_or("the study needs a [powder] section")?;
         match self {
             Self::PackingDensity => p.prep.packing_density = v,
-            Self::StiffnessFactor => p.law.normal_stiffness_n_m *= v,
+            Self::StiffnessFactor => {
+                if !(v > 0.0) {
+                    return Err("the stiffness factor must be positive".into());
+                }
+                p.law.normal_stiffness_n_m *= v
+            }
             Self::Friction => p.law.friction = v,
             Self::Restitution => p.law.restitution = v,
             Self::SurfaceEnergy => p.law.surface_energy_j_m2 = v,
             Self::D50 => {
+                if !(v > 0.0) {
+                    return Err("d50_m must be positive".into());
+                }
                 let f = v / p.d50_m;
                 p.d50_m = v;
                 s.run.time_step_s *= f;
             }
             Self::Orientation => {
-                s.run.gravity_m_s2 = match v as i64 {
-                    0 => [0.0, 0.0, -9.81],
-                    1 => [0.0, 0.0, 9.81],
-                    2 => [-9.81, 0.0, 0.0],
+                s.run.gravity_m_s2 = match v {
+                    0.0 => [0.0, 0.0, -9.81],
+                    1.0 => [0.0, 0.0, 9.81],
+                    2.0 => [-9.81, 0.0, 0.0],
                     _ => {
                         return Err(
                             "orientation values: 0 upright, 1 upside down, 2 horizontal".into()
@@ -159,6 +182,116 @@ fn table_line(r: &StudyRow) -> [f64; 16] {
     ]
 }
 
+/// Why a study refuses to run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StudyError {
+    /// A run directory holds results (or an interrupted run) of another scenario.
+    #[error(
+        "{dir} holds {what} of a different scenario (digest {found} vs {expected}); use another --out or remove it"
+    )]
+    ForeignRun {
+        /// The run directory.
+        dir: PathBuf,
+        /// `results` or `an interrupted run`.
+        what: &'static str,
+        /// Digest stored there.
+        found: String,
+        /// Digest of this study's scenario for the value.
+        expected: String,
+    },
+    /// A run directory's summary cannot be read.
+    #[error("{path}: {why}; remove the run directory {dir} to compute it again")]
+    Unreadable {
+        /// The file.
+        path: PathBuf,
+        /// The run directory.
+        dir: PathBuf,
+        /// What is wrong.
+        why: String,
+    },
+}
+
+/// Digest of the scenario a finished run's `summary.json` belongs to: its `scenario_digest`
+/// field, or (summaries written before the field existed) the digest of the scenario stored
+/// in it.
+pub fn summary_digest(js: &serde_json::Value) -> Result<String, String> {
+    if let Some(d) = js["scenario_digest"].as_str() {
+        return Ok(d.to_string());
+    }
+    let sc: CantileverScenario = serde_json::from_value(js["scenario"].clone())
+        .map_err(|e| format!("no scenario_digest and no readable scenario ({e})"))?;
+    cantilever::scenario_digest(&sc)
+}
+
+/// Scenario digest in the header of a checkpoint file (read without decoding the body);
+/// `None` if the bytes are no pdamp checkpoint.
+pub fn checkpoint_digest(bytes: &[u8]) -> Option<String> {
+    // MAGIC (8), format u32, then strings as u64 length + bytes (bincode, fixint, LE)
+    let mut at = 8 + 4;
+    if bytes.get(..8)? != b"PDAMPCK\0" {
+        return None;
+    }
+    let mut string = || -> Option<String> {
+        let n = u64::from_le_bytes(bytes.get(at..at + 8)?.try_into().ok()?) as usize;
+        let s = bytes.get(at + 8..(at + 8).checked_add(n)?)?;
+        at += 8 + n;
+        String::from_utf8(s.to_vec()).ok()
+    };
+    let _version = string()?;
+    string()
+}
+
+/// Refuses a run directory that holds results or a checkpoint of another scenario than the
+/// one with digest `expected`; `Ok(true)` if it holds finished results of this scenario.
+fn check_run_dir(dir: &Path, expected: &str) -> Result<bool, StudyError> {
+    let summary = dir.join("summary.json");
+    let foreign = |what, found: String| StudyError::ForeignRun {
+        dir: dir.to_path_buf(),
+        what,
+        found,
+        expected: expected.to_string(),
+    };
+    if summary.exists() {
+        let unreadable = |why: String| StudyError::Unreadable {
+            path: summary.clone(),
+            dir: dir.to_path_buf(),
+            why,
+        };
+        let text = std::fs::read_to_string(&summary).map_err(|e| unreadable(e.to_string()))?;
+        let js: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| unreadable(e.to_string()))?;
+        let found = summary_digest(&js).map_err(unreadable)?;
+        if found != expected {
+            return Err(foreign("results", found));
+        }
+        return Ok(true);
+    }
+    if let Ok(bytes) = std::fs::read(dir.join(pdamp_io::checkpoint::CHECKPOINT_FILE))
+        && let Some(found) = checkpoint_digest(&bytes)
+        && found != expected
+    {
+        return Err(foreign("an interrupted run", found));
+    }
+    Ok(false)
+}
+
+/// The tip history of a finished run (`tip.csv`: time, displacement).
+fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let path = dir.join("tip.csv");
+    let (_, data) = pdamp_io::csv::read_csv_f64(&path).map_err(|e| e.to_string())?;
+    if data.iter().any(|r| r.len() < 2) {
+        return Err(format!(
+            "{}: needs the columns time_s and tip_displacement_m; remove {} to compute it again",
+            path.display(),
+            dir.display()
+        ));
+    }
+    Ok((
+        data.iter().map(|r| r[0]).collect(),
+        data.iter().map(|r| r[1]).collect(),
+    ))
+}
+
 /// Runs the study into `out` and returns the table; `options` are passed to every run that
 /// is not finished yet (checkpoint interval; `resume` continues an interrupted run from its
 /// checkpoint).
@@ -179,15 +312,28 @@ pub fn run_study(
         pdamp_plot::Axis::linear("time (ms)"),
         pdamp_plot::Axis::linear("peak |x| (mm)"),
     );
-    for (q, &v) in values.iter().enumerate() {
+    // every value is validated and every existing run directory checked before any run
+    if values.is_empty() {
+        return Err("--values: give at least one value".into());
+    }
+    if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
+        return Err(format!(
+            "--checkpoint-interval-s: must be finite and ≥ 0, got {}",
+            options.checkpoint_interval_s
+        ));
+    }
+    let mut plan = Vec::with_capacity(values.len());
+    for &v in values {
         let sc = param.apply(base, v)?;
         let dir = out.join(format!("{}_{}", param.name(), v));
+        let digest = cantilever::scenario_digest(&sc)?;
+        let finished = check_run_dir(&dir, &digest).map_err(|e| e.to_string())?;
+        plan.push((v, sc, dir, finished));
+    }
+    for (q, (v, sc, dir, finished)) in plan.into_iter().enumerate() {
         let t_rel = sc.load.rise_s + sc.load.hold_s;
-        let (t, x, row) = if dir.join("summary.json").exists() {
-            let (_, data) =
-                pdamp_io::csv::read_csv_f64(dir.join("tip.csv")).map_err(|e| e.to_string())?;
-            let t: Vec<f64> = data.iter().map(|r| r[0]).collect();
-            let x: Vec<f64> = data.iter().map(|r| r[1]).collect();
+        let (t, x, row) = if finished {
+            let (t, x) = read_tip(&dir)?;
             let js: serde_json::Value = serde_json::from_str(
                 &std::fs::read_to_string(dir.join("summary.json")).map_err(|e| e.to_string())?,
             )

@@ -53,19 +53,22 @@ fn preparation_continued_from_checkpoints_is_bit_identical() {
         relax_time_s: 5e-4,
         ..PrepSettings::default()
     };
-    let (p_ref, mut rep_ref) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {});
+    let (p_ref, mut rep_ref) =
+        prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
     assert!(rep_ref.compressed, "the test must cover the compression");
     let mut pr = Preparation::new(cavity, &psd, law, 8000.0, dt, &s);
     let (mut calls, mut stops) = (0u64, 0);
     loop {
-        let flow = pr.run(&mut |_, _| {}, &mut |_| {
-            calls += 1;
-            if calls.is_multiple_of(311) {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        });
+        let flow = pr
+            .run(&mut |_, _| {}, &mut |_| {
+                calls += 1;
+                if calls.is_multiple_of(311) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })
+            .unwrap();
         if flow.is_continue() {
             break;
         }

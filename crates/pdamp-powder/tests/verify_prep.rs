@@ -26,7 +26,7 @@ fn prepared_bed_is_at_rest_under_one_g() {
         relax_time_s: 2e-3,
         ..PrepSettings::default()
     };
-    let (mut p, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {});
+    let (mut p, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
     assert!(!rep.compressed, "the bed must stay below the cavity top");
     let n = p.len();
     let mass: f64 = p.mass.iter().sum();

@@ -78,44 +78,57 @@ impl PowderLaw {
         (self.hamaker_j * r_eff / (6.0 * fs0)).sqrt() / self.adhesion_cutoff.sqrt()
     }
 
-    /// Checks ranges; the error names the key.
+    /// Checks that every value is finite and in its physical range; the error names the key
+    /// (with `prefix`), the value and the range.
     pub fn validate(&self, prefix: &str) -> Result<(), String> {
-        let chk = |ok: bool, key: &str, what: &str| {
+        let chk = |ok: bool, key: &str, v: f64, what: &str| {
             if ok {
                 Ok(())
             } else {
-                Err(format!("{prefix}{key}: {what}"))
+                Err(format!("{prefix}{key}: {what}, got {v}"))
             }
         };
+        let k = self.normal_stiffness_n_m;
         chk(
-            self.normal_stiffness_n_m > 0.0 && self.normal_stiffness_n_m.is_finite(),
+            k > 0.0 && k <= 1e12,
             "normal_stiffness_n_m",
-            "must be positive",
+            k,
+            "must be a finite stiffness in (0, 1e12] N/m (Table A.2: 5642)",
         )?;
         chk(
             self.restitution > 0.0 && self.restitution <= 1.0,
             "restitution",
+            self.restitution,
             "must be in (0, 1]",
         )?;
         chk(
-            self.friction >= 0.0 && self.friction.is_finite(),
+            self.friction >= 0.0 && self.friction <= 10.0,
             "friction",
-            "must be ≥ 0",
+            self.friction,
+            "must be in [0, 10]",
         )?;
         chk(
-            (-1.0..0.5).contains(&self.poisson_ratio),
+            self.poisson_ratio > -1.0 && self.poisson_ratio < 0.5,
             "poisson_ratio",
-            "must be in [-1, 0.5)",
+            self.poisson_ratio,
+            "must be in (-1, 0.5)",
         )?;
         chk(
-            self.surface_energy_j_m2 >= 0.0,
+            self.surface_energy_j_m2 >= 0.0 && self.surface_energy_j_m2 <= 100.0,
             "surface_energy_j_m2",
-            "must be ≥ 0",
+            self.surface_energy_j_m2,
+            "must be in [0, 100] J/m² (Sect. 3.6: 0.085)",
         )?;
-        chk(self.hamaker_j > 0.0, "hamaker_j", "must be positive")?;
+        chk(
+            self.hamaker_j > 0.0 && self.hamaker_j <= 1e-15,
+            "hamaker_j",
+            self.hamaker_j,
+            "must be in (0, 1e-15] J (Table A.2: 4e-19)",
+        )?;
         chk(
             self.adhesion_cutoff > 0.0 && self.adhesion_cutoff < 1.0,
             "adhesion_cutoff",
+            self.adhesion_cutoff,
             "must be in (0, 1)",
         )?;
         Ok(())

@@ -8,6 +8,7 @@ pub mod psd;
 pub mod wall;
 
 pub use law::PowderLaw;
+pub use neighbor::NeighborList;
 pub use powder::{Powder, PowderLedger};
 pub use psd::{LogNormal, Rng};
 pub use wall::{PlaneWall, WallSlots};

@@ -106,23 +106,36 @@ impl NeighborList {
         let reach = 2.0 * rmax + self.skin + extra_range;
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
+        // non-finite positions (a run about to fail its health check) must not break the
+        // grid: they are left out of the bounds and land in cell 0 without any pair
         for p in pos {
             for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+                if p[k].is_finite() {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
             }
         }
         let mut nc = [1usize; 3];
         for k in 0..3 {
-            if n > 0 {
-                nc[k] = (((hi[k] - lo[k]) / reach).floor() as usize + 1).min(1 << 10);
+            let span = (hi[k] - lo[k]) / reach;
+            if n > 0 && span.is_finite() && span > 0.0 {
+                nc[k] = (span.floor().min(1023.0) as usize) + 1;
             }
+        }
+        // at most 8 cells per particle (a bed blown apart must not allocate 1024³ cells);
+        // clamping positions into fewer cells keeps every pair (distances are checked)
+        let limit = (8 * n).max(4096);
+        while nc[0] * nc[1] * nc[2] > limit {
+            let k = (0..3).max_by_key(|&k| nc[k]).unwrap_or(0);
+            nc[k] = nc[k].div_ceil(2);
         }
         let ncell = nc[0] * nc[1] * nc[2];
         let cell_index = |p: &[f64; 3]| -> [usize; 3] {
             let mut c = [0; 3];
             for k in 0..3 {
-                c[k] = (((p[k] - lo[k]) / reach) as usize).min(nc[k] - 1);
+                // `as` saturates (NaN → 0): always a valid cell
+                c[k] = (((p[k] - lo[k]) / reach).max(0.0) as usize).min(nc[k] - 1);
             }
             c
         };

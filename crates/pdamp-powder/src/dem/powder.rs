@@ -176,9 +176,19 @@ impl Powder {
                 return Err(format!("powder state: {k} has {len} entries, expected {n}"));
             }
         }
-        if !(self.radius.iter().all(|&r| r > 0.0) && self.mass.iter().all(|&m| m > 0.0)) {
-            return Err("powder state: radii and masses must be positive".into());
+        let pos_fin = |v: &[f64]| v.iter().all(|&x| x > 0.0 && x.is_finite());
+        if !(pos_fin(&self.radius) && pos_fin(&self.mass) && pos_fin(&self.inertia)) {
+            return Err(
+                "powder state: radii, masses and inertias must be finite and positive".into(),
+            );
         }
+        if !(self.dt > 0.0 && self.dt.is_finite() && self.t.is_finite())
+            || self.gravity.iter().any(|g| !g.is_finite())
+            || !(self.nl.skin >= 0.0 && self.nl.skin.is_finite())
+        {
+            return Err("powder state: time step, time, gravity or skin not finite".into());
+        }
+        self.law.validate("powder state: law.")?;
         self.nl.check_consistency(n)
     }
 

@@ -76,21 +76,46 @@ impl LogNormal {
         }
         out
     }
-    /// Checks ranges; the error names the key.
+    /// Checks ranges (finite values; σ ≤ 1 so that the truncated sampling terminates
+    /// quickly); the error names the key.
     pub fn validate(&self, prefix: &str) -> Result<(), String> {
-        if !(self.d50_m > 0.0) {
-            return Err(format!("{prefix}d50_m: must be positive"));
+        if !(self.d50_m > 0.0 && self.d50_m.is_finite()) {
+            return Err(format!(
+                "{prefix}d50_m: must be a finite positive diameter, got {}",
+                self.d50_m
+            ));
         }
-        if !(self.sigma >= 0.0) {
-            return Err(format!("{prefix}sigma: must be ≥ 0"));
+        if !(self.sigma >= 0.0 && self.sigma <= 1.0) {
+            return Err(format!(
+                "{prefix}sigma: must be in [0, 1] (Table A.2: 0.2707), got {}",
+                self.sigma
+            ));
         }
         if !(self.d_min_m > 0.0 && self.d_min_m <= self.d50_m) {
             return Err(format!("{prefix}d_min_m: must be in (0, d50_m]"));
         }
-        if !(self.d_max_m >= self.d50_m) {
-            return Err(format!("{prefix}d_max_m: must be ≥ d50_m"));
+        if !(self.d_max_m >= self.d50_m && self.d_max_m.is_finite()) {
+            return Err(format!("{prefix}d_max_m: must be finite and ≥ d50_m"));
         }
         Ok(())
+    }
+
+    /// Mean particle volume of the truncated distribution [m³] (midpoint rule in ln D).
+    pub fn mean_volume_m3(&self) -> f64 {
+        let (a, b) = (self.d_min_m.ln(), self.d_max_m.ln());
+        let (mu, s) = (self.d50_m.ln(), self.sigma);
+        if s == 0.0 || !(b > a) {
+            return std::f64::consts::PI / 6.0 * self.d50_m.powi(3);
+        }
+        let n = 400;
+        let (mut w, mut v) = (0.0, 0.0);
+        for q in 0..n {
+            let l = a + (b - a) * (q as f64 + 0.5) / n as f64;
+            let p = (-0.5 * ((l - mu) / s).powi(2)).exp();
+            w += p;
+            v += p * (3.0 * l).exp();
+        }
+        std::f64::consts::PI / 6.0 * v / w
     }
 }
 

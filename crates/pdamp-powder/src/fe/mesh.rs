@@ -241,8 +241,9 @@ impl HexMesh {
     }
 }
 
-/// Errors of mesh import.
-#[derive(Debug, thiserror::Error)]
+/// Errors of mesh import. Every message names the line (1-based) and, where there is one, the
+/// node or element by its id in the file, and says what to fix.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
     /// Malformed file content.
     #[error("line {line}: {message}")]
@@ -252,6 +253,52 @@ pub enum MeshError {
         /// What is wrong.
         message: String,
     },
+    /// A section announces more entries than the rest of the file can hold (nothing is
+    /// allocated from such a count).
+    #[error(
+        "line {line}: announces {announced} {what}, but only {left} lines follow; the file is truncated or the count is wrong"
+    )]
+    AnnouncedSize {
+        /// 1-based line of the count.
+        line: usize,
+        /// The announced count.
+        announced: u64,
+        /// What is counted (`nodes`, `elements`, `node blocks`, …).
+        what: &'static str,
+        /// Lines left in the file after the count.
+        left: usize,
+    },
+    /// An element refers to a node the file does not define.
+    #[error(
+        "line {line}: element {element} references unknown node {node}; define node {node} in the node section or fix the element's connectivity"
+    )]
+    UnknownNode {
+        /// 1-based line of the element.
+        line: usize,
+        /// Element id in the file.
+        element: i64,
+        /// The missing node id.
+        node: i64,
+    },
+    /// An element whose Jacobian determinant is not positive at a corner or Gauss point.
+    #[error(
+        "line {line}: element {element} is {kind} (det J = {det:.3e} at {at}); hex8 nodes must be ordered (−,−,−), (+,−,−), (+,+,−), (−,+,−), then the same on the top face, with positive volume — reorder its nodes or remove the collapsed element"
+    )]
+    BadElement {
+        /// 1-based line of the element.
+        line: usize,
+        /// Element id in the file.
+        element: i64,
+        /// `inverted` (det J < 0) or `degenerate` (det J ≈ 0).
+        kind: &'static str,
+        /// The offending determinant (in the file's units, before scaling).
+        det: f64,
+        /// Where: `corner k (node id)` or `Gauss point q`.
+        at: String,
+    },
+    /// The scale factor is not a finite positive number.
+    #[error("scale: must be finite and positive, got {0}")]
+    BadScale(f64),
     /// The file has no hex8 elements.
     #[error("no hexahedral (8-node) elements found")]
     NoHexes,
@@ -268,18 +315,191 @@ fn nums<T: std::str::FromStr>(s: &str, line: usize) -> Result<Vec<T>, MeshError>
     s.split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
         .map(|t| {
-            t.parse::<T>()
-                .map_err(|_| perr(line, format!("cannot parse {t:?}")))
+            t.parse::<T>().map_err(|_| {
+                perr(
+                    line,
+                    format!("cannot parse {:?}", t.chars().take(40).collect::<String>()),
+                )
+            })
         })
         .collect()
 }
 
-/// Compacts a mesh given by node ids: keeps nodes used by elements, scales coordinates.
-fn compact(
-    nodes: &HashMap<i64, [f64; 3]>,
-    elems: &[[i64; 8]],
-    scale: f64,
-) -> Result<HexMesh, MeshError> {
+/// Parses a node line `id x y z …` (0-based line `l`): an integer id and three finite
+/// coordinates.
+fn node_line(s: &str, l: usize) -> Result<(i64, [f64; 3]), MeshError> {
+    let mut it = s
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty());
+    let id = it
+        .next()
+        .ok_or_else(|| perr(l, "node line needs id x y z"))?;
+    let id: i64 = id.parse().map_err(|_| {
+        perr(
+            l,
+            format!(
+                "node id {:?} is not an integer",
+                id.chars().take(40).collect::<String>()
+            ),
+        )
+    })?;
+    let rest: Vec<&str> = it.take(3).collect();
+    if rest.len() < 3 {
+        return Err(perr(l, format!("node {id}: line needs id x y z")));
+    }
+    let mut x = [0.0; 3];
+    for k in 0..3 {
+        let v: f64 = rest[k].parse().map_err(|_| {
+            perr(
+                l,
+                format!(
+                    "node {id}: cannot parse coordinate {:?}",
+                    rest[k].chars().take(40).collect::<String>()
+                ),
+            )
+        })?;
+        if !v.is_finite() {
+            return Err(perr(
+                l,
+                format!(
+                    "node {id}: coordinate {} is not finite ({v}); give finite coordinates",
+                    ["x", "y", "z"][k]
+                ),
+            ));
+        }
+        x[k] = v;
+    }
+    Ok((id, x))
+}
+
+/// Nodes by id with the 0-based line that defined them; a second definition is refused.
+#[derive(Default)]
+struct NodeTable(HashMap<i64, ([f64; 3], usize)>);
+
+impl NodeTable {
+    fn insert(&mut self, id: i64, x: [f64; 3], l: usize) -> Result<(), MeshError> {
+        if let Some((_, first)) = self.0.insert(id, (x, l)) {
+            return Err(perr(
+                l,
+                format!(
+                    "node {id} is defined twice (first on line {}); node ids must be unique",
+                    first + 1
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A hex8 element as read: id, node ids, 0-based line.
+struct RawHex {
+    id: i64,
+    nodes: [i64; 8],
+    line: usize,
+}
+
+/// Parametric coordinates of the corners, in node order.
+const CORNERS: [[f64; 3]; 8] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+];
+
+/// Jacobian determinant of a hex8 with corners `x` at the parametric point `xi`.
+pub fn jacobian_det(x: &[[f64; 3]; 8], xi: [f64; 3]) -> f64 {
+    let (_, dxi) = super::svk::shape(xi);
+    let mut j = [[0.0; 3]; 3];
+    for a in 0..8 {
+        for r in 0..3 {
+            for c in 0..3 {
+                j[r][c] += dxi[a][r] * x[a][c];
+            }
+        }
+    }
+    j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+        - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+        + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0])
+}
+
+/// Checks that a hex8 with corners `x` has a positive Jacobian determinant at its 8 corners
+/// and its 8 Gauss points (relative to its size: below 1e-10 of (largest corner distance)³/8
+/// counts as degenerate). Returns `(kind, det, where)` of the first failure: `where` is
+/// `Ok(corner)` or `Err(gauss point)`.
+pub fn check_hex(x: &[[f64; 3]; 8]) -> Result<(), (&'static str, f64, Result<usize, usize>)> {
+    let size = (1..8)
+        .map(|a| {
+            (0..3)
+                .map(|k| (x[a][k] - x[0][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0f64, f64::max);
+    let tiny = 1e-10 * size.powi(3) / 8.0;
+    let g = 0.577_350_269_189_625_8;
+    let points = CORNERS.iter().enumerate().map(|(a, c)| (*c, Ok(a))).chain(
+        CORNERS
+            .iter()
+            .enumerate()
+            .map(|(q, c)| ([c[0] * g, c[1] * g, c[2] * g], Err(q))),
+    );
+    for (xi, at) in points {
+        let det = jacobian_det(x, xi);
+        if !(det > tiny) {
+            let kind = if det < -tiny {
+                "inverted"
+            } else {
+                "degenerate"
+            };
+            return Err((kind, det, at));
+        }
+    }
+    Ok(())
+}
+
+impl HexMesh {
+    /// Checks finite coordinates, node indices in range and a positive Jacobian of every
+    /// element (see [`check_hex`]); the error names the element (0-based index).
+    pub fn validate(&self) -> Result<(), String> {
+        if let Some(i) = self
+            .nodes
+            .iter()
+            .position(|p| p.iter().any(|v| !v.is_finite()))
+        {
+            return Err(format!(
+                "mesh: node {i} has a non-finite coordinate {:?}",
+                self.nodes[i]
+            ));
+        }
+        for (e, el) in self.elements.iter().enumerate() {
+            if let Some(&n) = el.iter().find(|&&n| n >= self.nodes.len()) {
+                return Err(format!(
+                    "mesh: element {e} references node {n}, the mesh has {}",
+                    self.nodes.len()
+                ));
+            }
+            let x = el.map(|n| self.nodes[n]);
+            if let Err((kind, det, at)) = check_hex(&x) {
+                let at = match at {
+                    Ok(a) => format!("corner {a}"),
+                    Err(q) => format!("Gauss point {q}"),
+                };
+                return Err(format!(
+                    "mesh: element {e} is {kind} (det J = {det:.3e} at {at})"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Compacts a mesh given by node ids: keeps nodes used by elements, scales coordinates,
+/// checks every element's Jacobian.
+fn compact(nodes: &NodeTable, elems: &[RawHex], scale: f64) -> Result<HexMesh, MeshError> {
     if elems.is_empty() {
         return Err(MeshError::NoHexes);
     }
@@ -287,149 +507,216 @@ fn compact(
     let mut mesh = HexMesh::default();
     for el in elems {
         let mut e = [0; 8];
-        for (a, id) in el.iter().enumerate() {
+        let mut x = [[0.0; 3]; 8];
+        for (a, id) in el.nodes.iter().enumerate() {
             let next = mesh.nodes.len();
             let idx = *map.entry(*id).or_insert(next);
             if idx == next {
-                let p = nodes
-                    .get(id)
-                    .ok_or_else(|| perr(0, format!("element references unknown node {id}")))?;
-                mesh.nodes.push([p[0] * scale, p[1] * scale, p[2] * scale]);
+                let (p, l) = nodes.0.get(id).ok_or(MeshError::UnknownNode {
+                    line: el.line + 1,
+                    element: el.id,
+                    node: *id,
+                })?;
+                let q = [p[0] * scale, p[1] * scale, p[2] * scale];
+                if q.iter().any(|v| !v.is_finite()) {
+                    return Err(perr(
+                        *l,
+                        format!("node {id}: coordinates times the scale {scale} are not finite"),
+                    ));
+                }
+                mesh.nodes.push(q);
             }
             e[a] = idx;
+            x[a] = nodes.0[id].0;
+        }
+        if let Err((kind, det, at)) = check_hex(&x) {
+            let at = match at {
+                Ok(a) => format!("corner {a} (node {})", el.nodes[a]),
+                Err(q) => format!("Gauss point {q}"),
+            };
+            return Err(MeshError::BadElement {
+                line: el.line + 1,
+                element: el.id,
+                kind,
+                det,
+                at,
+            });
         }
         mesh.elements.push(e);
     }
     Ok(mesh)
 }
 
+/// A count announced on 0-based line `l`, checked against the `left` lines that follow (each
+/// entry takes at least `per_entry` lines).
+fn announced(
+    v: i64,
+    l: usize,
+    what: &'static str,
+    left: usize,
+    per_entry: usize,
+) -> Result<usize, MeshError> {
+    if v < 0 {
+        return Err(perr(l, format!("negative number of {what} ({v})")));
+    }
+    let n = v as u64;
+    if n.saturating_mul(per_entry as u64) > left as u64 {
+        return Err(MeshError::AnnouncedSize {
+            line: l + 1,
+            announced: n,
+            what,
+            left,
+        });
+    }
+    Ok(n as usize)
+}
+
 /// Reads a Gmsh ASCII mesh (format 2.2 or 4.1); keeps hex8 elements (type 5). Coordinates are
-/// multiplied by `scale` (e.g. 1e-3 for a mesh in mm).
+/// multiplied by `scale` (e.g. 1e-3 for a mesh in mm). Refused with the line: non-finite
+/// coordinates, duplicate node ids, unknown nodes, inverted or degenerate elements, and counts
+/// the rest of the file cannot hold (nothing is allocated from an announced count).
 pub fn read_gmsh(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
+    if !(scale > 0.0 && scale.is_finite()) {
+        return Err(MeshError::BadScale(scale));
+    }
     let lines: Vec<&str> = text.lines().collect();
+    let line = |l: usize| lines.get(l).copied().unwrap_or("");
     let mut version = 2.2;
-    let mut nodes = HashMap::new();
+    let mut nodes = NodeTable::default();
     let mut elems = Vec::new();
     let mut i = 0;
     while i < lines.len() {
+        let left = |l: usize| lines.len().saturating_sub(l + 1);
         match lines[i].trim() {
             "$MeshFormat" => {
-                version = nums::<f64>(lines.get(i + 1).copied().unwrap_or(""), i + 1)?
+                version = nums::<f64>(line(i + 1), i + 1)?
                     .first()
                     .copied()
                     .unwrap_or(2.2);
+                if !(2.0..5.0).contains(&version) {
+                    return Err(perr(
+                        i + 1,
+                        format!(
+                            "Gmsh format {version} is not supported; export as 2.2 or 4.1 ASCII"
+                        ),
+                    ));
+                }
                 i += 2;
             }
             "$Nodes" if version < 4.0 => {
-                let n = nums::<usize>(lines.get(i + 1).copied().unwrap_or(""), i + 1)?
-                    .first()
-                    .copied()
-                    .unwrap_or(0);
+                let h = nums::<i64>(line(i + 1), i + 1)?;
+                let n = announced(
+                    h.first().copied().unwrap_or(0),
+                    i + 1,
+                    "nodes",
+                    left(i + 1),
+                    1,
+                )?;
                 for k in 0..n {
                     let l = i + 2 + k;
-                    let v = nums::<f64>(
-                        lines
-                            .get(l)
-                            .copied()
-                            .ok_or_else(|| perr(l, "missing node"))?,
-                        l,
-                    )?;
-                    if v.len() < 4 {
-                        return Err(perr(l, "node line needs id x y z"));
-                    }
-                    nodes.insert(v[0] as i64, [v[1], v[2], v[3]]);
+                    let (id, x) = node_line(line(l), l)?;
+                    nodes.insert(id, x, l)?;
                 }
                 i += 2 + n;
             }
             "$Nodes" => {
-                let h = nums::<usize>(lines.get(i + 1).copied().unwrap_or(""), i + 1)?;
-                let blocks = h.first().copied().unwrap_or(0);
+                let h = nums::<i64>(line(i + 1), i + 1)?;
+                let blocks = announced(
+                    h.first().copied().unwrap_or(0),
+                    i + 1,
+                    "node blocks",
+                    left(i + 1),
+                    1,
+                )?;
                 let mut l = i + 2;
                 for _ in 0..blocks {
-                    let b = nums::<usize>(
-                        lines
-                            .get(l)
-                            .copied()
-                            .ok_or_else(|| perr(l, "missing block"))?,
-                        l,
-                    )?;
-                    let n = *b.get(3).ok_or_else(|| perr(l, "bad node block header"))?;
-                    let tags: Vec<i64> = (0..n)
-                        .map(|k| {
-                            nums::<i64>(lines.get(l + 1 + k).copied().unwrap_or(""), l + 1 + k)
-                                .map(|v| v.first().copied().unwrap_or(-1))
-                        })
-                        .collect::<Result<_, _>>()?;
+                    let b = nums::<i64>(line(l), l)?;
+                    if b.len() < 4 {
+                        return Err(perr(
+                            l,
+                            "node block header needs entityDim entityTag parametric numNodes",
+                        ));
+                    }
+                    let n = announced(b[3], l, "nodes in the block", left(l), 2)?;
+                    let mut tags = Vec::new();
+                    for k in 0..n {
+                        let v = nums::<i64>(line(l + 1 + k), l + 1 + k)?;
+                        tags.push(
+                            *v.first()
+                                .ok_or_else(|| perr(l + 1 + k, "missing node tag"))?,
+                        );
+                    }
                     for (k, t) in tags.iter().enumerate() {
                         let ll = l + 1 + n + k;
-                        let v = nums::<f64>(
-                            lines
-                                .get(ll)
-                                .copied()
-                                .ok_or_else(|| perr(ll, "missing coordinates"))?,
-                            ll,
-                        )?;
-                        if v.len() < 3 {
-                            return Err(perr(ll, "need x y z"));
-                        }
-                        nodes.insert(*t, [v[0], v[1], v[2]]);
+                        let (_, x) = node_line(&format!("{t} {}", line(ll)), ll)?;
+                        nodes.insert(*t, x, ll)?;
                     }
                     l += 1 + 2 * n;
                 }
                 i = l;
             }
             "$Elements" if version < 4.0 => {
-                let n = nums::<usize>(lines.get(i + 1).copied().unwrap_or(""), i + 1)?
-                    .first()
-                    .copied()
-                    .unwrap_or(0);
+                let h = nums::<i64>(line(i + 1), i + 1)?;
+                let n = announced(
+                    h.first().copied().unwrap_or(0),
+                    i + 1,
+                    "elements",
+                    left(i + 1),
+                    1,
+                )?;
                 for k in 0..n {
                     let l = i + 2 + k;
-                    let v = nums::<i64>(
-                        lines
-                            .get(l)
-                            .copied()
-                            .ok_or_else(|| perr(l, "missing element"))?,
-                        l,
-                    )?;
+                    let v = nums::<i64>(line(l), l)?;
                     if v.len() >= 3 && v[1] == 5 {
-                        let nt = v[2] as usize;
-                        let c = v
-                            .get(3 + nt..3 + nt + 8)
-                            .ok_or_else(|| perr(l, "hex8 needs 8 nodes"))?;
-                        elems.push(c.try_into().map_err(|_| perr(l, "hex8 needs 8 nodes"))?);
+                        let nt = usize::try_from(v[2])
+                            .map_err(|_| perr(l, "negative number of tags"))?;
+                        let c = nt
+                            .checked_add(3)
+                            .and_then(|s| v.get(s..s.checked_add(8)?))
+                            .ok_or_else(|| {
+                                perr(l, format!("element {}: hex8 needs 8 nodes", v[0]))
+                            })?;
+                        elems.push(RawHex {
+                            id: v[0],
+                            nodes: c.try_into().map_err(|_| perr(l, "hex8 needs 8 nodes"))?,
+                            line: l,
+                        });
                     }
                 }
                 i += 2 + n;
             }
             "$Elements" => {
-                let h = nums::<usize>(lines.get(i + 1).copied().unwrap_or(""), i + 1)?;
-                let blocks = h.first().copied().unwrap_or(0);
+                let h = nums::<i64>(line(i + 1), i + 1)?;
+                let blocks = announced(
+                    h.first().copied().unwrap_or(0),
+                    i + 1,
+                    "element blocks",
+                    left(i + 1),
+                    1,
+                )?;
                 let mut l = i + 2;
                 for _ in 0..blocks {
-                    let b = nums::<i64>(
-                        lines
-                            .get(l)
-                            .copied()
-                            .ok_or_else(|| perr(l, "missing block"))?,
-                        l,
-                    )?;
+                    let b = nums::<i64>(line(l), l)?;
                     if b.len() < 4 {
-                        return Err(perr(l, "bad element block header"));
+                        return Err(perr(
+                            l,
+                            "element block header needs entityDim entityTag elementType numElements",
+                        ));
                     }
-                    let (ty, n) = (b[2], b[3] as usize);
+                    let ty = b[2];
+                    let n = announced(b[3], l, "elements in the block", left(l), 1)?;
                     for k in 0..n {
                         let ll = l + 1 + k;
                         if ty == 5 {
-                            let v = nums::<i64>(
-                                lines
-                                    .get(ll)
-                                    .copied()
-                                    .ok_or_else(|| perr(ll, "missing element"))?,
-                                ll,
-                            )?;
-                            let c = v.get(1..9).ok_or_else(|| perr(ll, "hex8 needs 8 nodes"))?;
-                            elems.push(c.try_into().map_err(|_| perr(ll, "hex8 needs 8 nodes"))?);
+                            let v = nums::<i64>(line(ll), ll)?;
+                            let c = v
+                                .get(1..9)
+                                .ok_or_else(|| perr(ll, "hex8 needs a tag and 8 nodes"))?;
+                            elems.push(RawHex {
+                                id: v[0],
+                                nodes: c.try_into().map_err(|_| perr(ll, "hex8 needs 8 nodes"))?,
+                                line: ll,
+                            });
                         }
                     }
                     l += 1 + n;
@@ -442,9 +729,15 @@ pub fn read_gmsh(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
     compact(&nodes, &elems, scale)
 }
 
-/// Reads the `*NODE` and `*ELEMENT, TYPE=C3D8`/`C3D8R`/`C3D8I` blocks of an Abaqus input file.
+/// Reads the `*NODE` and `*ELEMENT, TYPE=C3D8`/`C3D8R`/`C3D8I` blocks of an Abaqus input file
+/// (an element may continue over several lines). Refused with the line: non-finite
+/// coordinates, duplicate node ids, elements with more or fewer than 8 nodes, unknown nodes,
+/// inverted or degenerate elements.
 pub fn read_abaqus_inp(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
-    let mut nodes = HashMap::new();
+    if !(scale > 0.0 && scale.is_finite()) {
+        return Err(MeshError::BadScale(scale));
+    }
+    let mut nodes = NodeTable::default();
     let mut elems = Vec::new();
     #[derive(PartialEq)]
     enum Mode {
@@ -454,12 +747,26 @@ pub fn read_abaqus_inp(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
     }
     let mut mode = Mode::None;
     let mut pending: Vec<i64> = Vec::new();
+    let mut pending_line = 0;
+    let unfinished = |pending: &[i64], l: usize| {
+        perr(
+            l,
+            format!(
+                "element {}: C3D8 needs an id and 8 nodes, got {} node(s)",
+                pending[0],
+                pending.len() - 1
+            ),
+        )
+    };
     for (l, raw) in text.lines().enumerate() {
         let line = raw.trim();
         if line.starts_with("**") || line.is_empty() {
             continue;
         }
         if line.starts_with('*') {
+            if !pending.is_empty() {
+                return Err(unfinished(&pending, pending_line));
+            }
             let up = line.to_ascii_uppercase().replace(' ', "");
             mode = if up.starts_with("*NODE")
                 && !up.starts_with("*NODESET")
@@ -476,26 +783,44 @@ pub fn read_abaqus_inp(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
             } else {
                 Mode::None
             };
-            pending.clear();
             continue;
         }
         match mode {
             Mode::Node => {
-                let v = nums::<f64>(line, l)?;
-                if v.len() < 4 {
-                    return Err(perr(l, "node line needs id, x, y, z"));
-                }
-                nodes.insert(v[0] as i64, [v[1], v[2], v[3]]);
+                let (id, x) = node_line(line, l)?;
+                nodes.insert(id, x, l)?;
             }
             Mode::Hex => {
+                if pending.is_empty() {
+                    pending_line = l;
+                }
                 pending.extend(nums::<i64>(line, l)?);
-                if pending.len() >= 9 {
-                    elems.push(pending[1..9].try_into().expect("8 nodes"));
+                if pending.len() > 9 {
+                    return Err(perr(
+                        l,
+                        format!(
+                            "element {}: C3D8 needs an id and 8 nodes, got {} numbers",
+                            pending[0],
+                            pending.len()
+                        ),
+                    ));
+                }
+                if pending.len() == 9 {
+                    let mut c = [0i64; 8];
+                    c.copy_from_slice(&pending[1..9]);
+                    elems.push(RawHex {
+                        id: pending[0],
+                        nodes: c,
+                        line: pending_line,
+                    });
                     pending.clear();
                 }
             }
             Mode::None => {}
         }
+    }
+    if !pending.is_empty() {
+        return Err(unfinished(&pending, pending_line));
     }
     compact(&nodes, &elems, scale)
 }
