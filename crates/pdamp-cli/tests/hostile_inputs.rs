@@ -1263,10 +1263,21 @@ fn corpus() -> Vec<Case> {
         vec![(
             "s.toml",
             damper()
-                + "\n[fields]\nfrequencies_hz = { from = 10.0, to = 50.0, count = 100000 }\namplitudes_m = { from = 1e-4, to = 1e-3, count = 10000 }\n",
+                + "\n[fields]\nfrequencies_hz = { from = 0.01, to = 0.02, count = 1000 }\namplitudes_m = { from = 1e-4, to = 1e-3, count = 1000 }\n",
         )],
         1,
-        &["1000000000 points", "days"],
+        &["1000000 points", "memory"],
+    ));
+    v.push(case(
+        "fields: an axis of 1e11 values (found by the fuzzer: allocation abort)",
+        &["check", "{dir}/s.toml"],
+        vec![(
+            "s.toml",
+            damper()
+                + "\n[fields]\nfrequencies_hz = { from = 10.0, to = 50.0, count = 100000000000 }\namplitudes_m = [1e-3]\n",
+        )],
+        1,
+        &["fields.frequencies_hz.count"],
     ));
     // A VTK frame per time step of a damper point (50 steps per cycle at 10 kHz).
     scenario_cases(

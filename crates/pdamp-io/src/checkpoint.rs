@@ -245,7 +245,8 @@ impl CheckpointTimer {
     /// A timer firing every `interval_s` seconds of wall-clock time (≤ 0: never).
     pub fn new(interval_s: f64) -> Self {
         Self {
-            interval: if interval_s > 0.0 {
+            // (An interval beyond what a Duration holds, infinity included, means never.)
+            interval: if interval_s > 0.0 && interval_s < 1e15 {
                 std::time::Duration::from_secs_f64(interval_s)
             } else {
                 std::time::Duration::MAX

@@ -74,6 +74,7 @@ impl Estimate {
     /// The estimate of running `sc` once (a plain run or a damper point), or as a field of
     /// `points` points when `points > 1` (each with its packings), on `threads` threads.
     pub fn of(sc: &Scenario, points: usize, threads: usize) -> Self {
+        let threads = threads.max(1);
         let particles = sc
             .particles
             .iter()
@@ -84,10 +85,27 @@ impl Estimate {
         let settle = sc.settle.as_ref().map_or(0.0, |s| {
             s.max_duration_s + s.turn_max_duration_s.unwrap_or(0.0)
         });
+        // Samples of the driving force, velocity and time kept over the evaluated cycles of
+        // every point running at once (8 bytes each).
+        let mut sample_bytes = 0.0;
         let (simulated, energy_rows, vtk_frames) = match &sc.damper {
             Some(d) => {
-                let f = d.frequency_hz.unwrap_or_else(|| lowest_field_frequency(sc));
-                let point = f64::from(d.cycles) / f;
+                // Mean period of the points: the single point's, or over the field's frequencies.
+                let period = match (&sc.fields, d.frequency_hz) {
+                    (Some(f), _) if points > 1 => {
+                        let v = f.frequencies_hz.values();
+                        v.iter().map(|f| 1.0 / f).sum::<f64>() / v.len().max(1) as f64
+                    }
+                    (_, Some(f)) => 1.0 / f,
+                    (Some(_), None) => 1.0 / lowest_field_frequency(sc),
+                    (None, None) => 1.0,
+                };
+                let longest =
+                    1.0 / lowest_field_frequency(sc).min(d.frequency_hz.unwrap_or(f64::INFINITY));
+                let evaluated = f64::from(d.cycles.saturating_sub(d.transient_cycles));
+                let running = points.clamp(1, threads.max(1)) as f64;
+                sample_bytes = 3.0 * 8.0 * evaluated * longest / dt * running;
+                let point = f64::from(d.cycles) * period;
                 let packings = d.packings.max(1) as f64;
                 let n = points.max(1) as f64;
                 // Only a single point (`pdamp run`) writes VTK frames; field points do not.
@@ -111,10 +129,9 @@ impl Estimate {
         };
         let steps = simulated / dt;
         let particle_steps = steps * particles as f64;
-        let threads = threads.max(1);
         Self {
             particles,
-            memory_bytes: particles as f64 * BYTES_PER_PARTICLE,
+            memory_bytes: particles as f64 * BYTES_PER_PARTICLE + sample_bytes,
             simulated_time_s: simulated,
             steps,
             particle_steps,
@@ -145,10 +162,12 @@ impl Estimate {
             && self.memory_bytes > total
         {
             return Err(format!(
-                "particles: {} particles need about {:.1} GB of memory ({BYTES_PER_PARTICLE} bytes \
-                 each); this machine has {:.1} GB in all. Use fewer or larger particles",
-                self.particles,
+                "particles: the run needs about {:.1} GB of memory ({} particles × \
+                 {BYTES_PER_PARTICLE} bytes, plus the force and velocity samples of the \
+                 evaluated cycles of damper points); this process may use {:.1} GB in all. Use \
+                 fewer or larger particles, or fewer cycles at low frequencies",
                 gb(self.memory_bytes),
+                self.particles,
                 gb(total)
             ));
         }
@@ -160,10 +179,10 @@ impl Estimate {
             && self.memory_bytes > 0.9 * avail
         {
             return Err(format!(
-                "particles: {} particles need about {:.1} GB of memory, {:.1} GB are available \
-                 now {force}",
-                self.particles,
+                "particles: the run needs about {:.1} GB of memory ({} particles, plus the \
+                 samples of damper points), {:.1} GB are available now {force}",
                 gb(self.memory_bytes),
+                self.particles,
                 gb(avail)
             ));
         }
@@ -209,13 +228,13 @@ impl Estimate {
     }
 }
 
-/// Lowest frequency of the scenario's field grid (1 Hz if there is none).
+/// Lowest frequency of the scenario's field grid (infinite without a grid).
 fn lowest_field_frequency(sc: &Scenario) -> f64 {
     use crate::scenario::AxisSpec;
     match sc.fields.as_ref().map(|f| &f.frequencies_hz) {
         Some(AxisSpec::List(v)) => v.iter().copied().fold(f64::INFINITY, f64::min),
         Some(AxisSpec::Range { from, to, .. }) => from.min(*to),
-        None => 1.0,
+        None => f64::INFINITY,
     }
     .max(1e-3)
 }
@@ -232,7 +251,23 @@ pub fn memory_of_machine() -> (Option<f64>, Option<f64>) {
             .and_then(|v| v.parse::<f64>().ok())
             .map(|kb| kb * 1024.0)
     };
-    (field("MemTotal:"), field("MemAvailable:"))
+    let (total, available) = (field("MemTotal:"), field("MemAvailable:"));
+    // A limit on the address space (`ulimit -v`, a batch system's memory limit) caps both.
+    let limit = std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("Max address space"))
+                .and_then(|l| l.split_whitespace().nth(3))
+                .and_then(|v| v.parse::<f64>().ok())
+        });
+    match limit {
+        Some(l) => (
+            Some(total.map_or(l, |t| t.min(l))),
+            Some(available.map_or(l, |a| a.min(l))),
+        ),
+        None => (total, available),
+    }
 }
 
 #[cfg(test)]

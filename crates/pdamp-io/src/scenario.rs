@@ -211,6 +211,8 @@ fn default_packings() -> usize {
 /// Most packings of an ensemble.
 pub const MAX_PACKINGS: usize = 1000;
 
+/// Most values of one axis of a field grid.
+pub const MAX_AXIS_VALUES: usize = 10_000;
 /// Most excitation cycles of a damper point.
 pub const MAX_DAMPER_CYCLES: u32 = 100_000;
 /// Most phases per cycle of the velocity fields.
@@ -399,6 +401,14 @@ impl AxisSpec {
     }
 
     fn validate(&self, key: &str) -> Result<(), String> {
+        // The count first: `values` allocates it.
+        if let AxisSpec::Range { count, .. } = self
+            && *count > MAX_AXIS_VALUES
+        {
+            return Err(format!(
+                "{key}.count must be at most {MAX_AXIS_VALUES}, got {count}"
+            ));
+        }
         let v = self.values();
         if v.is_empty() {
             return Err(format!("{key}: no values"));
