@@ -77,7 +77,27 @@ struct CheckpointArgs {
     /// Wall-clock seconds between checkpoints (0 = only on Ctrl-C/SIGTERM).
     #[arg(long, default_value_t = 60.0)]
     checkpoint_interval_s: f64,
+    /// Replace the results of an earlier run in DIR (exactly the files it wrote; of a study:
+    /// every run folder, also one of another scenario).
+    #[arg(long, conflicts_with = "resume")]
+    overwrite: bool,
 }
+
+/// What `pdamp powder run` and `study` write (checked for links and inputs).
+const OUTPUTS: [&str; 12] = [
+    "tip.csv",
+    "envelope.csv",
+    "energy.csv",
+    "summary.json",
+    "tip.png",
+    "tip.svg",
+    "table.csv",
+    "decay.png",
+    "envelope.png",
+    "checkpoint.bin",
+    "provenance.json",
+    "input.toml",
+];
 
 impl CheckpointArgs {
     fn options(self) -> Result<cantilever::RunOptions> {
@@ -124,10 +144,22 @@ pub fn run(args: PowderArgs) -> Result<()> {
         PowderAction::Run { scenario, out, ck } => {
             let sc = load(&scenario)?;
             let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
-            let r = cantilever::run_in_dir(&sc, &out, ck.options()?, &mut progress)
-                .map_err(|e| anyhow!(e))?;
+            let options = ck.options()?;
+            let mut dir = crate::open_out(
+                &out,
+                ck.resume,
+                ck.overwrite,
+                Some(pdamp_io::checkpoint::CHECKPOINT_FILE),
+                &OUTPUTS,
+                &[scenario.as_path()],
+            )?;
+            let r = cantilever::run_in_dir(&sc, &out, options, &mut progress)
+                .map_err(|e| anyhow!(e))
+                .and_then(|r| traced.write(&out).map(|()| r));
+            dir.set_outcome(&r);
+            dir.close()?;
+            let r = r?;
             bar.finish_and_clear();
-            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&r)?);
             eprintln!("wrote {}", out.display());
         }
@@ -150,10 +182,24 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 ParamArg::D50 => StudyParameter::D50,
                 ParamArg::Orientation => StudyParameter::Orientation,
             };
+            // A study continues its finished runs (each checked against its scenario).
+            let mut dir = pdamp_io::output_dir::OutputDir::open(
+                &out,
+                if ck.overwrite {
+                    pdamp_io::output_dir::OutputMode::Overwrite
+                } else {
+                    pdamp_io::output_dir::OutputMode::Continue
+                },
+                &OUTPUTS,
+                &[scenario.as_path()],
+            )?;
             let rows = study::run_study(&sc, p, &values, &out, options, &mut progress)
-                .map_err(|e| anyhow!(e))?;
+                .map_err(|e| anyhow!(e))
+                .and_then(|r| traced.write(&out).map(|()| r));
+            dir.set_outcome(&rows);
+            dir.close()?;
+            let rows = rows?;
             bar.finish_and_clear();
-            traced.write(&out)?;
             println!("{}", serde_json::to_string_pretty(&rows)?);
             eprintln!("wrote {}", out.join("table.csv").display());
         }

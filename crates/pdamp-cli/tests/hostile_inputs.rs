@@ -1291,7 +1291,148 @@ fn corpus() -> Vec<Case> {
         "transient_cycles = 1\nmotion_output = { vtk_frames_per_cycle = 999 }",
         "vtk_frames_per_cycle",
     );
+    structure_and_powder_cases(&mut v);
     v
+}
+
+/// A small beam structure (`pdamp structure modes`).
+const BEAM: &str = r#"[structure]
+n_modes = 3
+min_frequency_hz = 1.0
+
+[structure.beam]
+length_m = 1.8
+elements = 30
+youngs_modulus_pa = 68e9
+poisson_ratio = 0.34
+density_kg_m3 = 2700.0
+area_m2 = 1138e-6
+second_moment_m4 = 166000e-12
+timoshenko = true
+planar = true
+masses = [{ position_m = 0.04, mass_kg = 1.0 }]
+
+[[structure.points]]
+name = "damper"
+position_m = 0.9
+"#;
+
+/// The structure and DEM–FEM commands: bad numbers, meshes and matrices, sizes.
+fn structure_and_powder_cases(v: &mut Vec<Case>) {
+    let modes = ["structure", "modes", "{dir}/s.toml", "--out", "{dir}/out"];
+    for (tag, from, to, expect) in [
+        ("beam length NaN", "length_m = 1.8", "length_m = nan", "length_m"),
+        ("beam length negative", "length_m = 1.8", "length_m = -1.8", "length_m"),
+        ("no elements", "elements = 30", "elements = 0", "elements"),
+        ("a billion elements", "elements = 30", "elements = 1000000000", "elements"),
+        ("Young's modulus inf", "youngs_modulus_pa = 68e9", "youngs_modulus_pa = inf", "youngs_modulus_pa"),
+        ("density zero", "density_kg_m3 = 2700.0", "density_kg_m3 = 0.0", "density_kg_m3"),
+        ("area NaN", "area_m2 = 1138e-6", "area_m2 = nan", "area_m2"),
+        ("point outside the beam", "position_m = 0.9", "position_m = 7.0", "position_m"),
+        ("mass outside the beam", "position_m = 0.04, mass_kg", "position_m = -1.0, mass_kg", "position_m"),
+        ("negative point mass", "mass_kg = 1.0", "mass_kg = -1.0", "mass_kg"),
+        ("no modes", "n_modes = 3", "n_modes = 0", "n_modes"),
+        ("a million modes", "n_modes = 3", "n_modes = 1000000", "n_modes"),
+    ] {
+        assert!(BEAM.contains(from), "{tag}");
+        let mut c = case(
+            &format!("structure modes: {tag}"),
+            &modes,
+            vec![("s.toml", BEAM.replacen(from, to, 1))],
+            1,
+            &[expect],
+        );
+        c.no_out = true;
+        v.push(c);
+    }
+    // Matrix Market structures.
+    let mm = |k: &str, m: &str| {
+        vec![
+            (
+                "s.toml",
+                "[structure]\nn_modes = 1\nmin_frequency_hz = 0.0\n\n[structure.matrix_market]\nstiffness = \"K.mtx\"\nmass = \"M.mtx\"\ndof_map = \"dofs.txt\"\n\n[[structure.points]]\nname = \"tip\"\nnode = 2\ndof = \"UY\"\n"
+                    .to_string(),
+            ),
+            ("dofs.txt", "1 1 UY\n2 2 UY\n".to_string()),
+            ("K.mtx", k.to_string()),
+            ("M.mtx", m.to_string()),
+        ]
+    };
+    let head = "%%MatrixMarket matrix coordinate real symmetric\n";
+    let good_m = format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n");
+    for (tag, k, m, expect) in [
+        ("stiffness with NaN", format!("{head}2 2 2\n1 1 nan\n2 2 1.0\n"), good_m.clone(), "K.mtx"),
+        ("stiffness announcing 1e11 rows", format!("{head}100000000000 100000000000 1\n1 1 1.0\n"), good_m.clone(), "K.mtx"),
+        ("stiffness with a duplicate entry", format!("{head}2 2 3\n1 1 1.0\n1 1 1.0\n2 2 1.0\n"), good_m.clone(), "K.mtx"),
+        ("mass not positive definite", format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"), format!("{head}2 2 2\n1 1 -1.0\n2 2 1.0\n"), "M.mtx"),
+        ("stiffness of garbage", "\u{0}\u{1}garbage".to_string(), good_m.clone(), "K.mtx"),
+        ("missing mass file", format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"), String::new(), "M.mtx"),
+    ] {
+        let mut files = mm(&k, &m);
+        if m.is_empty() {
+            files.pop();
+        }
+        let mut c = case(&format!("structure modes: {tag}"), &modes, files, 1, &[expect]);
+        c.no_out = true;
+        v.push(c);
+    }
+    // DEM–FEM (powder) scenarios.
+    let tiny = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../pdamp-powder/tests/data/tiny_cantilever.toml"),
+    )
+    .unwrap();
+    let prun = ["powder", "run", "{dir}/s.toml", "--out", "{dir}/out"];
+    for (tag, from, to, expect) in [
+        ("pressure 1e300", "pressure_pa = 1e5", "pressure_pa = 1e300", "pressure_pa"),
+        ("pressure NaN", "pressure_pa = 1e5", "pressure_pa = nan", "pressure_pa"),
+        ("D50 NaN", "d50_m = 3e-3", "d50_m = nan", "d50_m"),
+        ("D50 of a micrometre (1e11 particles)", "d50_m = 3e-3", "d50_m = 1e-7", "d50_m"),
+        ("sigma 50", "sigma = 0.2707", "sigma = 50.0", "sigma"),
+        ("stiffness inf", "normal_stiffness_n_m = 5642.0", "normal_stiffness_n_m = inf", "normal_stiffness_n_m"),
+        ("restitution 2", "restitution = 0.4", "restitution = 2.0", "restitution"),
+        ("packing density 0.9", "packing_density = 0.45", "packing_density = 0.9", "packing_density"),
+        ("time step NaN", "time_step_s = 5e-6", "time_step_s = nan", "time_step_s"),
+        ("time step 1 s", "time_step_s = 5e-6", "time_step_s = 1.0", "time_step_s"),
+        ("duration of a year", "duration_s = 1e-3", "duration_s = 3e7", "duration_s"),
+        ("wall element zero", "wall_element_m = 0.001", "wall_element_m = 0.0", "wall_element_m"),
+        ("beam modulus NaN", "youngs_modulus_pa = 175e9", "youngs_modulus_pa = nan", "youngs_modulus_pa"),
+    ] {
+        assert!(tiny.contains(from), "{tag}");
+        let mut c = case(
+            &format!("powder run: {tag}"),
+            &prun,
+            vec![("s.toml", tiny.replacen(from, to, 1))],
+            1,
+            &[expect],
+        );
+        c.no_out = true;
+        v.push(c);
+    }
+    let mut c = case(
+        "powder run: checkpoint interval inf",
+        &["powder", "run", "{dir}/s.toml", "--out", "{dir}/out", "--checkpoint-interval-s", "inf"],
+        vec![("s.toml", tiny.clone())],
+        1,
+        &["--checkpoint-interval-s"],
+    );
+    c.no_out = true;
+    v.push(c);
+    let mut c = case(
+        "powder study: NaN value",
+        &["powder", "study", "{dir}/s.toml", "--parameter", "friction", "--values", "0.1,nan", "--out", "{dir}/out"],
+        vec![("s.toml", tiny.clone())],
+        1,
+        &["NaN"],
+    );
+    c.no_out = true;
+    v.push(c);
+    v.push(case(
+        "powder run: --out holds results of another run",
+        &["powder", "run", "{dir}/s.toml", "--out", "{dir}/out"],
+        vec![("s.toml", tiny), ("out/summary.json", "{}".to_string())],
+        1,
+        &["already holds the results"],
+    ));
 }
 
 /// Runs one case under a 2 GB address-space limit and a time limit; returns the problems.
