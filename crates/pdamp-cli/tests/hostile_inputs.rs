@@ -1321,18 +1321,63 @@ position_m = 0.9
 fn structure_and_powder_cases(v: &mut Vec<Case>) {
     let modes = ["structure", "modes", "{dir}/s.toml", "--out", "{dir}/out"];
     for (tag, from, to, expect) in [
-        ("beam length NaN", "length_m = 1.8", "length_m = nan", "length_m"),
-        ("beam length negative", "length_m = 1.8", "length_m = -1.8", "length_m"),
+        (
+            "beam length NaN",
+            "length_m = 1.8",
+            "length_m = nan",
+            "length_m",
+        ),
+        (
+            "beam length negative",
+            "length_m = 1.8",
+            "length_m = -1.8",
+            "length_m",
+        ),
         ("no elements", "elements = 30", "elements = 0", "elements"),
-        ("a billion elements", "elements = 30", "elements = 1000000000", "elements"),
-        ("Young's modulus inf", "youngs_modulus_pa = 68e9", "youngs_modulus_pa = inf", "youngs_modulus_pa"),
-        ("density zero", "density_kg_m3 = 2700.0", "density_kg_m3 = 0.0", "density_kg_m3"),
+        (
+            "a billion elements",
+            "elements = 30",
+            "elements = 1000000000",
+            "elements",
+        ),
+        (
+            "Young's modulus inf",
+            "youngs_modulus_pa = 68e9",
+            "youngs_modulus_pa = inf",
+            "youngs_modulus_pa",
+        ),
+        (
+            "density zero",
+            "density_kg_m3 = 2700.0",
+            "density_kg_m3 = 0.0",
+            "density_kg_m3",
+        ),
         ("area NaN", "area_m2 = 1138e-6", "area_m2 = nan", "area_m2"),
-        ("point outside the beam", "position_m = 0.9", "position_m = 7.0", "position_m"),
-        ("mass outside the beam", "position_m = 0.04, mass_kg", "position_m = -1.0, mass_kg", "position_m"),
-        ("negative point mass", "mass_kg = 1.0", "mass_kg = -1.0", "mass_kg"),
+        (
+            "point outside the beam",
+            "position_m = 0.9",
+            "position_m = 7.0",
+            "position_m",
+        ),
+        (
+            "mass outside the beam",
+            "position_m = 0.04, mass_kg",
+            "position_m = -1.0, mass_kg",
+            "position_m",
+        ),
+        (
+            "negative point mass",
+            "mass_kg = 1.0",
+            "mass_kg = -1.0",
+            "mass_kg",
+        ),
         ("no modes", "n_modes = 3", "n_modes = 0", "n_modes"),
-        ("a million modes", "n_modes = 3", "n_modes = 1000000", "n_modes"),
+        (
+            "a million modes",
+            "n_modes = 3",
+            "n_modes = 1000000",
+            "n_modes",
+        ),
     ] {
         assert!(BEAM.contains(from), "{tag}");
         let mut c = case(
@@ -1361,41 +1406,133 @@ fn structure_and_powder_cases(v: &mut Vec<Case>) {
     let head = "%%MatrixMarket matrix coordinate real symmetric\n";
     let good_m = format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n");
     for (tag, k, m, expect) in [
-        ("stiffness with NaN", format!("{head}2 2 2\n1 1 nan\n2 2 1.0\n"), good_m.clone(), "K.mtx"),
-        ("stiffness announcing 1e11 rows", format!("{head}100000000000 100000000000 1\n1 1 1.0\n"), good_m.clone(), "K.mtx"),
-        ("stiffness with a duplicate entry", format!("{head}2 2 3\n1 1 1.0\n1 1 1.0\n2 2 1.0\n"), good_m.clone(), "K.mtx"),
-        ("mass not positive definite", format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"), format!("{head}2 2 2\n1 1 -1.0\n2 2 1.0\n"), "M.mtx"),
-        ("stiffness of garbage", "\u{0}\u{1}garbage".to_string(), good_m.clone(), "K.mtx"),
-        ("missing mass file", format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"), String::new(), "M.mtx"),
+        (
+            "stiffness with NaN",
+            format!("{head}2 2 2\n1 1 nan\n2 2 1.0\n"),
+            good_m.clone(),
+            "K.mtx",
+        ),
+        (
+            "stiffness announcing 1e11 rows",
+            format!("{head}100000000000 100000000000 1\n1 1 1.0\n"),
+            good_m.clone(),
+            "K.mtx",
+        ),
+        (
+            "stiffness with a duplicate entry",
+            format!("{head}2 2 3\n1 1 1.0\n1 1 1.0\n2 2 1.0\n"),
+            good_m.clone(),
+            "K.mtx",
+        ),
+        (
+            "mass not positive definite",
+            format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"),
+            format!("{head}2 2 2\n1 1 -1.0\n2 2 1.0\n"),
+            "M.mtx",
+        ),
+        (
+            "stiffness of garbage",
+            "\u{0}\u{1}garbage".to_string(),
+            good_m.clone(),
+            "K.mtx",
+        ),
+        (
+            "missing mass file",
+            format!("{head}2 2 2\n1 1 1.0\n2 2 1.0\n"),
+            String::new(),
+            "M.mtx",
+        ),
     ] {
         let mut files = mm(&k, &m);
         if m.is_empty() {
             files.pop();
         }
-        let mut c = case(&format!("structure modes: {tag}"), &modes, files, 1, &[expect]);
+        let mut c = case(
+            &format!("structure modes: {tag}"),
+            &modes,
+            files,
+            1,
+            &[expect],
+        );
         c.no_out = true;
         v.push(c);
     }
     // DEM–FEM (powder) scenarios.
     let tiny = std::fs::read_to_string(
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../pdamp-powder/tests/data/tiny_cantilever.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../pdamp-powder/tests/data/tiny_cantilever.toml"),
     )
     .unwrap();
     let prun = ["powder", "run", "{dir}/s.toml", "--out", "{dir}/out"];
     for (tag, from, to, expect) in [
-        ("pressure 1e300", "pressure_pa = 1e5", "pressure_pa = 1e300", "pressure_pa"),
-        ("pressure NaN", "pressure_pa = 1e5", "pressure_pa = nan", "pressure_pa"),
+        (
+            "pressure 1e300",
+            "pressure_pa = 1e5",
+            "pressure_pa = 1e300",
+            "pressure_pa",
+        ),
+        (
+            "pressure NaN",
+            "pressure_pa = 1e5",
+            "pressure_pa = nan",
+            "pressure_pa",
+        ),
         ("D50 NaN", "d50_m = 3e-3", "d50_m = nan", "d50_m"),
-        ("D50 of a micrometre (1e11 particles)", "d50_m = 3e-3", "d50_m = 1e-7", "d50_m"),
+        (
+            "D50 of a micrometre (1e11 particles)",
+            "d50_m = 3e-3",
+            "d50_m = 1e-7",
+            "d50_m",
+        ),
         ("sigma 50", "sigma = 0.2707", "sigma = 50.0", "sigma"),
-        ("stiffness inf", "normal_stiffness_n_m = 5642.0", "normal_stiffness_n_m = inf", "normal_stiffness_n_m"),
-        ("restitution 2", "restitution = 0.4", "restitution = 2.0", "restitution"),
-        ("packing density 0.9", "packing_density = 0.45", "packing_density = 0.9", "packing_density"),
-        ("time step NaN", "time_step_s = 5e-6", "time_step_s = nan", "time_step_s"),
-        ("time step 1 s", "time_step_s = 5e-6", "time_step_s = 1.0", "time_step_s"),
-        ("duration of a year", "duration_s = 1e-3", "duration_s = 3e7", "duration_s"),
-        ("wall element zero", "wall_element_m = 0.001", "wall_element_m = 0.0", "wall_element_m"),
-        ("beam modulus NaN", "youngs_modulus_pa = 175e9", "youngs_modulus_pa = nan", "youngs_modulus_pa"),
+        (
+            "stiffness inf",
+            "normal_stiffness_n_m = 5642.0",
+            "normal_stiffness_n_m = inf",
+            "normal_stiffness_n_m",
+        ),
+        (
+            "restitution 2",
+            "restitution = 0.4",
+            "restitution = 2.0",
+            "restitution",
+        ),
+        (
+            "packing density 0.9",
+            "packing_density = 0.45",
+            "packing_density = 0.9",
+            "packing_density",
+        ),
+        (
+            "time step NaN",
+            "time_step_s = 5e-6",
+            "time_step_s = nan",
+            "time_step_s",
+        ),
+        (
+            "time step 1 s",
+            "time_step_s = 5e-6",
+            "time_step_s = 1.0",
+            "time_step_s",
+        ),
+        (
+            "duration of a year",
+            "duration_s = 1e-3",
+            "duration_s = 3e7",
+            "duration_s",
+        ),
+        (
+            "wall element zero",
+            "wall_element_m = 0.001",
+            "wall_element_m = 0.0",
+            "wall_element_m",
+        ),
+        (
+            "beam modulus NaN",
+            "youngs_modulus_pa = 175e9",
+            "youngs_modulus_pa = nan",
+            "youngs_modulus_pa",
+        ),
     ] {
         assert!(tiny.contains(from), "{tag}");
         let mut c = case(
@@ -1410,7 +1547,15 @@ fn structure_and_powder_cases(v: &mut Vec<Case>) {
     }
     let mut c = case(
         "powder run: checkpoint interval inf",
-        &["powder", "run", "{dir}/s.toml", "--out", "{dir}/out", "--checkpoint-interval-s", "inf"],
+        &[
+            "powder",
+            "run",
+            "{dir}/s.toml",
+            "--out",
+            "{dir}/out",
+            "--checkpoint-interval-s",
+            "inf",
+        ],
         vec![("s.toml", tiny.clone())],
         1,
         &["--checkpoint-interval-s"],
@@ -1419,7 +1564,17 @@ fn structure_and_powder_cases(v: &mut Vec<Case>) {
     v.push(c);
     let mut c = case(
         "powder study: NaN value",
-        &["powder", "study", "{dir}/s.toml", "--parameter", "friction", "--values", "0.1,nan", "--out", "{dir}/out"],
+        &[
+            "powder",
+            "study",
+            "{dir}/s.toml",
+            "--parameter",
+            "friction",
+            "--values",
+            "0.1,nan",
+            "--out",
+            "{dir}/out",
+        ],
         vec![("s.toml", tiny.clone())],
         1,
         &["NaN"],
@@ -1451,11 +1606,11 @@ fn run_case(c: &Case, root: &Path, k: usize) -> Vec<String> {
         .map(|a| a.replace("{dir}", &dir.to_string_lossy()))
         .collect();
     let quoted: Vec<String> = args.iter().map(|a| format!("'{a}'")).collect();
-    let script = format!(
-        "ulimit -v 4000000; exec '{}' {}",
-        env!("CARGO_BIN_EXE_pdamp"),
-        quoted.join(" ")
-    );
+    // PDAMP_HOSTILE_BIN runs the corpus against another build (e.g. an older release, to count
+    // the defects it had).
+    let bin = std::env::var("PDAMP_HOSTILE_BIN")
+        .unwrap_or_else(|_| env!("CARGO_BIN_EXE_pdamp").to_string());
+    let script = format!("ulimit -v 4000000; exec '{bin}' {}", quoted.join(" "));
     let start = Instant::now();
     let mut child = Command::new("sh")
         .args(["-c", &script])

@@ -462,6 +462,43 @@ fn a_second_run_into_a_busy_directory_is_refused() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// An output name that is a symbolic link out of the directory is refused; its target is
+/// left as it was (energy.csv used to be truncated through the link).
+#[cfg(unix)]
+#[test]
+fn outputs_are_never_written_through_a_link() {
+    let d = scratch("link");
+    let scn = scenario(&d);
+    let out = d.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    // The VTK folder as a link to a folder of the user's.
+    let target = d.join("precious");
+    std::fs::create_dir_all(&target).unwrap();
+    std::fs::write(target.join("notes.txt"), "keep me").unwrap();
+    std::os::unix::fs::symlink(&target, out.join("vtk")).unwrap();
+    let o = run(&scn, &out, "1", &[]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("symbolic link"), "{err}");
+    assert_eq!(std::fs::read_dir(&target).unwrap().count(), 1);
+    // A stale energy.csv linked out of the directory: --overwrite removes the link, not the
+    // file it points to.
+    std::fs::remove_file(out.join("vtk")).unwrap();
+    let file = d.join("precious.csv");
+    std::fs::write(&file, "keep me").unwrap();
+    std::os::unix::fs::symlink(&file, out.join("energy.csv")).unwrap();
+    let o = run(&scn, &out, "1", &["--overwrite"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me");
+    assert!(
+        !std::fs::symlink_metadata(out.join("energy.csv"))
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Sends SIGINT to a process.
 fn sigint(pid: u32) {
     let st = Command::new("kill")
