@@ -454,7 +454,7 @@ fn dispatch(command: Command) -> Result<()> {
                 velocity_m_s,
                 steps_per_contact: 2000.0,
             });
-            let v = serde_json::to_value(&r)?;
+            let v = serde_json::to_value(r)?;
             if let Some(bad) = v.as_object().and_then(|o| {
                 o.iter()
                     .find(|(_, x)| x.is_null() || x.as_f64().is_some_and(|x| !x.is_finite()))

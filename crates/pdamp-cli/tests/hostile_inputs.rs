@@ -1173,7 +1173,7 @@ fn corpus() -> Vec<Case> {
             "--duration-s",
         ),
     ] {
-        let mut c = case(&format!("{tag}"), &args, Vec::new(), code, &[expect]);
+        let mut c = case(tag, &args, Vec::new(), code, &[expect]);
         c.no_out = true;
         v.push(c);
     }
