@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use pdamp_impact::study::{CorModel, cor_curve};
+use pdamp_impact::study::{CorModel, cor_curve_with};
 use pdamp_impact::{FeOptions, MaterialSet, MeshDensity, Partner};
 use pdamp_plot::{Axis, LinePlot, Marker, Series, line_plot};
 
@@ -156,7 +156,17 @@ pub fn run(a: CorArgs) -> Result<()> {
         &inputs,
     )?;
     let start = std::time::Instant::now();
-    let pts = cor_curve(&sphere, &partner, a.sphere_radius_m, &vs, model, a.repeat);
+    let bar = crate::progress::Progress::new();
+    let pts = cor_curve_with(
+        &sphere,
+        &partner,
+        a.sphere_radius_m,
+        &vs,
+        model,
+        a.repeat,
+        &|done, total| bar.count("impacts", done, total),
+    );
+    bar.finish();
     if let Some((p, why)) = pts.iter().find_map(|p| {
         p.fe.as_ref()
             .and_then(|r| r.failure.as_ref())

@@ -4,7 +4,6 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use indicatif::{ProgressBar, ProgressStyle};
 use pdamp_dem::Material;
 use pdamp_dem::contact::NormalLaw;
 use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
@@ -14,6 +13,7 @@ mod cor;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod powder;
+mod progress;
 mod structure;
 
 #[derive(Parser)]
@@ -30,6 +30,9 @@ struct Cli {
     /// frames, rows, a month of run time); the limits of the machine stay.
     #[arg(long, global = true)]
     force: bool,
+    /// No progress output (bars on a terminal, lines every few seconds elsewhere).
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -302,6 +305,7 @@ fn main() -> std::process::ExitCode {
 fn run_cli() -> Result<()> {
     let cli = Cli::parse();
     pdamp_io::estimate::set_force(cli.force);
+    progress::set_quiet(cli.quiet);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let threads = match cli.threads {
         Some(0) => bail!("--threads must be >= 1 (leave it out to use all {cores} cores)"),
@@ -705,17 +709,8 @@ fn cmd_run(
         &RUN_OUTPUTS,
         &inputs,
     )?;
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let tick = |phase: &str, f: f64| {
-        bar.set_message(phase.to_string());
-        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-    };
+    let bar = progress::Progress::new();
+    let tick = |phase: &str, f: f64| bar.set(phase, f);
     let json = if sc.damper.is_some() {
         if options.resume
             && let Some(text) = pdamp_design::report::finished_damper_summary(&sc, &base, out)
@@ -735,7 +730,7 @@ fn cmd_run(
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     };
     dir.close()?;
-    bar.finish_and_clear();
+    bar.finish();
     println!("{json}");
     Ok(())
 }
@@ -775,13 +770,7 @@ fn cmd_fields(
         .parent()
         .map(|p| p.to_path_buf())
         .unwrap_or_default();
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>9} [{elapsed_precise}] {wide_bar} {pos}/{len} eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = progress::Progress::new();
     #[cfg(feature = "gpu")]
     let gpu = match device {
         Device::Gpu => Some(pdamp_gpu::GpuDevice::open()?),
@@ -810,24 +799,19 @@ fn cmd_fields(
         &RUN_OUTPUTS,
         &inputs,
     )?;
-    bar.set_message("settling");
     let start = std::time::Instant::now();
     let outcome = pdamp_design::report::run_fields_scenario_on(
         &sc,
         &base,
         out,
         engine,
-        |f| bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64),
-        |done, total| {
-            bar.set_message("points");
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-        },
+        |f| bar.set("settling", f),
+        |done, total| bar.count("points", done, total),
     );
     dir.set_outcome(&outcome);
     dir.close()?;
     let outcome = outcome.map_err(anyhow::Error::msg)?;
-    bar.finish_and_clear();
+    bar.finish();
     for (f, x, e) in &outcome.failed {
         eprintln!(
             "warning: point f = {f} Hz, X = {x:.4e} m failed (NaN in fields.csv, retried on the next run): {e}"
@@ -880,21 +864,12 @@ fn cmd_settle(
         .parent()
         .map(|p| p.to_path_buf())
         .unwrap_or_default();
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>9} [{elapsed_precise}] {wide_bar} {percent:>3}% eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let s = pdamp_io::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| {
-        bar.set_message(phase.to_string());
-        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-    });
+    let bar = progress::Progress::new();
+    let s = pdamp_io::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| bar.set(phase, f));
     dir.set_outcome(&s);
     dir.close()?;
     let s = s.map_err(anyhow::Error::msg)?;
-    bar.finish_and_clear();
+    bar.finish();
     println!("{}", serde_json::to_string_pretty(&s)?);
     Ok(())
 }

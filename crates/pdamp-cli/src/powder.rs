@@ -126,20 +126,8 @@ fn seed_of(sc: &CantileverScenario) -> u64 {
 
 /// Runs `pdamp powder …`.
 pub fn run(args: PowderArgs) -> Result<()> {
-    let bar = indicatif::ProgressBar::new(1000);
-    // without a terminal (background runs) print a line per stage and 5 % step on stderr
-    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let clock = std::time::Instant::now();
-    let mut last = (String::new(), -1i64);
-    let mut progress = |stage: &str, f: f64| {
-        bar.set_message(stage.to_string());
-        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64);
-        let pct = (f * 20.0).floor() as i64 * 5;
-        if !tty && (stage != last.0 || pct != last.1) {
-            eprintln!("[{:8.1} s] {stage} {pct} %", clock.elapsed().as_secs_f64());
-            last = (stage.to_string(), pct);
-        }
-    };
+    let bar = crate::progress::Progress::new();
+    let mut progress = |stage: &str, f: f64| bar.set(stage, f);
     match args.action {
         PowderAction::Run { scenario, out, ck } => {
             let sc = load(&scenario)?;
@@ -159,7 +147,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             dir.set_outcome(&r);
             dir.close()?;
             let r = r?;
-            bar.finish_and_clear();
+            bar.finish();
             println!("{}", serde_json::to_string_pretty(&r)?);
             eprintln!("wrote {}", out.display());
         }
@@ -199,7 +187,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             dir.set_outcome(&rows);
             dir.close()?;
             let rows = rows?;
-            bar.finish_and_clear();
+            bar.finish();
             println!("{}", serde_json::to_string_pretty(&rows)?);
             eprintln!("wrote {}", out.join("table.csv").display());
         }
@@ -207,7 +195,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             let sc = load(&scenario)?;
             let f = cantilever::empty_beam_modes(&sc.beam, count).map_err(|e| anyhow!(e))?;
             let timo = cantilever::timoshenko_reference(&sc.beam);
-            bar.finish_and_clear();
+            bar.finish();
             println!(
                 "{}",
                 serde_json::json!({ "frequencies_hz": f, "timoshenko_f1_hz": timo, "dofs": 3 * sc.beam.mesh().nodes.len() })

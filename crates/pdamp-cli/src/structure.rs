@@ -250,7 +250,7 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
 /// Runs `pdamp couple`.
 pub fn run_couple(args: CoupleArgs) -> Result<()> {
     let traced = crate::Traced::start(Some(&args.scenario), 0);
-    let bar = indicatif::ProgressBar::new(1000);
+    let bar = crate::progress::Progress::new();
     if !(args.checkpoint_interval_s.is_finite() && args.checkpoint_interval_s >= 0.0) {
         return Err(anyhow!(
             "--checkpoint-interval-s must be a finite number of seconds >= 0 (0 = only on Ctrl-C), got {}",
@@ -270,14 +270,14 @@ pub fn run_couple(args: CoupleArgs) -> Result<()> {
         || {
             let s =
                 pdamp_structure::report::run_couple(&args.scenario, &args.out, options, &mut |f| {
-                    bar.set_position((f * 1000.0) as u64)
+                    bar.set("running", f)
                 })
                 .map_err(|e| anyhow!(e))?;
             traced.write(&args.out)?;
             Ok(s)
         },
     )?;
-    bar.finish_and_clear();
+    bar.finish();
     println!("{}", serde_json::to_string_pretty(&s)?);
     eprintln!("wrote {}", args.out.display());
     Ok(())

@@ -174,7 +174,36 @@ pub fn cor_curve(
     model: CorModel,
     repeat: usize,
 ) -> Vec<CorPoint> {
+    cor_curve_with(
+        sphere,
+        partner,
+        radius,
+        velocities,
+        model,
+        repeat,
+        &|_, _| {},
+    )
+}
+
+/// [`cor_curve`] calling `on_impact(done, total)` after every impact (from the worker threads).
+pub fn cor_curve_with(
+    sphere: &Material,
+    partner: &Partner,
+    radius: f64,
+    velocities: &[f64],
+    model: CorModel,
+    repeat: usize,
+    on_impact: &(dyn Fn(usize, usize) + Sync),
+) -> Vec<CorPoint> {
     let repeat = repeat.max(1);
+    let total = velocities.len() * repeat;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let tick = || {
+        on_impact(
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+            total,
+        )
+    };
     let per_v: Vec<Vec<CorPoint>> = velocities
         .par_iter()
         .map(|&v| match model {
@@ -183,6 +212,7 @@ pub fn cor_curve(
                 (1..=repeat)
                     .map(|k| {
                         let r = fe.run(v);
+                        tick();
                         CorPoint {
                             velocity_m_s: v,
                             impact: k,
@@ -195,9 +225,12 @@ pub fn cor_curve(
                     .collect()
             }
             _ => (1..=repeat)
-                .map(|k| CorPoint {
-                    impact: k,
-                    ..analytical(sphere, partner, radius, v, model)
+                .map(|k| {
+                    tick();
+                    CorPoint {
+                        impact: k,
+                        ..analytical(sphere, partner, radius, v, model)
+                    }
                 })
                 .collect(),
         })
