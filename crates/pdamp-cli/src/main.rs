@@ -97,6 +97,12 @@ enum Command {
         /// Scenario file (TOML).
         scenario: PathBuf,
     },
+    /// Print a shell completion script: `pdamp completions bash > ~/.local/share/bash-completion/completions/pdamp`
+    /// (zsh: into a folder of `$fpath` as `_pdamp`; fish: `~/.config/fish/completions/pdamp.fish`).
+    Completions {
+        /// Shell.
+        shell: clap_complete::Shell,
+    },
     /// Print the built-in example scenario as TOML.
     Example {
         /// Number of particles.
@@ -359,6 +365,17 @@ fn dispatch(command: Command) -> Result<()> {
             overwrite,
         } => cmd_fields(&scenario, &out, device, overwrite),
         Command::Check { scenario } => cmd_check(&scenario),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            // Into a buffer first: a closed pipe (`| head`) is not an error worth a panic.
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "pdamp", &mut script);
+            use std::io::Write;
+            match std::io::stdout().write_all(&script) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+                _ => Ok(()),
+            }
+        }
         Command::Settle {
             scenario,
             out,

@@ -161,3 +161,19 @@ fn run_fields_cor_and_settle_print_progress_lines_without_a_terminal() {
     assert!(lines(&err, "").is_empty(), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `pdamp completions bash|zsh|fish` prints a completion script naming the commands.
+#[test]
+fn completion_scripts_for_three_shells() {
+    for shell in ["bash", "zsh", "fish"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_pdamp"))
+            .args(["completions", shell])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{shell}");
+        let text = String::from_utf8_lossy(&o.stdout);
+        for cmd in ["run", "fields", "settle", "couple", "powder", "overwrite"] {
+            assert!(text.contains(cmd), "{shell} script lacks {cmd}");
+        }
+    }
+}
