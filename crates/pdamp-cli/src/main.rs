@@ -545,6 +545,7 @@ fn dispatch(command: Command) -> Result<()> {
                         "particle_steps_per_s": r.particle_steps_per_s,
                         "neighbor_builds": r.neighbor_builds,
                         "contacts_pp": r.contacts_pp,
+                        "settling_wall_time_s": r.settling_wall_time_s,
                     })
                 );
                 return Ok(());
