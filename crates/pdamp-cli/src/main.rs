@@ -565,7 +565,9 @@ fn dispatch(command: Command) -> Result<()> {
 
 /// Files and folders the DEM commands write into their output directory (checked for
 /// symbolic links and for inputs they would replace before anything is written).
-const RUN_OUTPUTS: [&str; 14] = [
+const RUN_OUTPUTS: [&str; 16] = [
+    "energy.png",
+    "energy.svg",
     "scenario.toml",
     "provenance.json",
     "summary.json",
@@ -675,6 +677,41 @@ fn scenario_inputs(
         .collect()
 }
 
+/// `DIR/energy.png` and `.svg` of a plain run: the terms of the energy ledger over time
+/// (kinetic, potential and elastic energy as changes from the start, work of the walls,
+/// dissipation and the balance residual W − ΔE − D, which stays at zero in a healthy run).
+fn energy_plot(out: &std::path::Path) -> Result<(), String> {
+    use pdamp_plot::{Axis, LinePlot, Series, line_plot};
+    let (_, rows) =
+        pdamp_io::csv::read_csv_f64(out.join("energy.csv")).map_err(|e| format!("output: {e}"))?;
+    let Some(first) = rows.first() else {
+        return Ok(());
+    };
+    let col = |k: usize| -> Vec<f64> { rows.iter().map(|r| r[k]).collect() };
+    let delta = |k: usize| -> Vec<f64> { rows.iter().map(|r| r[k] - first[k]).collect() };
+    let t = col(0);
+    let dissipated: Vec<f64> = rows.iter().map(|r| r[5] + r[6]).collect();
+    let residual: Vec<f64> = rows
+        .iter()
+        .map(|r| r[4] - (r[1] - first[1]) - (r[2] - first[2]) - (r[3] - first[3]) - (r[5] + r[6]))
+        .collect();
+    let mut plot = LinePlot::new(Axis::linear("time (s)"), Axis::linear("energy (J)"));
+    plot.title = "energy ledger".to_string();
+    for (label, y) in [
+        ("kinetic − initial", delta(1)),
+        ("potential − initial", delta(2)),
+        ("elastic − initial", delta(3)),
+        ("work of the walls", col(4)),
+        ("dissipated", dissipated),
+        ("balance residual", residual),
+    ] {
+        plot.series.push(Series::new(label, t.clone(), y));
+    }
+    line_plot(out.join("energy"), &plot)
+        .map(|_| ())
+        .map_err(|e| format!("output: {e}"))
+}
+
 /// `pdamp bench`: the shaken box's size and length within the machine (see
 /// [`pdamp_io::estimate`]).
 fn bench_limits(particles: usize, steps: u64) -> Result<()> {
@@ -743,7 +780,8 @@ fn cmd_run(
         dir.set_outcome(&s);
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {
-        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick);
+        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
+            .and_then(|s| energy_plot(out).map(|()| s));
         dir.set_outcome(&s);
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     };

@@ -109,6 +109,18 @@ fn run_fields_cor_and_settle_print_progress_lines_without_a_terminal() {
     assert!(running.len() >= 2, "{err}");
     assert!(running.last().unwrap().contains("100.0 %"), "{err}");
     assert!(err.contains("eta"), "an estimate of the time left: {err}");
+    // The energy ledger as a picture, with its labels.
+    let svg = std::fs::read_to_string(o.join("energy.svg")).unwrap();
+    for label in [
+        "energy ledger",
+        "time (s)",
+        "energy (J)",
+        "dissipated",
+        "balance residual",
+    ] {
+        assert!(svg.contains(label), "energy.svg lacks {label}");
+    }
+    assert!(std::fs::metadata(o.join("energy.png")).unwrap().len() > 1000);
     // A damper point.
     let err = stderr_of(
         &["run", s, "--out", d.join("point").to_str().unwrap()],
