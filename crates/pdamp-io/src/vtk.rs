@@ -443,6 +443,9 @@ impl PvdSeries {
         if !time_s.is_finite() {
             return Err(VtkError::InvalidTime(time_s));
         }
+        // Clean times for ParaView: a clock summed step by step carries float noise
+        // (0.005000000000000001 s); rounded to the picosecond (far below any DEM step).
+        let time_s = (time_s * 1e12).round() / 1e12;
         self.entries.push((time_s, file.into()));
         self.write()
     }
@@ -756,5 +759,21 @@ mod tests {
             .count();
         assert_eq!(leftovers, 0);
         fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[cfg(test)]
+mod pvd_tests {
+    #[test]
+    fn pvd_times_are_clean() {
+        let dir = std::env::temp_dir().join(format!("pdamp-pvd-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut s = super::PvdSeries::new(dir.join("a.pvd"));
+        s.add(0.1 + 0.2, "f.vtp").unwrap();
+        s.add(0.005000000000000001, "g.vtp").unwrap();
+        let text = std::fs::read_to_string(dir.join("a.pvd")).unwrap();
+        assert!(text.contains("timestep=\"0.3\""), "{text}");
+        assert!(text.contains("timestep=\"0.005\""), "{text}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
