@@ -121,6 +121,16 @@ fn run_fields_cor_and_settle_print_progress_lines_without_a_terminal() {
         assert!(svg.contains(label), "energy.svg lacks {label}");
     }
     assert!(std::fs::metadata(o.join("energy.png")).unwrap().len() > 1000);
+    // One particles.pvd opens the particles and the container together (parts of a frame).
+    let pvd = std::fs::read_to_string(o.join("particles.pvd")).unwrap();
+    assert!(
+        pvd.contains(r#"part="1" file="vtk/wall_0_0_000000.vtp""#),
+        "{pvd}"
+    );
+    for f in pvd.split("file=\"").skip(1) {
+        let f = &f[..f.find('"').unwrap()];
+        assert!(o.join(f).is_file(), "{f} listed but missing");
+    }
     // A damper point.
     let err = stderr_of(
         &["run", s, "--out", d.join("point").to_str().unwrap()],

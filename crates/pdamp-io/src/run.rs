@@ -286,6 +286,21 @@ pub fn write_snapshot(
     Ok(PathBuf::from("vtk").join(name))
 }
 
+/// The files of snapshot `index` relative to the output directory (`vtk/particles_….vtp`
+/// and `vtk/wall_<body>_<wall>_….vtp` of every wall with a surface), as
+/// [`write_snapshot`] writes them: the parts of one frame of `particles.pvd`.
+pub fn snapshot_files(world: &World, index: usize) -> Vec<String> {
+    let mut v = vec![format!("vtk/particles_{index:06}.vtp")];
+    for (bi, b) in world.bodies.iter().enumerate() {
+        for (wi, w) in b.walls.iter().enumerate() {
+            if wall_surface(&w.geometry).is_some() {
+                v.push(format!("vtk/wall_{bi}_{wi}_{index:06}.vtp"));
+            }
+        }
+    }
+    v
+}
+
 /// A triangulated surface of a wall for display (boxes, cylinders, meshes; planes are skipped).
 pub fn wall_surface(g: &Geometry) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
     match g {
@@ -633,8 +648,8 @@ pub fn run_scenario(
             csv.write_row(&ledger_row(&world)).map_err(csvio)?;
             let mut snap = 0usize;
             if let Some(s) = series.as_mut() {
-                let f = write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
-                s.add(world.time_s, f.to_string_lossy())
+                write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
+                s.add_frame(world.time_s, &snapshot_files(&world, snap))
                     .map_err(|e| e.to_string())?;
                 snap += 1;
             }
@@ -668,8 +683,8 @@ pub fn run_scenario(
         {
             w.complete_step();
             match write_snapshot(w, &vtk_dir, snap) {
-                Ok(f) => {
-                    if let Err(e) = s.add(w.time_s, f.to_string_lossy()) {
+                Ok(_) => {
+                    if let Err(e) = s.add_frame(w.time_s, &snapshot_files(w, snap)) {
                         err = Some(format!("output: {e}"));
                         return ControlFlow::Break(());
                     }

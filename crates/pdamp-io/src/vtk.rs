@@ -450,6 +450,18 @@ impl PvdSeries {
         self.write()
     }
 
+    /// Appends a frame made of several parts (e.g. the particles and every wall) at `time_s`
+    /// and rewrites the collection once; ParaView shows the parts together.
+    pub fn add_frame(&mut self, time_s: f64, files: &[String]) -> Result<(), VtkError> {
+        if !time_s.is_finite() {
+            return Err(VtkError::InvalidTime(time_s));
+        }
+        let time_s = (time_s * 1e12).round() / 1e12;
+        self.entries
+            .extend(files.iter().map(|f| (time_s, f.clone())));
+        self.write()
+    }
+
     /// The frames so far as `(time_s, relative file name)`.
     pub fn entries(&self) -> &[(f64, String)] {
         &self.entries
@@ -470,12 +482,19 @@ impl PvdSeries {
             )?;
             writeln!(w, "  <Collection>")?;
             let mut t = String::new();
-            for (time, file) in &self.entries {
+            // Several files at one time are the parts of one frame (particles, walls, …).
+            let mut part = 0usize;
+            for (k, (time, file)) in self.entries.iter().enumerate() {
+                part = if k > 0 && self.entries[k - 1].0 == *time {
+                    part + 1
+                } else {
+                    0
+                };
                 t.clear();
                 format_f64(*time, &mut t);
                 writeln!(
                     w,
-                    "    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{}\"/>",
+                    "    <DataSet timestep=\"{t}\" group=\"\" part=\"{part}\" file=\"{}\"/>",
                     xml_escape(file)
                 )?;
             }
@@ -774,6 +793,18 @@ mod pvd_tests {
         let text = std::fs::read_to_string(dir.join("a.pvd")).unwrap();
         assert!(text.contains("timestep=\"0.3\""), "{text}");
         assert!(text.contains("timestep=\"0.005\""), "{text}");
+        // A frame of three parts: particles and two walls.
+        s.add_frame(0.01, &["p.vtp".into(), "w0.vtp".into(), "w1.vtp".into()])
+            .unwrap();
+        let text = std::fs::read_to_string(dir.join("a.pvd")).unwrap();
+        assert!(
+            text.contains("timestep=\"0.01\" group=\"\" part=\"2\" file=\"w1.vtp\""),
+            "{text}"
+        );
+        assert!(
+            text.contains("timestep=\"0.01\" group=\"\" part=\"0\" file=\"p.vtp\""),
+            "{text}"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
