@@ -137,6 +137,10 @@ pub struct Ticks {
     pub labels: Vec<String>,
 }
 
+/// Span in decades from which a log axis is labelled at the decades only; narrower
+/// log axes are labelled at 1-2-5 × 10ⁿ.
+pub const LOG_DECADES_ONLY_FROM: f64 = 2.0;
+
 /// Ticks for `[min, max]` on the given scale.
 pub fn ticks(scale: Scale, min: f64, max: f64) -> Ticks {
     match scale {
@@ -146,8 +150,10 @@ pub fn ticks(scale: Scale, min: f64, max: f64) -> Ticks {
 }
 
 /// Log-axis ticks for `0 < min < max`: labelled decades `10ⁿ` (thinned to at
-/// most ~8 labels) with minor ticks at 2…9 × 10ⁿ. Ranges spanning fewer than
-/// two decades get 1-2-5 ticks with plain number labels instead.
+/// most ~8 labels) with minor ticks at 2…9 × 10ⁿ. Ranges spanning less than
+/// [`LOG_DECADES_ONLY_FROM`] decades (e.g. 1–30, where only "1" and "10" would
+/// be labelled) get 1-2-5 ticks (or 1-2-3-…-9 when that gives fewer than
+/// three) with plain number labels instead.
 pub fn log_ticks(min: f64, max: f64) -> Ticks {
     if !(min > 0.0 && max > min && max.is_finite()) {
         return Ticks::default();
@@ -158,7 +164,7 @@ pub fn log_ticks(min: f64, max: f64) -> Ticks {
     let inside = |v: f64| v >= min * (1.0 - 1e-9) && v <= max * (1.0 + 1e-9);
     let n_dec = e_hi - e_lo + 1;
     let mut t = Ticks::default();
-    if n_dec >= 2 {
+    if n_dec >= 2 && lmax - lmin >= LOG_DECADES_ONLY_FROM {
         let step = ((n_dec + 7) / 8).max(1);
         for e in e_lo..=e_hi {
             let v = 10f64.powi(e);
@@ -380,6 +386,18 @@ mod tests {
         assert!(t.major.len() <= 9, "{:?}", t.major);
         assert!(t.major.contains(&1.0));
         assert!(!t.minor.is_empty());
+    }
+
+    /// A log axis over 1–30 (1.5 decades) is labelled at 1, 2, 5, 10, 20, not only at the
+    /// two decades 1 and 10.
+    #[test]
+    fn log_axis_under_two_decades_labels_125() {
+        let t = log_ticks(1.0, 30.0);
+        assert_eq!(t.major, vec![1.0, 2.0, 5.0, 10.0, 20.0]);
+        assert!(t.labels.contains(&"2".to_string()) && t.labels.contains(&"5".to_string()));
+        // 0.02–3 (2.2 decades) stays at the decades.
+        let t = log_ticks(0.02, 3.0);
+        assert_eq!(t.labels, ["10⁻¹", "10⁰"]);
     }
 
     #[test]

@@ -8,9 +8,13 @@ use plotters::prelude::*;
 
 use crate::axis::{Axis, cell_edges};
 use crate::color::{ColorScale, Rgb};
+use crate::legend::{
+    LegendEntry, Occupancy, Placement, PxRect, Swatch, draw_legend_box, legend_size, place_legend,
+};
 use crate::render::{
-    AxisLayout, COLORBAR_WIDTH, ColorBar, Figure, Frame, de, draw_axes, draw_colorbar, draw_frame,
-    draw_legend, draw_polyline, rgb, segments, titled, write_figure, y_label_width,
+    AxisLayout, COLORBAR_WIDTH, ColorBar, Figure, Frame, TICK_PT, chart_rect, clip_polyline, de,
+    draw_axes, draw_colorbar, draw_frame, draw_polyline, font, rgb, segments, titled, write_figure,
+    y_label_width,
 };
 use crate::{LegendPosition, PlotError, PlotFiles};
 
@@ -39,6 +43,9 @@ pub struct Polyline {
     pub width_px: u32,
     /// Draw dashed instead of solid.
     pub dashed: bool,
+    /// Text written on the map at the end of the line's visible part (e.g. `"X = 1 mm"` on
+    /// a line of constant displacement amplitude); empty for none.
+    pub annotation: String,
 }
 
 impl Polyline {
@@ -51,8 +58,39 @@ impl Polyline {
             color: None,
             width_px: 2,
             dashed: false,
+            annotation: String::new(),
         }
     }
+}
+
+/// Writes `text` next to `end` (pixels relative to `area`), kept inside `plot`, on a
+/// translucent white ground.
+fn draw_annotation<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: PxRect,
+    end: (f64, f64),
+    text: &str,
+) -> Result<(), PlotError> {
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let size = 0.85 * TICK_PT;
+    let (tw, th) = area.estimate_text_size(text, &font(size)).map_err(de)?;
+    let (tw, th) = (tw as f64, th as f64);
+    let x = (end.0 - tw - 6.0).clamp(plot.x0 + 3.0, (plot.x1 - tw - 3.0).max(plot.x0 + 3.0));
+    let y = (end.1 + 4.0).clamp(plot.y0 + 3.0, (plot.y1 - th - 3.0).max(plot.y0 + 3.0));
+    let (x, y) = (x.round() as i32, y.round() as i32);
+    area.draw(&Rectangle::new(
+        [(x - 2, y - 1), (x + tw as i32 + 2, y + th as i32 + 1)],
+        WHITE.mix(0.7).filled(),
+    ))
+    .map_err(de)?;
+    area.draw(&Text::new(
+        text.to_string(),
+        (x, y),
+        font(size)
+            .color(&RGBColor(40, 40, 40))
+            .pos(Pos::new(HPos::Left, VPos::Top)),
+    ))
+    .map_err(de)
 }
 
 /// A map of values on an `nx × ny` grid.
@@ -197,16 +235,46 @@ impl Figure for HeatMap {
         )?;
         draw_frame(&area, &chart, &xl, &yl)?;
 
-        let mut any_label = false;
+        let rect = chart_rect(&area, &chart);
+        let (xr, yr) = ((xl.lo, xl.hi), (yl.lo, yl.hi));
+        let mut entries = Vec::new();
+        let mut occ = Occupancy::default();
         for (i, p) in self.overlays.iter().enumerate() {
             let color = p.color.unwrap_or(OVERLAY_COLORS[i % OVERLAY_COLORS.len()]);
             let runs = segments(&p.x, &p.y, xs, ys);
-            any_label |= draw_polyline(
-                &mut chart, &runs, &xl, &yl, color, p.width_px, p.dashed, &p.label,
-            )?;
+            draw_polyline(&mut chart, &runs, (&xl, &yl), color, p.width_px, p.dashed)?;
+            occ.lines.extend(
+                runs.iter()
+                    .map(|r| r.iter().map(|t| rect.map(xr, yr, *t)).collect::<Vec<_>>()),
+            );
+            if !p.label.is_empty() {
+                entries.push(LegendEntry {
+                    label: p.label.clone(),
+                    swatch: Swatch::Line {
+                        color,
+                        width: p.width_px.max(1),
+                        dashed: p.dashed,
+                    },
+                });
+            }
+            let end = runs
+                .iter()
+                .flat_map(|r| clip_polyline(r, xr, yr))
+                .filter_map(|piece| piece.last().copied())
+                .next_back();
+            if let (false, Some(end)) = (p.annotation.is_empty(), end) {
+                draw_annotation(&area, rect, rect.map(xr, yr, end), &p.annotation)?;
+            }
         }
-        if any_label {
-            draw_legend(&mut chart, self.legend_position)?;
+        if !entries.is_empty() {
+            let size = legend_size(&area, &entries)?;
+            let pos = match self.legend_position {
+                LegendPosition::Outside => LegendPosition::Auto,
+                p => p,
+            };
+            if let Placement::Inside(r) = place_legend(pos, rect, size, &occ, false) {
+                draw_legend_box(&area, r, &entries)?;
+            }
         }
 
         let cb = ColorBar::for_values(&self.color, &self.colorbar_title, &self.values);

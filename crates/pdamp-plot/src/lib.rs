@@ -23,6 +23,7 @@
 mod axis;
 mod color;
 mod heatmap;
+mod legend;
 mod line;
 mod raster;
 mod render;
@@ -31,19 +32,29 @@ mod scatter;
 use std::path::PathBuf;
 
 pub use axis::{
-    Axis, Scale, Ticks, cell_edges, format_decade, format_number, linear_ticks, log_ticks,
-    midpoint, ticks,
+    Axis, LOG_DECADES_ONLY_FROM, Scale, Ticks, cell_edges, format_decade, format_number,
+    linear_ticks, log_ticks, midpoint, ticks,
 };
 pub use color::{ColorMap, ColorScale, MISSING_COLOR, PALETTE, Rgb, palette_color};
 pub use heatmap::{HeatMap, Polyline, heat_map};
-pub use line::{FrfPlot, FrfSeries, LinePlot, Marker, Series, frf_plot, frf_plot_with, line_plot};
-pub use scatter::{Quiver, ScatterField, scatter_field};
+pub use line::{
+    FrfPlot, FrfSeries, LinePlot, Marker, Series, XSpan, frf_plot, frf_plot_with, line_plot,
+};
+pub use scatter::{Quiver, QuiverKey, ScatterField, scatter_field, typical_spacing};
 
-/// Corner of the plotting area where the legend is placed.
+/// Where the legend is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LegendPosition {
-    /// Top right corner.
+    /// Off the data: the first corner (upper right, upper left, lower right, lower left) or
+    /// side (top, bottom, right, left) of the plotting area under which no line passes and no
+    /// marker lies; when every one is occupied, outside the plotting area on the right (line
+    /// and FRF plots) or where it hides the least (maps, whose right margin holds the colour
+    /// bar).
     #[default]
+    Auto,
+    /// Outside the plotting area, on the right (maps: as `Auto`).
+    Outside,
+    /// Top right corner.
     UpperRight,
     /// Top left corner.
     UpperLeft,

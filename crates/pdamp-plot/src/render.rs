@@ -14,8 +14,9 @@ use plotters::style::{FontTransform, register_font};
 
 use crate::axis::{Scale, Ticks, ticks};
 use crate::color::{ColorScale, MISSING_COLOR, Rgb};
+use crate::legend::PxRect;
 use crate::raster::RasterBackend;
-use crate::{LegendPosition, PlotError, PlotFiles};
+use crate::{PlotError, PlotFiles};
 
 /// Font family name under which the embedded font is registered.
 pub(crate) const FONT: &str = "sans-serif";
@@ -431,28 +432,6 @@ pub(crate) fn draw_frame<'a, DB: DrawingBackend + 'a>(
     Ok(())
 }
 
-pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
-    chart: &mut ChartContext<'a, DB, Coord2>,
-    pos: LegendPosition,
-) -> Result<(), PlotError> {
-    let pos = match pos {
-        LegendPosition::UpperRight => SeriesLabelPosition::UpperRight,
-        LegendPosition::UpperLeft => SeriesLabelPosition::UpperLeft,
-        LegendPosition::LowerLeft => SeriesLabelPosition::LowerLeft,
-        LegendPosition::LowerRight => SeriesLabelPosition::LowerRight,
-    };
-    chart
-        .configure_series_labels()
-        .position(pos)
-        .margin(10)
-        .legend_area_size(28)
-        .label_font(font(LEGEND_PT))
-        .background_style(WHITE.mix(0.88))
-        .border_style(RGBColor(120, 120, 120))
-        .draw()
-        .map_err(de)
-}
-
 /// Splits `(x, y)` into runs of points drawable on the given scales, mapped
 /// to display space; undrawable points (NaN, ≤ 0 on log axes) break lines.
 pub(crate) fn segments(x: &[f64], y: &[f64], xs: Scale, ys: Scale) -> Vec<Vec<(f64, f64)>> {
@@ -661,46 +640,131 @@ pub(crate) fn clip_polyline(
 }
 
 /// Draws a display-space polyline (already split into drawable runs),
-/// clipped to the axes; the first drawn piece gets the legend entry.
-#[allow(clippy::too_many_arguments)]
+/// clipped to the axes.
 pub(crate) fn draw_polyline<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Coord2>,
     runs: &[Vec<(f64, f64)>],
-    x: &AxisLayout,
-    y: &AxisLayout,
+    (x, y): (&AxisLayout, &AxisLayout),
     color: Rgb,
     width_px: u32,
     dashed: bool,
-    label: &str,
-) -> Result<bool, PlotError> {
+) -> Result<(), PlotError> {
     let style = rgb(color).stroke_width(width_px.max(1));
-    let mut labelled = label.is_empty();
     for run in runs {
         for piece in clip_polyline(run, (x.lo, x.hi), (y.lo, y.hi)) {
-            let anno = if dashed {
+            if dashed {
                 let dash = 8 + 2 * width_px;
                 chart
                     .draw_series(DashedLineSeries::new(piece, dash, dash / 2 + 2, style))
-                    .map_err(de)?
+                    .map_err(de)?;
             } else {
                 chart
                     .draw_series(LineSeries::new(piece, style))
-                    .map_err(de)?
-            };
-            if !labelled {
-                labelled = true;
-                let legend_w = width_px.max(1);
-                anno.label(label).legend(move |(lx, ly)| {
-                    PathElement::new(
-                        vec![(lx, ly), (lx + 22, ly)],
-                        rgb(color).stroke_width(legend_w),
-                    )
-                });
+                    .map_err(de)?;
             }
         }
     }
-    Ok(labelled && !label.is_empty())
+    Ok(())
 }
+
+/// The plotting area of a chart built with `frame` on an area of `dim` pixels, relative to
+/// the area (as [`build_chart`] lays it out).
+pub(crate) fn plot_rect(dim: (u32, u32), frame: &Frame) -> PxRect {
+    PxRect {
+        x0: (frame.left + frame.y_label) as f64,
+        y0: frame.top as f64,
+        x1: dim.0 as f64 - frame.right as f64,
+        y1: dim.1 as f64 - (frame.bottom + frame.x_label) as f64,
+    }
+}
+
+/// The plotting area of a built chart, relative to `area`.
+pub(crate) fn chart_rect<'a, DB: DrawingBackend + 'a>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &ChartContext<'a, DB, Coord2>,
+) -> PxRect {
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let base = area.get_base_pixel();
+    PxRect {
+        x0: (xr.start - base.0) as f64,
+        y0: (yr.start - base.1) as f64,
+        x1: (xr.end - base.0) as f64,
+        y1: (yr.end - base.1) as f64,
+    }
+}
+
+/// Width of the right margin that a secondary y axis with ticks of `y` and `title` needs.
+pub(crate) fn right_axis_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    y: &AxisLayout,
+    title: &str,
+) -> Result<u32, PlotError> {
+    let mut w = 0;
+    for l in &y.ticks.labels {
+        w = w.max(area.estimate_text_size(l, &font(TICK_PT)).map_err(de)?.0);
+    }
+    let th = if title.is_empty() {
+        0
+    } else {
+        area.estimate_text_size(title, &font(AXIS_TITLE_PT))
+            .map_err(de)?
+            .1
+            + 14
+    };
+    Ok((w + 14 + th + 8).clamp(30, 220))
+}
+
+/// Draws a secondary y axis `y2` on the right edge of the plotting area `plot` (relative to
+/// `area`): ticks outward, labels and the title (rotated, reading upwards).
+pub(crate) fn draw_right_axis<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: PxRect,
+    y2: &AxisLayout,
+    title: &str,
+) -> Result<(), PlotError> {
+    let x = plot.x1.round() as i32 - 1;
+    let ypix = |v: f64| {
+        let f = (y2.t(v) - y2.lo) / (y2.hi - y2.lo);
+        (plot.y1 - f * plot.h()).round() as i32
+    };
+    let style = BLACK.stroke_width(1);
+    let label_style = font(TICK_PT).pos(Pos::new(HPos::Left, VPos::Center));
+    let mut max_w = 0;
+    for (v, label) in y2.ticks.major.iter().zip(&y2.ticks.labels) {
+        let y = ypix(*v);
+        area.draw(&PathElement::new(vec![(x, y), (x + 5, y)], style))
+            .map_err(de)?;
+        area.draw(&Text::new(label.clone(), (x + 8, y), label_style.clone()))
+            .map_err(de)?;
+        max_w = max_w.max(
+            area.estimate_text_size(label, &font(TICK_PT))
+                .map_err(de)?
+                .0,
+        );
+    }
+    for v in &y2.ticks.minor {
+        let y = ypix(*v);
+        area.draw(&PathElement::new(vec![(x, y), (x + 3, y)], style))
+            .map_err(de)?;
+    }
+    if !title.is_empty() {
+        let (_, th) = area
+            .estimate_text_size(title, &font(AXIS_TITLE_PT))
+            .map_err(de)?;
+        let tx = x + 14 + max_w as i32 + th as i32 / 2;
+        let ty = ((plot.y0 + plot.y1) / 2.0).round() as i32;
+        let style = font(AXIS_TITLE_PT)
+            .transform(FontTransform::Rotate270)
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        area.draw(&Text::new(title.to_string(), (tx, ty), style))
+            .map_err(de)?;
+    }
+    Ok(())
+}
+
+/// Margin added on each side of an automatically scaled linear axis, as a fraction of the
+/// data range, so that no data point lies on the frame.
+pub(crate) const AUTO_MARGIN: f64 = 0.04;
 
 #[cfg(test)]
 mod tests {

@@ -6,8 +6,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use pdamp_plot::{
     Axis, ColorScale, FrfPlot, FrfSeries, HeatMap, LegendPosition, LinePlot, Marker, PlotError,
-    Polyline, Quiver, ScatterField, Series, frf_plot, frf_plot_with, heat_map, line_plot,
-    scatter_field,
+    Polyline, Quiver, QuiverKey, Rgb, ScatterField, Series, XSpan, frf_plot, frf_plot_with,
+    heat_map, line_plot, scatter_field,
 };
 
 /// Fresh, unique directory under the system temp dir, removed on drop
@@ -61,6 +61,17 @@ fn svg_text(path: &Path) -> String {
     );
     assert!(s.trim_end().ends_with("</svg>"), "SVG end");
     s
+}
+
+/// The texts of an SVG's `<text>` elements, trimmed.
+fn svg_labels(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let body = &t[t.find('>')? + 1..];
+            Some(body[..body.find("</text>")?].trim().to_string())
+        })
+        .collect()
 }
 
 /// No temporary files are left behind.
@@ -295,4 +306,121 @@ fn rewriting_replaces_files_atomically() {
     // Stems with dots keep their full name.
     let out = line_plot(dir.join("run.v2"), &p).unwrap();
     assert_eq!(out.svg, dir.join("run.v2.svg"));
+}
+
+/// A time series with a secondary (right) axis, a shaded span and a legend pushed outside by
+/// data everywhere; the SVG has both axis titles, the span's legend entry and 1-2-5 labels on
+/// a log axis over less than two decades.
+#[test]
+fn line_plot_secondary_axis_and_span() {
+    let dir = temp_dir("twin");
+    let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-3).collect();
+    let w = 2.0 * std::f64::consts::PI * 5.0;
+    let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("bed force f_p (N)"));
+    p.title = "force and displacement".into();
+    p.y2_axis = Some(Axis::linear("container displacement x (mm)"));
+    p.spans.push(XSpan::new(0.0, 0.6, "transient cycles"));
+    p.series.push(Series::new(
+        "bed force",
+        t.clone(),
+        t.iter().map(|t| 3.0 * (w * t + 0.4).sin()).collect(),
+    ));
+    p.series.push(
+        Series::new(
+            "displacement",
+            t.clone(),
+            t.iter().map(|t| 2.0 * (w * t).sin()).collect(),
+        )
+        .on_secondary_axis(),
+    );
+    let out = line_plot(dir.join("twin"), &p).unwrap();
+    let svg = svg_text(&out.svg);
+    for s in [
+        "time (s)",
+        "bed force f_p (N)",
+        "container displacement x (mm)",
+        "transient cycles",
+        "displacement",
+    ] {
+        assert!(svg.contains(s), "SVG lacks {s:?}");
+    }
+
+    let mut q = LinePlot::new(Axis::log("frequency (Hz)"), Axis::linear("η̄ (-)"));
+    q.series.push(Series::new(
+        "η̄",
+        vec![1.0, 3.0, 10.0, 30.0],
+        vec![0.1, 0.4, 0.9, 0.3],
+    ));
+    q.legend_position = LegendPosition::Outside;
+    let out = line_plot(dir.join("log125"), &q).unwrap();
+    let labels = svg_labels(&svg_text(&out.svg));
+    for l in ["1", "2", "5", "10", "20"] {
+        assert!(
+            labels.iter().any(|s| s == l),
+            "no tick label {l}: {labels:?}"
+        );
+    }
+}
+
+/// Arrows with a reference key and the container's outline; the key's label is in the SVG.
+#[test]
+fn scatter_field_with_key_and_outline() {
+    let dir = temp_dir("quiver-key");
+    let (mut x, mut y, mut u, mut v) = (vec![], vec![], vec![], vec![]);
+    for i in 0..24 {
+        for j in 0..12 {
+            x.push(1.0 + 2.0 * i as f64);
+            y.push(1.0 + 2.0 * j as f64);
+            u.push((j as f64 - 6.0) * 0.1);
+            v.push(-(i as f64 - 12.0) * 0.05);
+        }
+    }
+    let speed: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a.hypot(*b)).collect();
+    let mut f = ScatterField::new(x, y, speed);
+    f.x_axis = Axis::linear("along excitation (mm)");
+    f.y_axis = Axis::linear("up (mm)");
+    let mut q = Quiver::new(u, v);
+    q.key = Some(QuiverKey {
+        magnitude: 0.5,
+        label: "|v|/V = 0.5 (0.12 m/s)".into(),
+    });
+    f.arrows = Some(q);
+    let mut outline = Polyline::new(
+        "container",
+        vec![0.0, 48.0, 48.0, 0.0, 0.0],
+        vec![0.0, 0.0, 24.0, 24.0, 0.0],
+    );
+    outline.color = Some(Rgb(0, 0, 0));
+    f.outlines.push(outline);
+    let out = scatter_field(dir.join("field"), &f).unwrap();
+    let svg = svg_text(&out.svg);
+    assert!(svg.contains("|v|/V = 0.5 (0.12 m/s)") && svg.contains("up (mm)"));
+}
+
+/// Map overlays with annotations (lines of constant X) are written on the map.
+#[test]
+fn heat_map_annotated_overlays() {
+    let dir = temp_dir("heat-annot");
+    let f = logspace(1.0, 3.0, 12);
+    let g = logspace(0.0, 1.5, 9);
+    let v: Vec<f64> = (0..f.len() * g.len())
+        .map(|k| (k % 7) as f64 / 7.0)
+        .collect();
+    let mut map = HeatMap::new(f.clone(), g, v);
+    map.x_axis = Axis::log("frequency f (Hz)");
+    map.y_axis = Axis::log("intensity Γ (-)");
+    let mut line = Polyline::new(
+        "",
+        f.clone(),
+        f.iter()
+            .map(|f| 1e-4 * (2.0 * std::f64::consts::PI * f).powi(2) / 9.81)
+            .collect(),
+    );
+    line.annotation = "X = 0.1 mm".into();
+    map.overlays.push(line);
+    map.overlays
+        .push(Polyline::new("A = g", f.clone(), vec![1.0; f.len()]));
+    let out = heat_map(dir.join("map"), &map).unwrap();
+    let svg = svg_text(&out.svg);
+    assert!(svg.contains("X = 0.1 mm") && svg.contains("A = g"));
 }
