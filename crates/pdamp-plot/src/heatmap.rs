@@ -63,30 +63,48 @@ impl Polyline {
     }
 }
 
-/// Writes `text` next to `end` (pixels relative to `area`), kept inside `plot`, on a
-/// translucent white ground.
-fn draw_annotation<DB: DrawingBackend>(
+/// Font size of overlay annotations, pt.
+const ANNOTATION_PT: f64 = 0.85 * TICK_PT;
+
+/// Box of the annotation `text` next to `end` (pixels relative to `area`), kept inside
+/// `plot`.
+fn annotation_rect<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     plot: PxRect,
     end: (f64, f64),
     text: &str,
-) -> Result<(), PlotError> {
-    use plotters::style::text_anchor::{HPos, Pos, VPos};
-    let size = 0.85 * TICK_PT;
-    let (tw, th) = area.estimate_text_size(text, &font(size)).map_err(de)?;
+) -> Result<PxRect, PlotError> {
+    let (tw, th) = area
+        .estimate_text_size(text, &font(ANNOTATION_PT))
+        .map_err(de)?;
     let (tw, th) = (tw as f64, th as f64);
     let x = (end.0 - tw - 6.0).clamp(plot.x0 + 3.0, (plot.x1 - tw - 3.0).max(plot.x0 + 3.0));
     let y = (end.1 + 4.0).clamp(plot.y0 + 3.0, (plot.y1 - th - 3.0).max(plot.y0 + 3.0));
-    let (x, y) = (x.round() as i32, y.round() as i32);
+    Ok(PxRect {
+        x0: x.round(),
+        y0: y.round(),
+        x1: (x + tw).round(),
+        y1: (y + th).round(),
+    })
+}
+
+/// Writes `text` in the box `r` on a translucent white ground.
+fn draw_annotation<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    r: PxRect,
+    text: &str,
+) -> Result<(), PlotError> {
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let (x0, y0, x1, y1) = (r.x0 as i32, r.y0 as i32, r.x1 as i32, r.y1 as i32);
     area.draw(&Rectangle::new(
-        [(x - 2, y - 1), (x + tw as i32 + 2, y + th as i32 + 1)],
+        [(x0 - 2, y0 - 1), (x1 + 2, y1 + 1)],
         WHITE.mix(0.7).filled(),
     ))
     .map_err(de)?;
     area.draw(&Text::new(
         text.to_string(),
-        (x, y),
-        font(size)
+        (x0, y0),
+        font(ANNOTATION_PT)
             .color(&RGBColor(40, 40, 40))
             .pos(Pos::new(HPos::Left, VPos::Top)),
     ))
@@ -239,6 +257,7 @@ impl Figure for HeatMap {
         let (xr, yr) = ((xl.lo, xl.hi), (yl.lo, yl.hi));
         let mut entries = Vec::new();
         let mut occ = Occupancy::default();
+        let mut annotations = Vec::new();
         for (i, p) in self.overlays.iter().enumerate() {
             let color = p.color.unwrap_or(OVERLAY_COLORS[i % OVERLAY_COLORS.len()]);
             let runs = segments(&p.x, &p.y, xs, ys);
@@ -263,8 +282,20 @@ impl Figure for HeatMap {
                 .filter_map(|piece| piece.last().copied())
                 .next_back();
             if let (false, Some(end)) = (p.annotation.is_empty(), end) {
-                draw_annotation(&area, rect, rect.map(xr, yr, end), &p.annotation)?;
+                let r = annotation_rect(&area, rect, rect.map(xr, yr, end), &p.annotation)?;
+                // The legend keeps off the annotation too.
+                occ.lines.push(vec![
+                    (r.x0, r.y0),
+                    (r.x1, r.y0),
+                    (r.x1, r.y1),
+                    (r.x0, r.y1),
+                    (r.x0, r.y0),
+                ]);
+                annotations.push((r, p.annotation.as_str()));
             }
+        }
+        for (r, text) in annotations {
+            draw_annotation(&area, r, text)?;
         }
         if !entries.is_empty() {
             let size = legend_size(&area, &entries)?;

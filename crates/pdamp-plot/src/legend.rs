@@ -3,9 +3,10 @@
 //! With [`LegendPosition::Auto`] the box goes into the first corner of the plotting area
 //! (upper right, upper left, lower right, lower left), else the first side (top, bottom,
 //! right, left) that it leaves free of data — no line passes under it and no marker
-//! lies under it — and, when every corner and side is occupied, outside the plotting area
-//! on the right (line plots) or into the place that hides the least data (maps, whose
-//! right margin holds the colour bar).
+//! lies under it —, else the first of these places moved inwards by 8 % of the plot (inside
+//! a frame of data such as a container's outline), and, when all are occupied, outside the
+//! plotting area on the right (line plots) or into the place that hides the least data
+//! (maps, whose right margin holds the colour bar).
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -174,9 +175,9 @@ pub(crate) fn place_legend(
     allow_outside: bool,
 ) -> Placement {
     let (w, h) = size;
-    let at = |fx: f64, fy: f64| {
-        let x0 = plot.x0 + INSET_PX + fx * (plot.w() - 2.0 * INSET_PX - w);
-        let y0 = plot.y0 + INSET_PX + fy * (plot.h() - 2.0 * INSET_PX - h);
+    let at_inset = |fx: f64, fy: f64, ix: f64, iy: f64| {
+        let x0 = plot.x0 + ix + fx * (plot.w() - 2.0 * ix - w);
+        let y0 = plot.y0 + iy + fy * (plot.h() - 2.0 * iy - h);
         PxRect {
             x0,
             y0,
@@ -184,6 +185,7 @@ pub(crate) fn place_legend(
             y1: y0 + h,
         }
     };
+    let at = |fx: f64, fy: f64| at_inset(fx, fy, INSET_PX, INSET_PX);
     let fixed = match pos {
         LegendPosition::UpperRight => Some(at(1.0, 0.0)),
         LegendPosition::UpperLeft => Some(at(0.0, 0.0)),
@@ -195,17 +197,25 @@ pub(crate) fn place_legend(
     if let Some(r) = fixed {
         return Placement::Inside(r);
     }
-    let candidates = [
-        at(1.0, 0.0),
-        at(0.0, 0.0),
-        at(1.0, 1.0),
-        at(0.0, 1.0),
-        at(0.5, 0.0),
-        at(0.5, 1.0),
-        at(1.0, 0.5),
-        at(0.0, 0.5),
+    // The corners and sides, then the same places moved inwards by 8 % of the plot (inside
+    // a frame of data such as a container's outline drawn along the axis margins).
+    let places = [
+        (1.0, 0.0),
+        (0.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 1.0),
+        (0.5, 0.0),
+        (0.5, 1.0),
+        (1.0, 0.5),
+        (0.0, 0.5),
     ];
-    let fits = w + 2.0 * INSET_PX <= plot.w() && h + 2.0 * INSET_PX <= plot.h();
+    let (ix, iy) = (INSET_PX + 0.08 * plot.w(), INSET_PX + 0.08 * plot.h());
+    let candidates: Vec<PxRect> = places
+        .iter()
+        .map(|&(fx, fy)| at(fx, fy))
+        .chain(places.iter().map(|&(fx, fy)| at_inset(fx, fy, ix, iy)))
+        .collect();
+    let fits = w + 2.0 * ix <= plot.w() && h + 2.0 * iy <= plot.h();
     let costs: Vec<f64> = candidates
         .iter()
         .map(|r| occ.cost(&r.grown(CLEARANCE_PX)))

@@ -47,9 +47,9 @@ pub use scatter::{Quiver, QuiverKey, ScatterField, scatter_field, typical_spacin
 pub enum LegendPosition {
     /// Off the data: the first corner (upper right, upper left, lower right, lower left) or
     /// side (top, bottom, right, left) of the plotting area under which no line passes and no
-    /// marker lies; when every one is occupied, outside the plotting area on the right (line
-    /// and FRF plots) or where it hides the least (maps, whose right margin holds the colour
-    /// bar).
+    /// marker lies, else the first such place moved inwards by 8 % of the plot; when every
+    /// one is occupied, outside the plotting area on the right (line and FRF plots) or where
+    /// it hides the least (maps, whose right margin holds the colour bar).
     #[default]
     Auto,
     /// Outside the plotting area, on the right (maps: as `Auto`).
