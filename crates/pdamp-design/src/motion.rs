@@ -1,6 +1,8 @@
 //! Motion modes of the bed [D Sect. 3.2.1]: phase-resolved velocity fields in the container frame
-//! normalised by the container velocity amplitude V, trajectories of chosen particles, and VTK
-//! frames of the last cycle for animation.
+//! normalised by the container velocity amplitude V, trajectories of chosen particles, VTK
+//! frames of the last cycle for animation, and the force–displacement record of every cycle
+//! (bed force, driving force and container motion; its loops give the dissipated energy
+//! [D Sect. 3.2.2]).
 
 use crate::damper::{Damper, PointObserver};
 use pdamp_dem::{Vec3, World};
@@ -20,7 +22,23 @@ pub struct PhaseField {
     pub count: Vec<u64>,
 }
 
-/// Records velocity fields, trajectories and VTK frames while a point runs.
+/// Rows of the force–displacement record per cycle (plus the cycle's closing row, see
+/// [`MotionRecorder::force_displacement`]).
+pub const FD_SAMPLES_PER_CYCLE: u32 = 200;
+
+/// Columns of [`MotionRecorder::force_displacement`] (and of `force_displacement.csv`).
+pub const FORCE_DISPLACEMENT_COLUMNS: [&str; 7] = [
+    "time_s",
+    "cycle",
+    "displacement_m",
+    "velocity_m_s",
+    "bed_force_n",
+    "driving_force_n",
+    "work_on_bed_j",
+];
+
+/// Records velocity fields, trajectories, VTK frames and the force–displacement record while
+/// a point runs.
 #[derive(Debug)]
 pub struct MotionRecorder {
     /// Unit vectors of the field plane: excitation direction and the up direction.
@@ -45,6 +63,26 @@ pub struct MotionRecorder {
     pub vtk_frames: Vec<(f64, String)>,
     /// First error while writing VTK frames.
     pub error: Option<String>,
+    /// Force–displacement record of all cycles, transient ones included, one row
+    /// ([`FORCE_DISPLACEMENT_COLUMNS`]) at the first step at or after each of
+    /// [`FD_SAMPLES_PER_CYCLE`] equally spaced instants per cycle, with the values of that
+    /// step (its exact time; no interpolation): time t (s), cycle (from 0), container
+    /// displacement x and velocity ẋ along the excitation (m, m/s), the force of the bed on
+    /// the container along the excitation f_p (N; the particles' contact forces on its walls),
+    /// the driving force m_con ẍ − f_p (N) the complex power method evaluates
+    /// [D Sect. 3.2.2], and the work of the container on the bed since t = 0, ∫(−f_p) ẋ dt
+    /// over every step by the trapezoidal rule (the first step by the rectangle rule), J: its
+    /// increase over whole cycles is their dissipated energy Ẽ_diss of the complex power
+    /// method [D Eq. 3.13] without the sampling error of the decimated rows. Each cycle's rows
+    /// start and end at its boundaries (the boundary step is the last row of one cycle and,
+    /// repeated, the first row of the next), so the rows of one cycle form a closed loop whose
+    /// area ∮(−f_p) dx approximates the work on the bed in that cycle; the first cycle starts
+    /// at its first sample instead of t = 0.
+    pub force_displacement: Vec<[f64; 7]>,
+    /// The container's extent in the field plane, `[[lo, hi] along axis 0, [lo, hi] along
+    /// axis 1]` in the container frame, m (from the bounding boxes of its walls; `None` when
+    /// they are unbounded).
+    pub container_extent_m: Option<[[f64; 2]; 2]>,
     /// Angular excitation frequency Ω, rad/s.
     pub omega_rad_s: f64,
     prev_phase: f64,
@@ -53,6 +91,11 @@ pub struct MotionRecorder {
     /// evaluated cycle is written, each over the previous one, as any may be the last).
     vtk_cycle: u32,
     traj_every: u64,
+    /// Last force–displacement sample slot, ⌊f t · FD_SAMPLES_PER_CYCLE⌋ (−1: none yet).
+    fd_slot: i64,
+    /// Work of the container on the bed so far, J, and the time and power −f_p ẋ of the
+    /// previous step (for the trapezoidal rule).
+    fd_work: (f64, Option<(f64, f64)>),
 }
 
 impl MotionRecorder {
@@ -103,6 +146,8 @@ impl MotionRecorder {
                 }
             }
         }
+        let container_extent_m =
+            (lo[0].is_finite() && lo[1].is_finite()).then_some([[lo[0], hi[0]], [lo[1], hi[1]]]);
         if !lo[0].is_finite() || !lo[1].is_finite() {
             for (x, r) in w.particles.position.iter().zip(&w.particles.radius) {
                 let rel = x - body.reference.position_m;
@@ -143,12 +188,92 @@ impl MotionRecorder {
             vtk: None,
             vtk_frames: Vec::new(),
             error: None,
+            force_displacement: Vec::new(),
+            container_extent_m,
             omega_rad_s: 2.0 * PI * frequency_hz,
             prev_phase: 0.0,
             prev_theta: 0.0,
             vtk_cycle: u32::MAX,
             traj_every: ((steps_per_cycle / 200.0).floor() as u64).max(1),
+            fd_slot: -1,
+            fd_work: (0.0, None),
         }
+    }
+
+    /// Adds this step's work on the bed and appends the force–displacement row of this step
+    /// when it is the first at or after a sample instant (see [`Self::force_displacement`]);
+    /// no allocation beyond the growing record.
+    fn record_force_displacement(&mut self, w: &World, cycle: u32, damper: &Damper) {
+        let per_cycle = FD_SAMPLES_PER_CYCLE as i64;
+        let b = &w.bodies[damper.container];
+        let e = damper.direction;
+        let x = (b.state.position_m - b.reference.position_m).dot(&e);
+        let v = b.state.velocity_m_s.dot(&e);
+        let f_p = b.contact_force_n.dot(&e);
+        let power = -f_p * v;
+        let (work, prev) = &mut self.fd_work;
+        *work += match *prev {
+            Some((t0, p0)) => 0.5 * (p0 + power) * (w.time_s - t0),
+            None => power * w.time_s,
+        };
+        *prev = Some((w.time_s, power));
+        // A new cycle opens with the closing row of the previous one.
+        if self.fd_slot == cycle as i64 * per_cycle
+            && let Some(last) = self.force_displacement.last()
+            && last[1] < cycle as f64
+        {
+            let mut row = *last;
+            row[1] = cycle as f64;
+            self.force_displacement.push(row);
+        }
+        // Slot of this step; the 1e-6 puts the step that ends a cycle (t = kT up to rounding)
+        // into the slot of the boundary.
+        let slot =
+            (self.omega_rad_s * w.time_s / (2.0 * PI) * per_cycle as f64 + 1e-6).floor() as i64;
+        if slot <= self.fd_slot {
+            return;
+        }
+        self.fd_slot = slot;
+        // ẍ = −Ω² x for x = X sin Ωt [D Eq. 3.8–3.10].
+        let a = -self.omega_rad_s * self.omega_rad_s * x;
+        self.force_displacement.push([
+            w.time_s,
+            cycle as f64,
+            x,
+            v,
+            f_p,
+            damper.container_mass_kg * a - f_p,
+            self.fd_work.0,
+        ]);
+    }
+
+    /// Mean work of the container on the bed per cycle over the cycles `from_cycle..`,
+    /// ∮(−f_p) dx by the trapezoidal rule over each cycle's rows of
+    /// [`Self::force_displacement`], J: the area of the hysteresis loops, equal to the
+    /// dissipated energy per cycle Ẽ_diss of the complex power method [D Eq. 3.13] up to the
+    /// sampling (and to the ledger's dissipation in a steady state). Cycles without rows at
+    /// both of their boundaries (the first one) are left out; `None` without a complete cycle.
+    pub fn loop_work_per_cycle_j(&self, from_cycle: u32) -> Option<f64> {
+        let rows = &self.force_displacement;
+        let mut total = 0.0;
+        let mut cycles = 0u32;
+        let mut k = 0;
+        while k < rows.len() {
+            let c = rows[k][1];
+            let end = k + rows[k..].iter().take_while(|r| r[1] == c).count();
+            // Complete cycles only: rows at both of the cycle's boundaries.
+            let at = |t: f64, n: f64| (self.omega_rad_s * t / (2.0 * PI) - n).abs() < 1e-6;
+            let closed = at(rows[k][0], c) && at(rows[end - 1][0], c + 1.0);
+            if c >= from_cycle as f64 && closed && end - k >= 2 {
+                total += rows[k..end]
+                    .windows(2)
+                    .map(|w| -0.5 * (w[0][4] + w[1][4]) * (w[1][2] - w[0][2]))
+                    .sum::<f64>();
+                cycles += 1;
+            }
+            k = end;
+        }
+        (cycles > 0).then(|| total / cycles as f64)
     }
 
     fn accumulate(&mut self, w: &World, k: usize, container_pos: &Vec3) {
@@ -195,6 +320,9 @@ struct RecorderState {
     prev_phase: f64,
     prev_theta: f64,
     vtk_cycle: u32,
+    force_displacement: Vec<[f64; 7]>,
+    fd_slot: i64,
+    fd_work: (f64, Option<(f64, f64)>),
 }
 
 impl PointObserver for MotionRecorder {
@@ -207,6 +335,9 @@ impl PointObserver for MotionRecorder {
             prev_phase: self.prev_phase,
             prev_theta: self.prev_theta,
             vtk_cycle: self.vtk_cycle,
+            force_displacement: self.force_displacement.clone(),
+            fd_slot: self.fd_slot,
+            fd_work: self.fd_work,
         })
     }
 
@@ -227,10 +358,14 @@ impl PointObserver for MotionRecorder {
         self.prev_phase = s.prev_phase;
         self.prev_theta = s.prev_theta;
         self.vtk_cycle = s.vtk_cycle;
+        self.force_displacement = s.force_displacement;
+        self.fd_slot = s.fd_slot;
+        self.fd_work = s.fd_work;
         Ok(())
     }
 
     fn on_step(&mut self, w: &World, cycle: u32, phase: f64, damper: &Damper) {
+        self.record_force_displacement(w, cycle, damper);
         let prev = self.prev_phase;
         self.prev_phase = phase;
         if cycle < damper.transient_cycles {

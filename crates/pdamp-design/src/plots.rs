@@ -1,10 +1,15 @@
 //! Plots of damper results: effective-field maps [D Fig. 3.6, 8.3], phase-resolved velocity
-//! fields [D Fig. 3.5c, 8.2] and particle trajectories [D Fig. 3.5b]. PNG and SVG each.
+//! fields [D Fig. 3.5c, 8.2], particle trajectories [D Fig. 3.5b], and the bed force and
+//! container displacement of a point over time and as hysteresis loops [D Sect. 3.2.2]. PNG
+//! and SVG each.
 
 use crate::damper::PointResult;
 use crate::fields::FieldGrid;
 use crate::motion::MotionRecorder;
-use pdamp_plot::{Axis, ColorScale, HeatMap, LinePlot, Quiver, ScatterField, Series};
+use pdamp_plot::{
+    Axis, ColorScale, HeatMap, LinePlot, Polyline, Quiver, QuiverKey, Rgb, ScatterField, Series,
+    XSpan,
+};
 use std::path::Path;
 
 fn err(e: impl std::fmt::Display) -> String {
@@ -34,23 +39,7 @@ fn axis_value(grid: &FieldGrid, f_hz: f64, x_m: f64) -> f64 {
 /// when the bed's clearance h is known, the bouncing optimum X_opt = h/π [D Eq. 6.11, 7.16, 8.2].
 fn eta_overlays(grid: &FieldGrid, clearance_m: Option<f64>) -> Vec<pdamp_plot::Polyline> {
     use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
-    let (f0, f1) = (
-        grid.frequencies_hz[0],
-        *grid
-            .frequencies_hz
-            .last()
-            .unwrap_or(&grid.frequencies_hz[0]),
-    );
-    let fs: Vec<f64> = (0..=64)
-        .map(|k| {
-            let s = k as f64 / 64.0;
-            if grid.frequency_log {
-                f0 * (f1 / f0).powf(s)
-            } else {
-                f0 + (f1 - f0) * s
-            }
-        })
-        .collect();
+    let fs = line_frequencies(grid);
     let line = |label: &str, x_of_f: &dyn Fn(f64) -> f64, dashed: bool| {
         let mut l = pdamp_plot::Polyline::new(
             label,
@@ -74,6 +63,87 @@ fn eta_overlays(grid: &FieldGrid, clearance_m: Option<f64>) -> Vec<pdamp_plot::P
         ));
     }
     v
+}
+
+/// Frequencies along the grid's frequency axis for drawing lines over a map (65, log or
+/// linear as the axis).
+fn line_frequencies(grid: &FieldGrid) -> Vec<f64> {
+    let (f0, f1) = (
+        grid.frequencies_hz[0],
+        *grid
+            .frequencies_hz
+            .last()
+            .unwrap_or(&grid.frequencies_hz[0]),
+    );
+    (0..=64)
+        .map(|k| {
+            let s = k as f64 / 64.0;
+            if grid.frequency_log {
+                f0 * (f1 / f0).powf(s)
+            } else {
+                f0 + (f1 - f0) * s
+            }
+        })
+        .collect()
+}
+
+/// Lines of constant displacement amplitude X over a map whose amplitude axis is the
+/// acceleration A = XΩ² or the intensity Γ = XΩ²/g [D Eq. 3.9–3.11], as in D's field
+/// figures: the decades of X (every other one when more than four cross the map; 1-2-5
+/// values when fewer than two do) that cross the map's range, each annotated "X = … mm".
+/// None on a displacement axis (X is the axis itself).
+fn constant_x_overlays(grid: &FieldGrid) -> Vec<Polyline> {
+    use pdamp_io::scenario::AmplitudeAxis;
+    if grid.amplitude_axis == AmplitudeAxis::Displacement || grid.frequencies_hz.is_empty() {
+        return Vec::new();
+    }
+    let fs = line_frequencies(grid);
+    let (a_lo, a_hi) = grid
+        .amplitude_values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    let (f_lo, f_hi) = (fs[0].min(fs[fs.len() - 1]), fs[0].max(fs[fs.len() - 1]));
+    // Axis value per metre of X is increasing in f: X crosses the map for X in [x_lo, x_hi].
+    let (x_lo, x_hi) = (
+        a_lo / axis_value(grid, f_hi, 1.0),
+        a_hi / axis_value(grid, f_lo, 1.0),
+    );
+    if !(x_lo > 0.0 && x_hi > x_lo && x_hi.is_finite()) {
+        return Vec::new();
+    }
+    let inside = |x: f64| x > x_lo * (1.0 + 1e-9) && x < x_hi * (1.0 - 1e-9);
+    let (k0, k1) = (x_lo.log10().floor() as i32, x_hi.log10().ceil() as i32);
+    let mut xs: Vec<f64> = (k0..=k1)
+        .map(|k| 10f64.powi(k))
+        .filter(|x| inside(*x))
+        .collect();
+    if xs.len() > 4 {
+        xs = xs.into_iter().step_by(2).collect();
+    } else if xs.len() < 2 {
+        xs = (k0..=k1)
+            .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+            .filter(|x| inside(*x))
+            .collect();
+        if xs.len() > 4 {
+            xs = xs.into_iter().step_by(2).collect();
+        }
+    }
+    xs.into_iter()
+        .map(|x| {
+            let mut l = Polyline::new(
+                "",
+                fs.clone(),
+                fs.iter().map(|&f| axis_value(grid, f, x)).collect(),
+            );
+            l.color = Some(Rgb(225, 225, 225));
+            l.width_px = 1;
+            l.dashed = true;
+            l.annotation = format!("X = {} mm", pdamp_plot::format_number(x * 1e3));
+            l
+        })
+        .collect()
 }
 
 /// [`field_maps`] with the bed's clearance h along the excitation for the X_opt = h/π line
@@ -107,6 +177,7 @@ pub fn field_maps_with(
     } else {
         Axis::linear(grid.amplitude_title())
     };
+    let constant_x = constant_x_overlays(grid);
     let make = |values: Vec<f64>, color: ColorScale, title: &str, bar: &str| {
         let mut m = HeatMap::new(
             grid.frequencies_hz.clone(),
@@ -118,6 +189,7 @@ pub fn field_maps_with(
         m.color = color;
         m.title = title.to_string();
         m.colorbar_title = bar.to_string();
+        m.overlays = constant_x.clone();
         m
     };
     let eta = pick(&|p| p.effective_loss_factor);
@@ -127,7 +199,9 @@ pub fn field_maps_with(
         "effective loss factor (values ≥ 1 saturate)",
         "η̄ (-)",
     );
-    eta_map.overlays = eta_overlays(grid, clearance_m);
+    eta_map
+        .overlays
+        .splice(0..0, eta_overlays(grid, clearance_m));
     pdamp_plot::heat_map(out.join("effective_loss_factor"), &eta_map).map_err(err)?;
     let mass = pick(&|p| p.effective_mass_ratio);
     let mmax = mass
@@ -201,43 +275,101 @@ pub fn field_maps_with(
     Ok(())
 }
 
-/// One scatter plot per recorded phase: cell centres in the container frame coloured by the
-/// phase-averaged |v|/V, with arrows of the in-plane mean velocity.
-pub fn velocity_field_plots(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
-    for (k, f) in rec.fields.iter().enumerate() {
-        let (mut x, mut y, mut val, mut u, mut v) = (vec![], vec![], vec![], vec![], vec![]);
-        for c in 0..f.count.len() {
-            let n = f.count[c];
-            if n == 0 {
-                continue;
-            }
-            let [cx, cy] = rec.cell_center(c);
-            x.push(cx * 1e3);
-            y.push(cy * 1e3);
-            val.push(f.speed_sum[c] / n as f64);
-            u.push(f.vel_sum[c][0] / n as f64);
-            v.push(f.vel_sum[c][1] / n as f64);
-        }
-        if x.is_empty() {
+/// `v` rounded to `digits` significant digits, as a tick label would show it.
+fn significant(v: f64, digits: usize) -> String {
+    let r: f64 = format!("{v:.*e}", digits.saturating_sub(1))
+        .parse()
+        .unwrap_or(v);
+    pdamp_plot::format_number(r)
+}
+
+/// Largest 1-2-5 × 10ⁿ value not above `v` (for reference arrows), `v` > 0.
+fn nice_below(v: f64) -> f64 {
+    let e = 10f64.powf(v.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * e)
+        .find(|x| *x <= v * (1.0 + 1e-12))
+        .unwrap_or(e)
+}
+
+/// The container's outline in the field plane (container frame, mm) as a closed rectangle
+/// (the walls' bounding box along the two plotted axes), if the walls are bounded.
+fn container_outline_mm(rec: &MotionRecorder) -> Option<(Vec<f64>, Vec<f64>)> {
+    let [[a0, a1], [b0, b1]] = rec.container_extent_m?;
+    let (a0, a1, b0, b1) = (a0 * 1e3, a1 * 1e3, b0 * 1e3, b1 * 1e3);
+    Some((vec![a0, a1, a1, a0, a0], vec![b0, b0, b1, b1, b0]))
+}
+
+/// The velocity field of phase `k`: cell centres in the container frame (mm) coloured by the
+/// phase-averaged |v|/V, arrows of the in-plane mean velocity scaled so that the fastest cell's
+/// arrow is one cell long, a reference arrow stating the velocity it stands for, and the
+/// container's outline. `None` for a phase without samples.
+pub fn velocity_field_figure(rec: &MotionRecorder, k: usize) -> Option<ScatterField> {
+    let f = rec.fields.get(k)?;
+    let (mut x, mut y, mut val, mut u, mut v) = (vec![], vec![], vec![], vec![], vec![]);
+    for c in 0..f.count.len() {
+        let n = f.count[c];
+        if n == 0 {
             continue;
         }
-        let mut s = ScatterField::new(x, y, val);
-        s.title = format!(
-            "velocity field at Ωt = {:.0}° (container frame)",
-            f.phase_rad.to_degrees()
-        );
-        s.x_axis = Axis::linear("along excitation (mm)");
-        s.y_axis = Axis::linear("up (mm)");
-        s.color = ColorScale::linear(0.0, 2.0);
-        s.colorbar_title = "|v| / V (-)".into();
-        s.arrows = Some(Quiver::new(u, v));
-        s.marker_px = 6;
-        pdamp_plot::scatter_field(out.join(format!("velocity_field_phase{k}")), &s).map_err(err)?;
+        let [cx, cy] = rec.cell_center(c);
+        x.push(cx * 1e3);
+        y.push(cy * 1e3);
+        val.push(f.speed_sum[c] / n as f64);
+        u.push(f.vel_sum[c][0] / n as f64);
+        v.push(f.vel_sum[c][1] / n as f64);
+    }
+    if x.is_empty() {
+        return None;
+    }
+    let mut s = ScatterField::new(x, y, val);
+    s.title = format!(
+        "velocity field at Ωt = {:.0}° (container frame)",
+        f.phase_rad.to_degrees()
+    );
+    s.x_axis = Axis::linear("along excitation (mm)");
+    s.y_axis = Axis::linear("up (mm)");
+    s.color = ColorScale::linear(0.0, 2.0);
+    s.colorbar_title = "|v| / V (-)".into();
+    let mut q = Quiver::new(u, v);
+    let vmax = q.max_magnitude();
+    if vmax > 0.0 {
+        q.scale = Some(rec.cell_m * 1e3 / vmax);
+        let r = nice_below(vmax);
+        q.key = Some(QuiverKey {
+            magnitude: r,
+            label: format!(
+                "mean velocity v/V = {} ({} m/s)",
+                pdamp_plot::format_number(r),
+                significant(r * rec.velocity_amplitude_m_s, 3)
+            ),
+        });
+    }
+    s.arrows = Some(q);
+    if let Some((ox, oy)) = container_outline_mm(rec) {
+        let mut o = Polyline::new("container", ox, oy);
+        o.color = Some(Rgb::BLACK);
+        s.outlines.push(o);
+    }
+    s.marker_px = 6;
+    Some(s)
+}
+
+/// One scatter plot per recorded phase ([`velocity_field_figure`]):
+/// `velocity_field_phaseK.png/.svg`.
+pub fn velocity_field_plots(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
+    for k in 0..rec.fields.len() {
+        if let Some(s) = velocity_field_figure(rec, k) {
+            pdamp_plot::scatter_field(out.join(format!("velocity_field_phase{k}")), &s)
+                .map_err(err)?;
+        }
     }
     Ok(())
 }
 
-/// Trajectories of the chosen particles in the container frame (excitation direction vs up).
+/// Trajectories of the chosen particles in the container frame (excitation direction vs up),
+/// with the container's outline.
 pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
     if rec.trajectories.is_empty() {
         return Ok(());
@@ -256,7 +388,142 @@ pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
         }
         plot.series.push(Series::new(format!("particle {i}"), a, b));
     }
+    if let Some((ox, oy)) = container_outline_mm(rec) {
+        // Last in the list: the particles keep their palette colours.
+        plot.series
+            .push(Series::new("container", ox, oy).with_color(Rgb::BLACK));
+    }
     pdamp_plot::line_plot(out.join("trajectories"), &plot).map_err(err)?;
+    Ok(())
+}
+
+/// Evaluated cycles drawn each in its own colour in the hysteresis plot (earlier evaluated
+/// cycles are grey).
+const HYSTERESIS_COLOURED_CYCLES: usize = 5;
+
+/// The bed force on the container and the container displacement of a damper point
+/// ([`MotionRecorder::force_displacement`]): `force_time.png/.svg`, both over time (force
+/// left, displacement in mm on the right axis, the transient cycles shaded), and
+/// `hysteresis.png/.svg`, the force against the displacement, one loop per cycle (transient
+/// cycles faint, the last evaluated ones in colour), titled with the mean loop area
+/// ∮(−f_p) dx per evaluated cycle and Ẽ_diss of the complex power method [D Sect. 3.2.2,
+/// Eq. 3.13].
+pub fn force_displacement_plots(
+    rec: &MotionRecorder,
+    transient_cycles: u32,
+    point: &PointResult,
+    out: &Path,
+) -> Result<(), String> {
+    let rows = &rec.force_displacement;
+    if rows.len() < 2 {
+        return Ok(());
+    }
+    let col = |k: usize, scale: f64| -> Vec<f64> { rows.iter().map(|r| r[k] * scale).collect() };
+    let heading = format!(
+        "f = {} Hz, X = {} mm",
+        pdamp_plot::format_number(point.frequency_hz),
+        significant(point.amplitude_m * 1e3, 4)
+    );
+
+    let mut ft = LinePlot::new(
+        Axis::linear("time t (s)"),
+        Axis::linear("bed force on the container f_p (N)"),
+    );
+    ft.title = format!("bed force and container displacement, {heading}");
+    ft.y2_axis = Some(Axis::linear("container displacement x (mm)"));
+    let t_transient = transient_cycles as f64 / point.frequency_hz;
+    if transient_cycles > 0 {
+        ft.spans.push(XSpan::new(
+            0.0,
+            t_transient.min(rows[rows.len() - 1][0]),
+            "transient cycles (not evaluated)",
+        ));
+    }
+    ft.series.push(
+        Series::new("bed force f_p", col(0, 1.0), col(4, 1.0))
+            .with_color(Rgb(31, 119, 180))
+            .with_width(1),
+    );
+    ft.series.push(
+        Series::new("displacement x", col(0, 1.0), col(2, 1e3))
+            .with_color(Rgb(255, 127, 14))
+            .on_secondary_axis(),
+    );
+    ft.size_px = (1000, 520);
+    pdamp_plot::line_plot(out.join("force_time"), &ft).map_err(err)?;
+
+    let mut hy = LinePlot::new(
+        Axis::linear("container displacement x (mm)"),
+        Axis::linear("bed force on the container f_p (N)"),
+    );
+    let area = rec.loop_work_per_cycle_j(transient_cycles);
+    hy.title = match area {
+        Some(a) => format!(
+            "hysteresis, {heading}: ∮(−f_p)dx = {} J/cycle, Ẽ_diss = {} J",
+            significant(a, 4),
+            significant(point.dissipated_energy_per_cycle_j, 4)
+        ),
+        None => format!("hysteresis, {heading}"),
+    };
+    let cycles: Vec<u32> = {
+        let mut c: Vec<u32> = rows.iter().map(|r| r[1] as u32).collect();
+        c.dedup();
+        c
+    };
+    let evaluated: Vec<u32> = cycles
+        .iter()
+        .copied()
+        .filter(|c| *c >= transient_cycles)
+        .collect();
+    let coloured = &evaluated[evaluated.len().saturating_sub(HYSTERESIS_COLOURED_CYCLES)..];
+    let loop_of = |c: u32| -> (Vec<f64>, Vec<f64>) {
+        rows.iter()
+            .filter(|r| r[1] as u32 == c)
+            .map(|r| (r[2] * 1e3, r[4]))
+            .unzip()
+    };
+    let (mut transient_labelled, mut grey_labelled) = (false, false);
+    for &c in &cycles {
+        let (x, f) = loop_of(c);
+        let s = if c < transient_cycles {
+            let label = if transient_labelled {
+                String::new()
+            } else {
+                transient_labelled = true;
+                match transient_cycles {
+                    1 => "transient cycle 0".to_string(),
+                    n => format!("transient cycles 0–{}", n - 1),
+                }
+            };
+            Series::new(label, x, f)
+                .with_color(Rgb(205, 205, 205))
+                .with_width(1)
+        } else if coloured.contains(&c) {
+            Series::new(format!("cycle {c}"), x, f).with_width(2)
+        } else {
+            let label = if grey_labelled {
+                String::new()
+            } else {
+                grey_labelled = true;
+                format!("cycles {}–{}", evaluated[0], coloured[0] - 1)
+            };
+            Series::new(label, x, f)
+                .with_color(Rgb(140, 140, 140))
+                .with_width(1)
+        };
+        hy.series.push(s);
+    }
+    // Palette colours for the coloured loops in order, whatever precedes them.
+    for (k, s) in hy
+        .series
+        .iter_mut()
+        .filter(|s| s.color.is_none())
+        .enumerate()
+    {
+        s.color = Some(pdamp_plot::palette_color(k));
+    }
+    hy.size_px = (900, 620);
+    pdamp_plot::line_plot(out.join("hysteresis"), &hy).map_err(err)?;
     Ok(())
 }
 
@@ -311,6 +578,126 @@ pub fn value_map(
 mod tests {
     use super::*;
     use pdamp_io::scenario::AmplitudeAxis;
+
+    /// A recorder on a 20 × 10 × 6 mm box (one particle, excitation along x, gravity −z) with
+    /// 10 cells along the excitation: cells of 2 mm; phase 0 filled with a made-up field.
+    fn recorder() -> MotionRecorder {
+        use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
+        use pdamp_dem::walls::{BoxInside, Geometry};
+        use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
+        let model = ContactModel {
+            normal: NormalLaw::Linear {
+                stiffness_n_m: 2e5,
+                restitution: 0.5,
+                clip_attractive: false,
+            },
+            friction: FrictionLaw::Frictionless,
+            rolling: None,
+            adhesion: None,
+        };
+        let mut w = World::new(vec![Material::new("steel", 7800.0, 2e9, 0.3)], model, 1e-6);
+        w.add_body(
+            RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+                "box",
+                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(10e-3, 5e-3, 3e-3))),
+                0,
+            ),
+        );
+        w.add_particle(Vec3::new(0.0, 0.0, -2e-3), 1e-3, 0);
+        let damper = crate::Damper::from_world(w, 0, Vec3::x(), 0.1, 3, 1);
+        let mut rec = MotionRecorder::new(&damper, 50.0, 0.25, 2, 10, vec![], 2e4);
+        let f = &mut rec.fields[0];
+        for c in 0..f.count.len() {
+            let k = c as f64;
+            f.count[c] = 2;
+            f.speed_sum[c] = 0.2 * k;
+            f.vel_sum[c] = [0.1 * k, -0.05 * k];
+        }
+        rec
+    }
+
+    /// The fastest cell's arrow is one cell (2 mm) long, the reference arrow stands for a
+    /// 1-2-5 value not above the largest velocity and states it in m/s too, and the container
+    /// outline is the box's inner extent along the plotted axes (x and up = z).
+    #[test]
+    fn velocity_field_arrows_one_cell_and_outline() {
+        let rec = recorder();
+        assert!((rec.cell_m - 2e-3).abs() < 1e-15);
+        let fig = velocity_field_figure(&rec, 0).expect("phase 0 has samples");
+        let q = fig.arrows.as_ref().unwrap();
+        let longest = fig.arrow_scale(q) * q.max_magnitude();
+        assert!((longest - 2.0).abs() < 1e-12, "longest arrow {longest} mm");
+        let key = q.key.as_ref().unwrap();
+        assert!(key.magnitude <= q.max_magnitude() && key.magnitude > 0.4 * q.max_magnitude());
+        assert!(key.label.contains("m/s"), "{}", key.label);
+        let o = &fig.outlines[0];
+        let (xmin, xmax) =
+            o.x.iter()
+                .fold((f64::MAX, f64::MIN), |a, v| (a.0.min(*v), a.1.max(*v)));
+        let (ymin, ymax) =
+            o.y.iter()
+                .fold((f64::MAX, f64::MIN), |a, v| (a.0.min(*v), a.1.max(*v)));
+        assert!(
+            (xmin + 10.0).abs() < 1e-9 && (xmax - 10.0).abs() < 1e-9,
+            "{xmin} {xmax}"
+        );
+        assert!(
+            (ymin + 3.0).abs() < 1e-9 && (ymax - 3.0).abs() < 1e-9,
+            "{ymin} {ymax}"
+        );
+        assert_eq!((o.x[0], o.y[0]), (o.x[4], o.y[4]), "closed");
+        assert_eq!(nice_below(0.83), 0.5);
+        assert_eq!(nice_below(2.0), 2.0);
+        assert_eq!(nice_below(0.0123), 0.01);
+    }
+
+    /// Lines of constant X on maps over Γ or A: decades of X crossing the map, each the curve
+    /// XΩ²/g (XΩ²) and annotated in mm; none over X.
+    #[test]
+    fn constant_x_lines_on_intensity_and_acceleration_maps() {
+        let mut grid = FieldGrid {
+            frequencies_hz: vec![40.0, 1000.0],
+            amplitude_axis: AmplitudeAxis::Intensity,
+            amplitude_values: vec![1.0, 40.0],
+            frequency_log: true,
+            amplitude_log: true,
+        };
+        let lines = constant_x_overlays(&grid);
+        // Γ from 1 to 40 over 40–1000 Hz: X from 2.5e-7 m to 6.2e-3 m → 1 µm … 1 mm.
+        let labels: Vec<&str> = lines.iter().map(|l| l.annotation.as_str()).collect();
+        assert!(labels.len() >= 2 && labels.len() <= 4, "{labels:?}");
+        assert!(labels.contains(&"X = 0.01 mm") || labels.contains(&"X = 0.001 mm"));
+        for l in &lines {
+            let x_mm: f64 = l.annotation["X = ".len()..l.annotation.len() - 3]
+                .parse()
+                .unwrap();
+            let f = l.x[20];
+            let w = 2.0 * std::f64::consts::PI * f;
+            assert!(
+                (l.y[20] / (x_mm * 1e-3 * w * w / pdamp_io::scenario::STANDARD_GRAVITY_M_S2) - 1.0)
+                    .abs()
+                    < 1e-12
+            );
+            assert!(
+                l.y.iter().any(|g| (1.0..=40.0).contains(g)),
+                "crosses the map"
+            );
+            assert!(l.label.is_empty(), "no legend entry");
+        }
+        grid.amplitude_axis = AmplitudeAxis::Acceleration;
+        grid.amplitude_values = vec![10.0, 30.0];
+        let lines = constant_x_overlays(&grid);
+        assert!(!lines.is_empty());
+        for l in &lines {
+            let x_mm: f64 = l.annotation["X = ".len()..l.annotation.len() - 3]
+                .parse()
+                .unwrap();
+            let w = 2.0 * std::f64::consts::PI * l.x[0];
+            assert!((l.y[0] / (x_mm * 1e-3 * w * w) - 1.0).abs() < 1e-12);
+        }
+        grid.amplitude_axis = AmplitudeAxis::Displacement;
+        assert!(constant_x_overlays(&grid).is_empty());
+    }
 
     /// The overlay lines in the units of each amplitude axis: A = g is Γ = 1, A = 9.81 m/s² and
     /// X = g/Ω²; X_opt = h/π is constant in X and grows as Ω² in Γ.

@@ -223,7 +223,10 @@ pub fn run_other_packings(
 }
 
 /// Runs the single excitation point of a damper scenario and writes `summary.json`,
-/// `velocity_fields.csv`, `trajectories.csv`, `particles.pvd` + `vtk/` and plots into `out`.
+/// `velocity_fields.csv`, `trajectories.csv`, `force_displacement.csv` (bed force, driving
+/// force and container motion over all cycles, [`MotionRecorder::force_displacement`]),
+/// `particles.pvd` + `vtk/` and plots (velocity fields, trajectories, `force_time`,
+/// `hysteresis`) into `out`.
 pub fn run_damper_scenario(
     sc: &Scenario,
     base_dir: &Path,
@@ -340,6 +343,13 @@ pub fn run_damper_scenario_with(
     }
     crate::plots::velocity_field_plots(&rec, out)?;
     crate::plots::trajectory_plot(&rec, out)?;
+    pdamp_io::csv::write_csv_atomic(
+        out.join("force_displacement.csv"),
+        &crate::motion::FORCE_DISPLACEMENT_COLUMNS,
+        &rec.force_displacement,
+    )
+    .map_err(|e| format!("output: {e}"))?;
+    crate::plots::force_displacement_plots(&rec, damper.transient_cycles, &p, out)?;
     let bed = damper.bed_statistics();
     let packings = spec.packings;
     let ensemble = if packings > 1 {
