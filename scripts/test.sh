@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# All tests of the project (what CI runs, see README.md). The GPU kernels' tests need a Vulkan
+# All tests of the project (what CI runs, see README.md): Rust, the GPU kernels on a CPU Vulkan
+# driver, ParaView output read back by VTK. The GPU kernels' tests need a Vulkan
 # driver with 64-bit float shaders: on a machine without a GPU that is Mesa's lavapipe (CPU
 # Vulkan, Debian package mesa-vulkan-drivers), installed here when missing. Where lavapipe (or a
 # GPU) is present the GPU tests are required to run (PDAMP_REQUIRE_GPU_TESTS=1), not skipped.
@@ -26,4 +27,29 @@ else
 fi
 # lavapipe's window-system layer complains without it
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
-cargo test --workspace "$@"
+
+# A Python with VTK (the library ParaView is built on) for the tests that open pdamp's ParaView
+# output with VTK's own readers (crates/pdamp-cli/tests/paraview.rs), in target/test-venv.
+venv=target/test-venv
+has_vtk() { "$venv/bin/python" -c "import vtkmodules.vtkIOXML" >/dev/null 2>&1; }
+if ! has_vtk; then
+  if ! command -v python3 >/dev/null 2>&1 || ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+    if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+      echo "installing python3 and python3-venv for the VTK reader tests"
+      apt-get update -qq >/dev/null
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3 python3-venv >/dev/null
+    fi
+  fi
+  echo "making $venv (pip install -r scripts/requirements-test.txt)"
+  rm -rf "$venv"
+  python3 -m venv "$venv" && "$venv/bin/pip" install -q -r scripts/requirements-test.txt \
+    || echo "WARNING: no Python with VTK: the VTK reader tests will be skipped" >&2
+fi
+if has_vtk; then
+  export PDAMP_TEST_PYTHON="$PWD/$venv/bin/python"
+  export PDAMP_REQUIRE_VTK_TESTS=1
+fi
+
+# --release: the same build as the README's `cargo run --release` (built once, not twice; see
+# the profiles in Cargo.toml). The test harnesses keep debug assertions ([profile.bench]).
+cargo test --release --workspace "$@"

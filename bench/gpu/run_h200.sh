@@ -30,7 +30,8 @@ run() { # label, command...
   log "$label: $*"
   local t0=$(date +%s.%N)
   local line
-  line=$("$@" 2>>"$LOG" | tail -1)
+  # (pdamp prints one pretty-printed JSON object; without its newlines it is one JSON line)
+  line=$("$@" 2>>"$LOG" | tr -d '\n')
   local rc=$?
   local t1=$(date +%s.%N)
   if [ -n "$line" ] && [ "${line:0:1}" = "{" ]; then

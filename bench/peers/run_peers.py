@@ -93,7 +93,7 @@ def run_pdamp(exe, n, steps, threads, settled, export=None):
         cmd += ["--export-liggghts", export]
     c0 = cpu_times()
     out = sh(cmd).stdout
-    r = json.loads(out.strip().splitlines()[-1])
+    r = json.loads(out)  # pdamp prints one pretty-printed JSON object on stdout
     r["steal_fraction"] = steal_fraction(c0, cpu_times())
     return r
 

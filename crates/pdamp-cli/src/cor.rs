@@ -40,7 +40,7 @@ pub struct CorArgs {
     #[arg(long, value_enum, default_value_t = MeshArg::Medium)]
     mesh: MeshArg,
     /// Output directory.
-    #[arg(long, default_value = "out/cor")]
+    #[arg(long)]
     out: PathBuf,
     /// TOML file with `[materials.NAME]` tables (added to the built-ins).
     #[arg(long)]

@@ -308,8 +308,29 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// `pdamp` with `--opt -1` accepted as a value in every subcommand (clap takes `-1` for an
+/// option otherwise and asks for `--opt=-1`); a negative value where none is allowed gets the
+/// option's own range error.
+fn cli_command() -> clap::Command {
+    fn negative_numbers(cmd: clap::Command) -> clap::Command {
+        let names: Vec<String> = cmd
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        names
+            .into_iter()
+            .fold(cmd.allow_negative_numbers(true), |c, n| {
+                c.mut_subcommand(n, negative_numbers)
+            })
+    }
+    negative_numbers(<Cli as clap::CommandFactory>::command())
+}
+
 fn run_cli() -> Result<()> {
-    let cli = Cli::parse();
+    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&cli_command().get_matches()) {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
     pdamp_io::estimate::set_force(cli.force);
     progress::set_quiet(cli.quiet);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -366,10 +387,9 @@ fn dispatch(command: Command) -> Result<()> {
         } => cmd_fields(&scenario, &out, device, overwrite),
         Command::Check { scenario } => cmd_check(&scenario),
         Command::Completions { shell } => {
-            use clap::CommandFactory;
             // Into a buffer first: a closed pipe (`| head`) is not an error worth a panic.
             let mut script = Vec::new();
-            clap_complete::generate(shell, &mut Cli::command(), "pdamp", &mut script);
+            clap_complete::generate(shell, &mut cli_command(), "pdamp", &mut script);
             use std::io::Write;
             match std::io::stdout().write_all(&script) {
                 Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
@@ -519,7 +539,7 @@ fn dispatch(command: Command) -> Result<()> {
                         );
                     }
                     let r = gpu::bench(particles, steps, batch, settle_steps)?;
-                    println!("{r}");
+                    println!("{}", serde_json::to_string_pretty(&r)?);
                     return Ok(());
                 }
                 #[cfg(not(feature = "gpu"))]
@@ -537,7 +557,7 @@ fn dispatch(command: Command) -> Result<()> {
                     .map_err(anyhow::Error::msg)?;
                 println!(
                     "{}",
-                    serde_json::json!({
+                    serde_json::to_string_pretty(&serde_json::json!({
                         "particles": r.particles,
                         "steps": r.steps,
                         "threads": rayon::current_num_threads(),
@@ -546,7 +566,7 @@ fn dispatch(command: Command) -> Result<()> {
                         "neighbor_builds": r.neighbor_builds,
                         "contacts_pp": r.contacts_pp,
                         "settling_wall_time_s": r.settling_wall_time_s,
-                    })
+                    }))?
                 );
                 return Ok(());
             }
@@ -557,7 +577,7 @@ fn dispatch(command: Command) -> Result<()> {
                     .map_err(anyhow::Error::msg)?;
             }
             let r = pdamp_io::bench::run_peer(&mut world, steps);
-            println!("{}", serde_json::to_string(&r)?);
+            println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }
     }
@@ -565,7 +585,8 @@ fn dispatch(command: Command) -> Result<()> {
 
 /// Files and folders the DEM commands write into their output directory (checked for
 /// symbolic links and for inputs they would replace before anything is written).
-const RUN_OUTPUTS: [&str; 16] = [
+const RUN_OUTPUTS: [&str; 22] = [
+    "input.toml",
     "energy.png",
     "energy.svg",
     "scenario.toml",
@@ -582,7 +603,20 @@ const RUN_OUTPUTS: [&str; 16] = [
     "packings",
     "points",
     "fields.csv",
+    "force_displacement.csv",
+    "force_time.png",
+    "force_time.svg",
+    "hysteresis.png",
+    "hysteresis.svg",
 ];
+
+/// `DIR/input.toml`: a verbatim copy of the input file, in every command's output directory
+/// (the DEM commands add `scenario.toml`, the scenario as run with every default filled in).
+fn copy_input(out: &std::path::Path, input: &std::path::Path) -> Result<()> {
+    let bytes = std::fs::read(input).with_context(|| format!("reading {}", input.display()))?;
+    pdamp_io::atomic::write_atomic(out.join("input.toml"), &bytes)
+        .with_context(|| format!("writing {}", out.join("input.toml").display()))
+}
 
 /// Opens the output directory of a command (see [`pdamp_io::output_dir`]): `resume` continues
 /// an earlier run that left `checkpoint` in it (with nothing to continue in an empty
@@ -764,6 +798,9 @@ fn cmd_run(
         &RUN_OUTPUTS,
         &inputs,
     )?;
+    if scenario != "builtin:shaken-box" {
+        copy_input(out, std::path::Path::new(scenario))?;
+    }
     let bar = progress::Progress::new();
     let tick = |phase: &str, f: f64| bar.set(phase, f);
     let json = if sc.damper.is_some() {
@@ -855,6 +892,7 @@ fn cmd_fields(
         &RUN_OUTPUTS,
         &inputs,
     )?;
+    copy_input(out, scenario)?;
     let start = std::time::Instant::now();
     let outcome = pdamp_design::report::run_fields_scenario_on(
         &sc,
@@ -906,6 +944,7 @@ fn cmd_settle(
         overwrite,
         None,
         &[
+            "input.toml",
             "scenario.toml",
             "provenance.json",
             "bed.pdbed",
@@ -916,6 +955,7 @@ fn cmd_settle(
         ],
         &inputs,
     )?;
+    copy_input(out, scenario)?;
     let base = scenario
         .parent()
         .map(|p| p.to_path_buf())

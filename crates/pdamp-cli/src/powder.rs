@@ -84,7 +84,9 @@ struct CheckpointArgs {
 }
 
 /// What `pdamp powder run` and `study` write (checked for links and inputs).
-const OUTPUTS: [&str; 12] = [
+const OUTPUTS: [&str; 14] = [
+    "particles.pvd",
+    "vtk",
     "tip.csv",
     "envelope.csv",
     "energy.csv",
@@ -198,7 +200,9 @@ pub fn run(args: PowderArgs) -> Result<()> {
             bar.finish();
             println!(
                 "{}",
-                serde_json::json!({ "frequencies_hz": f, "timoshenko_f1_hz": timo, "dofs": 3 * sc.beam.mesh().nodes.len() })
+                serde_json::to_string_pretty(
+                    &serde_json::json!({ "frequencies_hz": f, "timoshenko_f1_hz": timo, "dofs": 3 * sc.beam.mesh().nodes.len() })
+                )?
             );
         }
     }

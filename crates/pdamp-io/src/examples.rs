@@ -35,6 +35,7 @@ pub fn shaken_box(n: usize, duration_s: f64) -> Scenario {
         output: OutputSpec {
             energy_interval_s: 1e-3,
             vtk_interval_s: 0.05,
+            vtk_format: Default::default(),
         },
         materials: vec![Material::new("steel", 7800.0, 2e9, 0.3)],
         contact: ContactSpec {

@@ -28,6 +28,8 @@ use std::path::{Path, PathBuf};
 pub const LOCK_FILE: &str = ".pdamp.lock";
 /// Name of the manifest inside an output directory.
 pub const MANIFEST_FILE: &str = "manifest.json";
+/// The verbatim copy of the input file every command writes into its output directory.
+pub const INPUT_COPY_FILE: &str = "input.toml";
 
 /// Output files of earlier pdamp versions (without a manifest) that mark a directory as
 /// holding results.
@@ -355,8 +357,13 @@ impl OutputDir {
             .into_iter()
             .filter(|f| !before.contains(f) && f != MANIFEST_FILE)
             .collect();
-        // A command that failed before writing anything leaves no directory it created.
-        if self.status == RunStatus::Failed && self.created && files.is_empty() {
+        // A command that failed before writing anything (a copy of its input is no result)
+        // leaves no directory it created.
+        if self.status == RunStatus::Failed
+            && self.created
+            && files.iter().all(|f| f == INPUT_COPY_FILE)
+        {
+            let _ = fs::remove_file(self.path.join(INPUT_COPY_FILE));
             self.lock = None;
             let _ = fs::remove_file(self.path.join(MANIFEST_FILE));
             let _ = fs::remove_file(self.path.join(LOCK_FILE));

@@ -3,7 +3,9 @@
 
 use crate::csv::CsvWriter;
 use crate::scenario::Scenario;
-use crate::vtk::{PointField, PvdSeries, write_mesh_vtp, write_particles_vtp};
+use crate::vtk::{
+    PointField, PvdSeries, VtkEncoding, write_mesh_vtp_with, write_particles_vtp_with,
+};
 use pdamp_dem::WorldState;
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::{Geometry, Motion, Vec3, World};
@@ -244,18 +246,30 @@ pub fn settle_with_or_break(
     Some(t)
 }
 
-/// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`.
+/// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`
+/// (compressed binary; see [`write_snapshot_with`]).
 pub fn write_snapshot(
     world: &World,
     dir: &Path,
     index: usize,
+) -> Result<PathBuf, crate::vtk::VtkError> {
+    write_snapshot_with(world, dir, index, VtkEncoding::default())
+}
+
+/// Writes the particles and all mesh-like walls of `world` as VTK files into `dir` with the
+/// array encoding `encoding` (`output.vtk_format`).
+pub fn write_snapshot_with(
+    world: &World,
+    dir: &Path,
+    index: usize,
+    encoding: VtkEncoding,
 ) -> Result<PathBuf, crate::vtk::VtkError> {
     let p = &world.particles;
     let name = format!("particles_{index:06}.vtp");
     let speed: Vec<f64> = p.velocity.iter().map(|v| v.norm()).collect();
     let mat: Vec<u32> = p.material.iter().map(|&m| m as u32).collect();
     let ids: Vec<u32> = p.id.clone();
-    write_particles_vtp(
+    write_particles_vtp_with(
         dir.join(&name),
         &p.position,
         &p.radius,
@@ -269,21 +283,105 @@ pub fn write_snapshot(
             ("material", PointField::Int(&mat)),
             ("id", PointField::Int(&ids)),
         ],
+        encoding,
     )?;
     for (bi, b) in world.bodies.iter().enumerate() {
         for (wi, w) in b.walls.iter().enumerate() {
             if let Some((verts, tris)) = wall_surface(&w.geometry) {
                 let world_verts: Vec<Vec3> =
                     verts.iter().map(|v| b.state.point_to_world(v)).collect();
-                write_mesh_vtp(
+                write_mesh_vtp_with(
                     dir.join(format!("wall_{bi}_{wi}_{index:06}.vtp")),
                     &world_verts,
                     &tris,
+                    encoding,
                 )?;
             }
         }
     }
     Ok(PathBuf::from("vtk").join(name))
+}
+
+/// A ParaView series of DEM snapshots (particles and every wall with a surface) written every
+/// `every_steps` steps of a time loop: `DIR/NAME.pvd` with the files in `DIR/SUBDIR/`. A run
+/// resumed at a step continues the series: the earlier frames are those of the earlier
+/// multiples of `every_steps` (checked to exist), so no state beyond the step is needed.
+#[derive(Debug)]
+pub struct SnapshotSeries {
+    out: PathBuf,
+    subdir: String,
+    every_steps: u64,
+    encoding: VtkEncoding,
+    series: PvdSeries,
+    next_index: usize,
+}
+
+impl SnapshotSeries {
+    /// A series `out/pvd_name` with frames in `out/subdir/`, one every `every_steps` (≥ 1).
+    pub fn new(
+        out: &Path,
+        pvd_name: &str,
+        subdir: &str,
+        every_steps: u64,
+        encoding: VtkEncoding,
+    ) -> Self {
+        SnapshotSeries {
+            out: out.to_path_buf(),
+            subdir: subdir.to_string(),
+            every_steps: every_steps.max(1),
+            encoding,
+            series: PvdSeries::new(out.join(pvd_name)),
+            next_index: 0,
+        }
+    }
+
+    /// Steps between frames for a snapshot interval of `interval_s` at time step `dt_s`
+    /// (`None`: no snapshots, `interval_s` ≤ 0).
+    pub fn every_steps_for(interval_s: f64, dt_s: f64) -> Option<u64> {
+        (interval_s > 0.0 && dt_s > 0.0).then(|| ((interval_s / dt_s).round() as u64).max(1))
+    }
+
+    fn files(&self, world: &World, index: usize) -> Vec<String> {
+        snapshot_files(world, index)
+            .into_iter()
+            .map(|f| format!("{}/{}", self.subdir, f.trim_start_matches("vtk/")))
+            .collect()
+    }
+
+    /// Continues a run resumed after step `step` (the frames of the steps `0, every, 2·every,
+    /// … ≤ step`, at `k·every·dt_s`, were written by the interrupted run and must exist).
+    pub fn resume_after(&mut self, step: u64, dt_s: f64, world: &World) -> Result<(), String> {
+        let n = (step / self.every_steps + 1) as usize;
+        let mut entries = Vec::new();
+        for k in 0..n {
+            let t = (k as u64 * self.every_steps) as f64 * dt_s;
+            let t = (t * 1e12).round() / 1e12;
+            entries.extend(self.files(world, k).into_iter().map(|f| (t, f)));
+        }
+        self.series =
+            PvdSeries::resume(self.series.path(), entries).map_err(|e| format!("output: {e}"))?;
+        self.next_index = n;
+        Ok(())
+    }
+
+    /// Writes the frame of step `step` at time `time_s` if `step` is a multiple of the
+    /// interval (call it for step 0 too).
+    pub fn on_step(&mut self, step: u64, time_s: f64, world: &World) -> Result<(), String> {
+        if !step.is_multiple_of(self.every_steps) {
+            return Ok(());
+        }
+        let dir = self.out.join(&self.subdir);
+        std::fs::create_dir_all(&dir).map_err(|e| format!("output: {}: {e}", dir.display()))?;
+        let index = self.next_index;
+        write_snapshot_with(world, &dir, index, self.encoding)
+            .map_err(|e| format!("output: {e}"))?;
+        let files = self.files(world, index);
+        self.series
+            .add_frame(time_s, &files)
+            .map_err(|e| format!("output: {e}"))?;
+        self.next_index += 1;
+        Ok(())
+    }
 }
 
 /// The files of snapshot `index` relative to the output directory (`vtk/particles_….vtp`
@@ -603,6 +701,7 @@ pub fn run_scenario(
     // Main run: outputs opened fresh or continued at the checkpoint.
     let vtk_dir = out_dir.join("vtk");
     let vtk_every = scenario.output.vtk_interval_s;
+    let vtk_encoding: VtkEncoding = scenario.output.vtk_format.into();
     let e_every = scenario.output.energy_interval_s;
     let csvio = |e: crate::csv::CsvError| format!("output: {e}");
     let pvd_path = out_dir.join("particles.pvd");
@@ -648,7 +747,8 @@ pub fn run_scenario(
             csv.write_row(&ledger_row(&world)).map_err(csvio)?;
             let mut snap = 0usize;
             if let Some(s) = series.as_mut() {
-                write_snapshot(&world, &vtk_dir, snap).map_err(|e| e.to_string())?;
+                write_snapshot_with(&world, &vtk_dir, snap, vtk_encoding)
+                    .map_err(|e| e.to_string())?;
                 s.add_frame(world.time_s, &snapshot_files(&world, snap))
                     .map_err(|e| e.to_string())?;
                 snap += 1;
@@ -682,7 +782,7 @@ pub fn run_scenario(
             && w.time_s >= next_v - 1e-12
         {
             w.complete_step();
-            match write_snapshot(w, &vtk_dir, snap) {
+            match write_snapshot_with(w, &vtk_dir, snap, vtk_encoding) {
                 Ok(_) => {
                     if let Err(e) = s.add_frame(w.time_s, &snapshot_files(w, snap)) {
                         err = Some(format!("output: {e}"));

@@ -535,6 +535,30 @@ pub struct OutputSpec {
     /// Interval of VTK snapshots, s; 0 disables VTK.
     #[serde(default = "default_vtk_interval")]
     pub vtk_interval_s: f64,
+    /// Data encoding of the VTK files: `"binary"` (zlib-compressed, appended; the default)
+    /// or `"ascii"` (readable and diffable, ≈ 5 × larger).
+    #[serde(default)]
+    pub vtk_format: VtkFormat,
+}
+
+/// Data encoding of VTK output (`output.vtk_format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VtkFormat {
+    /// zlib-compressed raw binary appended to the file (ParaView's own default).
+    #[default]
+    Binary,
+    /// Shortest round-trip decimal numbers.
+    Ascii,
+}
+
+impl From<VtkFormat> for crate::vtk::VtkEncoding {
+    fn from(f: VtkFormat) -> Self {
+        match f {
+            VtkFormat::Binary => crate::vtk::VtkEncoding::Binary,
+            VtkFormat::Ascii => crate::vtk::VtkEncoding::Ascii,
+        }
+    }
 }
 
 fn default_energy_interval() -> f64 {
@@ -549,6 +573,7 @@ impl Default for OutputSpec {
         Self {
             energy_interval_s: default_energy_interval(),
             vtk_interval_s: default_vtk_interval(),
+            vtk_format: VtkFormat::default(),
         }
     }
 }

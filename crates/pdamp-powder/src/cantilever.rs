@@ -343,6 +343,14 @@ pub struct RunSpec {
     /// Sampling interval of tip.csv [s] (0 = every step).
     #[serde(default)]
     pub output_interval_s: f64,
+    /// Interval of the ParaView frames (particles and deformed structure,
+    /// `particles.pvd`) [s]; 0 = none. Default 1 ms.
+    #[serde(default = "d_vtk_interval")]
+    pub vtk_interval_s: f64,
+}
+
+fn d_vtk_interval() -> f64 {
+    1e-3
 }
 
 /// A cantilever scenario.
@@ -416,6 +424,19 @@ impl CantileverScenario {
             return Err(format!(
                 "run.output_interval_s: must be in [0, duration_s] (0 = every step), got {}",
                 r.output_interval_s
+            ));
+        }
+        if !(r.vtk_interval_s >= 0.0 && r.vtk_interval_s.is_finite()) {
+            return Err(format!(
+                "run.vtk_interval_s: must be finite and >= 0 (seconds between ParaView frames, 0 = none), got {}",
+                r.vtk_interval_s
+            ));
+        }
+        if r.vtk_interval_s > 0.0 && r.duration_s / r.vtk_interval_s > 20_000.0 {
+            return Err(format!(
+                "run.vtk_interval_s: {:.3e} ParaView frames over duration_s = {} s, more than 20 000; use a larger interval (or 0 for none)",
+                r.duration_s / r.vtk_interval_s,
+                r.duration_s
             ));
         }
         let c = &r.coupling;
@@ -731,7 +752,7 @@ pub fn run(
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<CantileverResult, String> {
     sc.validate()?;
-    run_core(sc, None, None, progress)
+    run_core(sc, None, None, None, progress)
 }
 
 /// Runs the scenario and writes its outputs ([`write_outputs`]) into `dir`, checkpointing
@@ -776,16 +797,18 @@ pub fn run_in_dir(
             .map_err(|e| format!("{}: {e}", path.display()));
     }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let r = run_core(sc, Some(&c), resumed, progress)?;
+    let r = run_core(sc, Some(&c), resumed, Some(dir), progress)?;
     write_outputs(dir, sc, &r)?;
     c.save(&Phase::Finished)?;
     Ok(r)
 }
 
+/// The run; with `vtk_dir` the ParaView frames of [`crate::vtk::PowderSnapshots`] go there.
 fn run_core(
     sc: &CantileverScenario,
     ckp: Option<&Checkpointing>,
     resumed: Option<Phase>,
+    vtk_dir: Option<&Path>,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<CantileverResult, String> {
     let (mut s, tip) = build_structure(&sc.beam, &sc.load, sc.run.gravity_m_s2);
@@ -938,6 +961,25 @@ fn run_core(
     {
         cp.save(&state(&c, &res, 0, wall(&clock)))?;
     }
+    let mut snapshots = match vtk_dir {
+        Some(d) if sc.run.vtk_interval_s > 0.0 => {
+            let every = ((sc.run.vtk_interval_s / dt).round() as u64).max(1);
+            Some(crate::vtk::PowderSnapshots::new(
+                d,
+                every,
+                dt,
+                &c.structure.mesh,
+            ))
+        }
+        _ => None,
+    };
+    if let Some(s) = snapshots.as_mut() {
+        if first > 1 {
+            s.resume_after(first - 1)?;
+        } else {
+            s.on_step(0, &c)?;
+        }
+    }
     let every = ((sc.run.output_interval_s / dt).round() as u64).max(1);
     let e_every = (nsteps / 2000).max(1);
     let t_release = sc.load.rise_s + sc.load.hold_s;
@@ -957,6 +999,9 @@ fn run_core(
             let e = c.energy();
             res.energy.push((t, e));
             check_energy_health(&c, &res.energy)?;
+        }
+        if let Some(s) = snapshots.as_mut() {
+            s.on_step(q, &c)?;
         }
         if q % 200 == 0 {
             progress("coupled run", q as f64 / nsteps as f64);

@@ -32,3 +32,4 @@ pub mod fuzz;
 pub mod health;
 pub mod prep;
 pub mod study;
+pub mod vtk;

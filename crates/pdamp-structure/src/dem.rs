@@ -60,6 +60,24 @@ pub struct CouplingCheckpoint {
     pub interval_s: f64,
     /// Continue from `path` if it exists.
     pub resume: bool,
+    /// ParaView output of the bed during the run (`None`: none).
+    pub bed_vtk: Option<BedVtk>,
+}
+
+/// ParaView output of a coupled run's DEM bed: particles and container walls every
+/// `interval_s` of simulated time, as `dir/pvd_name` with the frames in `dir/subdir/`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BedVtk {
+    /// Output directory.
+    pub dir: PathBuf,
+    /// Name of the `.pvd` collection, e.g. `particles.pvd`.
+    pub pvd_name: String,
+    /// Folder of the frames inside `dir`, e.g. `vtk`.
+    pub subdir: String,
+    /// Simulated seconds between frames (the damper scenario's `output.vtk_interval_s`).
+    pub interval_s: f64,
+    /// Array encoding (the damper scenario's `output.vtk_format`).
+    pub encoding: pdamp_io::vtk::VtkEncoding,
 }
 
 /// Kind tag of coupled-DEM checkpoints.
@@ -455,6 +473,21 @@ fn coupled_run(
     let _stoppable = ck.map(|_| cp::StoppableSection::enter());
     let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
     let n_steps = (duration_s / dt).round() as usize;
+    // The bed in ParaView: a frame every `interval_s` (frames of a resumed run's earlier steps
+    // are the interrupted run's).
+    let mut snapshots = match ck.and_then(|c| c.bed_vtk.as_ref()) {
+        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
+            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
+        }),
+        None => None,
+    };
+    if let Some(s) = snapshots.as_mut() {
+        if first > 1 {
+            s.resume_after((first - 1) as u64, dt, &w)?;
+        } else {
+            s.on_step(0, 0.0, &w)?;
+        }
+    }
     let every = sample_every.max(1);
     let report = (n_steps / 200).max(1);
     for step in first..=n_steps {
@@ -501,6 +534,9 @@ fn coupled_run(
         it.check_health(structure, step == n_steps)?;
         if step % every == 0 {
             push(&it, &mut hist);
+        }
+        if let Some(s) = snapshots.as_mut() {
+            s.on_step(step as u64, t1, &w)?;
         }
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);

@@ -107,6 +107,8 @@ pub fn run_couple(
     if dem_count > 1 || (dem_count == 1 && scn.dampers.len() > 1) {
         return Err("a DEM damper (approach 1) must be the only damper of a scenario".into());
     }
+    // The DEM bed's ParaView output: the damper scenario's `[output]` interval and format.
+    let mut bed_vtk = None;
     let dem = match scn.dampers.first() {
         Some(
             spec @ DamperSpec::Dem {
@@ -125,6 +127,7 @@ pub fn run_couple(
             let sc = pdamp_io::scenario::Scenario::load(&p)
                 .map_err(|e| format!("{}: {e}", p.display()))?;
             inputs.extend_from_slice(sc.to_toml().as_bytes());
+            bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
             let d = pdamp_design::Damper::from_scenario(
                 &sc,
                 p.parent().unwrap_or(Path::new(".")),
@@ -146,6 +149,13 @@ pub fn run_couple(
         inputs_digest: pdamp_io::checkpoint::digest(&inputs),
         interval_s: options.checkpoint_interval_s,
         resume: options.resume,
+        bed_vtk: bed_vtk.map(|(interval_s, format)| crate::dem::BedVtk {
+            dir: out.to_path_buf(),
+            pvd_name: "particles.pvd".into(),
+            subdir: "vtk".into(),
+            interval_s,
+            encoding: format.into(),
+        }),
     };
     let analysis_mode = match &scn.analysis {
         AnalysisSpec::Free { mode, .. }
@@ -293,6 +303,11 @@ pub fn run_couple(
                                 inputs_digest: pdamp_io::checkpoint::digest(
                                     format!("{} segment {i}", ck.inputs_digest).as_bytes(),
                                 ),
+                                bed_vtk: ck.bed_vtk.clone().map(|b| crate::dem::BedVtk {
+                                    pvd_name: format!("particles_segment_{}.pvd", i + 1),
+                                    subdir: format!("vtk/segment_{}", i + 1),
+                                    ..b
+                                }),
                                 ..ck.clone()
                             };
                             let h = run_dem_sweep(
