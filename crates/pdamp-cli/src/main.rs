@@ -326,8 +326,40 @@ fn cli_command() -> clap::Command {
     negative_numbers(<Cli as clap::CommandFactory>::command())
 }
 
+/// `--opt -1e-3` → `--opt=-1e-3`: an option followed by a negative number (or a comma list of
+/// numbers starting with one) takes it as its value; clap alone reads `-1e-3` as short flags.
+fn negative_values(args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let is_negative_number = |a: &std::ffi::OsString| {
+        a.to_str().is_some_and(|s| {
+            s.starts_with('-')
+                && s.split(',')
+                    .all(|x| !x.is_empty() && x.trim().parse::<f64>().is_ok())
+        })
+    };
+    let mut out: Vec<std::ffi::OsString> = Vec::with_capacity(args.len());
+    let mut it = args.into_iter().peekable();
+    while let Some(a) = it.next() {
+        let is_long = a
+            .to_str()
+            .is_some_and(|s| s.starts_with("--") && s.len() > 2 && !s.contains('='));
+        match it.peek() {
+            Some(next) if is_long && is_negative_number(next) => {
+                let mut joined = a;
+                joined.push("=");
+                joined.push(it.next().unwrap_or_default());
+                out.push(joined);
+            }
+            _ => out.push(a),
+        }
+    }
+    out
+}
+
 fn run_cli() -> Result<()> {
-    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&cli_command().get_matches()) {
+    let args = negative_values(std::env::args_os().collect());
+    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(
+        &cli_command().get_matches_from(args),
+    ) {
         Ok(c) => c,
         Err(e) => e.exit(),
     };

@@ -23,7 +23,7 @@ enum StructureAction {
         /// Structure file (TOML with a [structure] section).
         structure: PathBuf,
         /// Output directory.
-        #[arg(long, default_value = "out/structure")]
+        #[arg(long)]
         out: PathBuf,
         /// Replace the results of an earlier run in DIR (exactly the files it wrote).
         #[arg(long)]
@@ -127,7 +127,9 @@ fn in_out_dir<T>(
 }
 
 /// What the structure and coupling commands write.
-const OUTPUTS: [&str; 18] = [
+const OUTPUTS: [&str; 20] = [
+    "particles.pvd",
+    "vtk",
     "modes.csv",
     "mode_shapes.png",
     "mode_shapes.svg",
