@@ -179,3 +179,26 @@ fn powder_run_pvd_has_particles_and_deformed_structure() {
     assert!(u(2) > 0.0, "{}", frames[2]);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A damper point's animation of the last cycle (`particles.pvd`): the bed and the container
+/// as the parts of every frame, read by VTK.
+#[test]
+fn damper_point_animation_has_bed_and_container() {
+    let Some(py) = python() else { return };
+    let d = scratch("damper");
+    let sc =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/damper_cylinder_small.toml");
+    let out = d.join("point");
+    pdamp(&["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let read = vtk_read(&py, &[&out.join("particles.pvd")]);
+    let frames = read[0]["frames"].as_array().unwrap();
+    assert!(frames.len() >= 8, "{} frames", frames.len());
+    for f in frames {
+        let parts = f["parts"].as_array().unwrap();
+        assert_eq!(parts.len(), 2, "{f}");
+        assert_eq!(parts[0]["points"], 300);
+        assert_eq!(parts[0]["compressed"], true);
+        assert!(parts[1]["polys"].as_u64().unwrap() > 0, "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -327,9 +327,11 @@ pub fn run_damper_scenario_with(
         return Err(format!("output: {e}"));
     }
     if !rec.vtk_frames.is_empty() {
+        // Particles and the container (every wall with a surface) as the parts of each frame.
         let mut pvd = pdamp_io::vtk::PvdSeries::new(out.join("particles.pvd"));
-        for (t, file) in &rec.vtk_frames {
-            pvd.add(*t, file.clone()).map_err(|e| e.to_string())?;
+        for (idx, (t, _)) in rec.vtk_frames.iter().enumerate() {
+            pvd.add_frame(*t, &pdamp_io::run::snapshot_files(&damper.settled, idx))
+                .map_err(|e| e.to_string())?;
         }
     }
     write_velocity_fields(&rec, &out.join("velocity_fields.csv"))?;
