@@ -9,7 +9,10 @@ energy balance P = (W_box - dE_kin - dE_pot) / T of each code, which must agree 
 
 Usage: python3 bench/peers/run_peers.py [--sizes 1000,8000,32000] [--threads 1,2]
                                         [--steps 5000] [--work target/peers]
-(PDAMP_BIN=path/to/pdamp skips the release build.)
+                                        [--compare-bin LABEL=PATH ...]
+(PDAMP_BIN=path/to/pdamp skips the release build. --compare-bin runs further pdamp binaries,
+e.g. the build of an earlier commit or other profile settings, in the same rounds, interleaved
+with the main one and LIGGGHTS: a before/after comparison in one run.)
 """
 import argparse
 import json
@@ -167,7 +170,10 @@ def main():
     ap.add_argument("--steps", type=int, default=5000)
     ap.add_argument("--work", default=os.path.join(ROOT, "target", "peers"))
     ap.add_argument("--repeat", type=int, default=1, help="runs per configuration (best time is kept)")
+    ap.add_argument("--compare-bin", action="append", default=[], metavar="LABEL=PATH",
+                    help="a further pdamp binary run in the same rounds (repeatable)")
     args = ap.parse_args()
+    compare = [tuple(x.split("=", 1)) for x in args.compare_bin]
     ensure_liggghts()
     exe = pdamp_binary()
     capacity = parallel_capacity()
@@ -185,10 +191,17 @@ def main():
         # in the same states (its speed drifts over minutes on a shared VM); best time kept.
         threads = [int(x) for x in args.threads.split(",")]
         best = {t: [None, None] for t in threads}
+        best_cmp = {(t, label): None for t in threads for label, _ in compare}
         runs = {t: [] for t in threads}
         for _ in range(args.repeat):
             for t in threads:
                 p = run_pdamp(exe, n, args.steps, t, settled)
+                for label, other in compare:
+                    c = run_pdamp(other, n, args.steps, t, settled)
+                    print(f"  N={n} threads={t}: [{label}] pdamp {c['particle_steps_per_s']:.3e}",
+                          file=sys.stderr, flush=True)
+                    if best_cmp[(t, label)] is None or c["wall_time_s"] < best_cmp[(t, label)]["wall_time_s"]:
+                        best_cmp[(t, label)] = c
                 l = run_liggghts(case, t)
                 runs[t].append({"pdamp_particle_steps_per_s": p["particle_steps_per_s"],
                                 "pdamp_steal_fraction": p["steal_fraction"],
@@ -208,6 +221,19 @@ def main():
             row = {"particles": n, "threads": t, "steps": args.steps, "pdamp": best_p,
                    "liggghts": best_l, "runs": runs[t], "speed_ratio": ratio, "dissipated_power_difference": diff,
                    "same_physics": abs(diff) <= 0.10}
+            row["compare"] = {}
+            for label, _ in compare:
+                c = best_cmp[(t, label)]
+                row["compare"][label] = {
+                    "particle_steps_per_s": c["particle_steps_per_s"],
+                    "speed_ratio_to_liggghts": c["particle_steps_per_s"] / best_l["particle_steps_per_s"],
+                    "main_over_this": best_p["particle_steps_per_s"] / c["particle_steps_per_s"],
+                    "dissipated_power_w": c["dissipated_power_w"],
+                }
+                print(f"N={n:6d} threads={t}: [{label}] pdamp {c['particle_steps_per_s']:.3e} p-steps/s, "
+                      f"ratio to LIGGGHTS {row['compare'][label]['speed_ratio_to_liggghts']:.2f}; main build / "
+                      f"{label} = {row['compare'][label]['main_over_this']:.3f}; P_diss {c['dissipated_power_w']:.4g} W",
+                      flush=True)
             results.append(row)
             print(f"N={n:6d} threads={t}: pdamp {best_p['particle_steps_per_s']:.3e} p-steps/s, "
                   f"LIGGGHTS {best_l['particle_steps_per_s']:.3e} p-steps/s, ratio {ratio:.2f}; "
