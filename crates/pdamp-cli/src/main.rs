@@ -1003,8 +1003,22 @@ fn cmd_settle(
 }
 
 /// Warnings about a scenario that runs but is unlikely to be what the user wants.
-fn scenario_warnings(sc: &pdamp_io::scenario::Scenario) -> Vec<String> {
+fn scenario_warnings(sc: &pdamp_io::scenario::Scenario, world: &pdamp_dem::World) -> Vec<String> {
     let mut w = Vec::new();
+    for b in &world.bodies {
+        for wall in &b.walls {
+            if let pdamp_dem::walls::Geometry::Mesh(m) = &wall.geometry
+                && !m.is_closed()
+            {
+                w.push(format!(
+                    "body '{}', wall '{}': the mesh is not closed (some edge is not shared by exactly two \
+                     triangles running along it in opposite directions): particles can leave a container \
+                     through the gap; close the mesh if it is meant to hold the bed",
+                    b.name, wall.name
+                ));
+            }
+        }
+    }
     if sc.damper.is_some() {
         for g in sc.crystal_groups() {
             w.push(format!(
@@ -1052,7 +1066,12 @@ fn cmd_check(scenario: &std::path::Path) -> Result<()> {
                 .map_or(1, |g| g.frequencies_hz.len() * g.amplitude_values.len()),
             rayon::current_num_threads(),
         ),
-        "warnings": scenario_warnings(&sc),
+        "estimate_for": if sc.fields.is_some() {
+            "pdamp fields (every point of the [fields] grid)"
+        } else {
+            "pdamp run"
+        },
+        "warnings": scenario_warnings(&sc, &world),
     });
     #[cfg(feature = "gpu")]
     {
@@ -1061,7 +1080,7 @@ fn cmd_check(scenario: &std::path::Path) -> Result<()> {
             Err(e) => serde_json::json!(format!("not supported: {e}")),
         };
     }
-    for w in scenario_warnings(&sc) {
+    for w in scenario_warnings(&sc, &world) {
         eprintln!("warning: {w}");
     }
     if let Some(d) = &sc.damper {

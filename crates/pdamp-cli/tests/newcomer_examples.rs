@@ -132,6 +132,42 @@ fn stl_container_example_checks_and_runs() {
     let v = check(&toml);
     assert_eq!(v["particles"].as_u64(), Some(150));
     assert!(v["gpu_backend"].as_str().unwrap().contains("triangle-mesh"));
+    assert!(
+        v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|w| !w.as_str().unwrap().contains("not closed"))
+    );
+    assert_eq!(
+        v["estimate_for"],
+        "pdamp fields (every point of the [fields] grid)"
+    );
+
+    // The same container with one facet missing: `pdamp check` warns, naming the wall.
+    let open_dir = temp_dir("open_stl");
+    let text = std::fs::read_to_string(&stl).unwrap();
+    let k = text.find("facet normal").unwrap();
+    let end = text[k..].find("endfacet").unwrap() + k + "endfacet".len();
+    std::fs::write(
+        open_dir.join("stl_cylinder_r8_l24_mm.stl"),
+        format!("{}{}", &text[..k], &text[end..]),
+    )
+    .unwrap();
+    std::fs::copy(&toml, open_dir.join("damper.toml")).unwrap();
+    let v = check(&open_dir.join("damper.toml"));
+    let w: Vec<&str> = v["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("the mesh is not closed") && w.contains("wall '")),
+        "{w:?}"
+    );
+    let _ = std::fs::remove_dir_all(&open_dir);
 
     let dir = temp_dir("stl");
     std::fs::copy(&stl, dir.join("stl_cylinder_r8_l24_mm.stl")).unwrap();

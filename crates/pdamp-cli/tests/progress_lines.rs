@@ -175,6 +175,22 @@ fn run_fields_cor_and_settle_print_progress_lines_without_a_terminal() {
         lines(&err, "impacts").iter().any(|l| l.contains("3/3")),
         "{err}"
     );
+    // A powder run (the tiny cantilever): preparation and the coupled run.
+    let tiny = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../pdamp-powder/tests/data/tiny_cantilever.toml");
+    let err = stderr_of(
+        &[
+            "powder",
+            "run",
+            tiny.to_str().unwrap(),
+            "--out",
+            d.join("powder").to_str().unwrap(),
+        ],
+        false,
+    );
+    let coupled = lines(&err, "coupled run");
+    assert!(!coupled.is_empty(), "{err}");
+    assert!(coupled.last().unwrap().contains("100.0 %"), "{err}");
     // --quiet: no progress at all.
     let err = stderr_of(
         &["run", s, "--out", d.join("quiet").to_str().unwrap()],

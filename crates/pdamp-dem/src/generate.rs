@@ -1494,7 +1494,7 @@ pub const LAYER_TILE_CELLS: u64 = 1600;
 /// within the next one or two layers of its column, so the pair loop sweeps a window that stays
 /// in cache and reads it in a few sequential streams (LIGGGHTS sorts its atoms spatially for the
 /// same reason). Measured on the 32 000-sphere shaken box: about 17 % more particle-steps per
-/// second than the Morton order of [`morton_order`] (docs/performance.md).
+/// second than the Morton order of [`morton_order`] (docs/dev/performance-log.md).
 pub fn layer_order(points: &[Vec3], cell_m: f64) -> Vec<usize> {
     let finite = |x: &&Vec3| x.iter().all(|c| c.is_finite());
     let lo = points

@@ -41,8 +41,15 @@ pub const FORCE_DISPLACEMENT_COLUMNS: [&str; 7] = [
 /// a point runs.
 #[derive(Debug)]
 pub struct MotionRecorder {
-    /// Unit vectors of the field plane: excitation direction and the up direction.
+    /// Unit vectors of the field plane: excitation direction and the up direction (when
+    /// gravity is along the excitation or zero: a direction perpendicular to it).
     pub axes: [Vec3; 2],
+    /// +1 (−1) when the excitation points up (down), i.e. gravity is along it; 0 when the
+    /// excitation is horizontal or there is no gravity. Plots of a vertical excitation draw
+    /// the excitation axis upwards ([`crate::plots`]).
+    pub excitation_up: f64,
+    /// No gravity: `axes[1]` is only a direction perpendicular to the excitation.
+    pub gravity_free: bool,
     /// Lower corner of the grid in (axis 0, axis 1), container frame, m.
     pub origin_m: [f64; 2],
     /// Cell size, m.
@@ -126,6 +133,11 @@ impl MotionRecorder {
         }
         let up = up.normalize();
         let axes = [e, up];
+        let excitation_up = if g.norm() > 0.0 && (g - e * g.dot(&e)).norm() < 1e-9 * g.norm() {
+            g.dot(&e).signum()
+        } else {
+            0.0
+        };
         // Extent: container walls (body frame) or, without bounded walls, the bed ± 50 %.
         let body = &w.bodies[damper.container];
         let mut lo = [f64::INFINITY; 2];
@@ -178,6 +190,8 @@ impl MotionRecorder {
             .collect();
         Self {
             axes,
+            excitation_up,
+            gravity_free: g.norm() == 0.0,
             origin_m: lo,
             cell_m: cell,
             cells,

@@ -293,12 +293,57 @@ fn nice_below(v: f64) -> f64 {
         .unwrap_or(e)
 }
 
+/// How the field plane (coordinates along `rec.axes`) is drawn: a horizontal excitation
+/// along the plot's x axis with up along y; a vertical excitation (gravity along it) upwards
+/// along y, the perpendicular direction along x, so that the bed lies at the bottom as it does
+/// in the container.
+struct PlaneView {
+    /// Draw (axis 1, s · axis 0) instead of (axis 0, axis 1).
+    vertical: bool,
+    /// +1 when the excitation points up, −1 when down.
+    sign: f64,
+}
+
+impl PlaneView {
+    fn of(rec: &MotionRecorder) -> Self {
+        PlaneView {
+            vertical: rec.excitation_up != 0.0,
+            sign: if rec.excitation_up < 0.0 { -1.0 } else { 1.0 },
+        }
+    }
+
+    /// Plot coordinates of the plane coordinates (a, b) (any unit).
+    fn xy(&self, a: f64, b: f64) -> (f64, f64) {
+        if self.vertical {
+            (b, self.sign * a)
+        } else {
+            (a, b)
+        }
+    }
+
+    fn titles(&self, rec: &MotionRecorder) -> (&'static str, &'static str) {
+        if self.vertical {
+            ("horizontal (mm)", "up, along the excitation (mm)")
+        } else if rec.gravity_free {
+            ("along excitation (mm)", "perpendicular (mm)")
+        } else {
+            ("along excitation (mm)", "up (mm)")
+        }
+    }
+}
+
 /// The container's outline in the field plane (container frame, mm) as a closed rectangle
 /// (the walls' bounding box along the two plotted axes), if the walls are bounded.
 fn container_outline_mm(rec: &MotionRecorder) -> Option<(Vec<f64>, Vec<f64>)> {
     let [[a0, a1], [b0, b1]] = rec.container_extent_m?;
-    let (a0, a1, b0, b1) = (a0 * 1e3, a1 * 1e3, b0 * 1e3, b1 * 1e3);
-    Some((vec![a0, a1, a1, a0, a0], vec![b0, b0, b1, b1, b0]))
+    let view = PlaneView::of(rec);
+    let corners = [(a0, b0), (a1, b0), (a1, b1), (a0, b1), (a0, b0)];
+    Some(
+        corners
+            .iter()
+            .map(|&(a, b)| view.xy(a * 1e3, b * 1e3))
+            .unzip(),
+    )
 }
 
 /// The velocity field of phase `k`: cell centres in the container frame (mm) coloured by the
@@ -307,6 +352,7 @@ fn container_outline_mm(rec: &MotionRecorder) -> Option<(Vec<f64>, Vec<f64>)> {
 /// container's outline. `None` for a phase without samples.
 pub fn velocity_field_figure(rec: &MotionRecorder, k: usize) -> Option<ScatterField> {
     let f = rec.fields.get(k)?;
+    let view = PlaneView::of(rec);
     let (mut x, mut y, mut val, mut u, mut v) = (vec![], vec![], vec![], vec![], vec![]);
     for c in 0..f.count.len() {
         let n = f.count[c];
@@ -314,11 +360,13 @@ pub fn velocity_field_figure(rec: &MotionRecorder, k: usize) -> Option<ScatterFi
             continue;
         }
         let [cx, cy] = rec.cell_center(c);
-        x.push(cx * 1e3);
-        y.push(cy * 1e3);
+        let (px, py) = view.xy(cx * 1e3, cy * 1e3);
+        x.push(px);
+        y.push(py);
         val.push(f.speed_sum[c] / n as f64);
-        u.push(f.vel_sum[c][0] / n as f64);
-        v.push(f.vel_sum[c][1] / n as f64);
+        let (pu, pv) = view.xy(f.vel_sum[c][0] / n as f64, f.vel_sum[c][1] / n as f64);
+        u.push(pu);
+        v.push(pv);
     }
     if x.is_empty() {
         return None;
@@ -328,8 +376,9 @@ pub fn velocity_field_figure(rec: &MotionRecorder, k: usize) -> Option<ScatterFi
         "velocity field at Ωt = {:.0}° (container frame)",
         f.phase_rad.to_degrees()
     );
-    s.x_axis = Axis::linear("along excitation (mm)");
-    s.y_axis = Axis::linear("up (mm)");
+    let (xt, yt) = view.titles(rec);
+    s.x_axis = Axis::linear(xt);
+    s.y_axis = Axis::linear(yt);
     s.color = ColorScale::linear(0.0, 2.0);
     s.colorbar_title = "|v| / V (-)".into();
     let mut q = Quiver::new(u, v);
@@ -374,17 +423,17 @@ pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
     if rec.trajectories.is_empty() {
         return Ok(());
     }
-    let mut plot = LinePlot::new(
-        Axis::linear("along excitation (mm)"),
-        Axis::linear("up (mm)"),
-    );
+    let view = PlaneView::of(rec);
+    let (xt, yt) = view.titles(rec);
+    let mut plot = LinePlot::new(Axis::linear(xt), Axis::linear(yt));
     plot.title = "particle trajectories (container frame)".into();
     for &i in &rec.trajectory_particles {
         let (mut a, mut b) = (vec![], vec![]);
         for row in rec.trajectories.iter().filter(|r| r[0] as usize == i) {
             let p = pdamp_dem::Vec3::new(row[2], row[3], row[4]);
-            a.push(p.dot(&rec.axes[0]) * 1e3);
-            b.push(p.dot(&rec.axes[1]) * 1e3);
+            let (x, y) = view.xy(p.dot(&rec.axes[0]) * 1e3, p.dot(&rec.axes[1]) * 1e3);
+            a.push(x);
+            b.push(y);
         }
         plot.series.push(Series::new(format!("particle {i}"), a, b));
     }
@@ -649,6 +698,57 @@ mod tests {
         assert_eq!(nice_below(0.83), 0.5);
         assert_eq!(nice_below(2.0), 2.0);
         assert_eq!(nice_below(0.0123), 0.01);
+    }
+
+    /// A vertical excitation (gravity along it) is drawn upwards: the y axis is the excitation
+    /// ("up"), the x axis the horizontal direction, outline and arrows turned with it.
+    #[test]
+    fn vertical_excitation_is_drawn_upwards() {
+        use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
+        use pdamp_dem::walls::{BoxInside, Geometry};
+        use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
+        let model = ContactModel {
+            normal: NormalLaw::Linear {
+                stiffness_n_m: 2e5,
+                restitution: 0.5,
+                clip_attractive: false,
+            },
+            friction: FrictionLaw::Frictionless,
+            rolling: None,
+            adhesion: None,
+        };
+        let mut w = World::new(vec![Material::new("steel", 7800.0, 2e9, 0.3)], model, 1e-6);
+        w.gravity_m_s2 = Vec3::new(0.0, 0.0, -9.81);
+        w.add_body(
+            RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+                "box",
+                // 20 mm high (z), 8 mm wide (x), 6 mm deep (y)
+                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(4e-3, 3e-3, 10e-3))),
+                0,
+            ),
+        );
+        w.add_particle(Vec3::new(0.0, 0.0, -8e-3), 1e-3, 0);
+        let damper = crate::Damper::from_world(w, 0, Vec3::z(), 0.1, 3, 1);
+        let mut rec = MotionRecorder::new(&damper, 50.0, 0.25, 1, 10, vec![], 2e4);
+        assert_eq!(rec.excitation_up, 1.0);
+        rec.fields[0].count[0] = 1;
+        rec.fields[0].speed_sum[0] = 1.0;
+        rec.fields[0].vel_sum[0] = [1.0, 0.0]; // along the excitation: an upward arrow
+        let fig = velocity_field_figure(&rec, 0).unwrap();
+        assert_eq!(fig.x_axis.title, "horizontal (mm)");
+        assert_eq!(fig.y_axis.title, "up, along the excitation (mm)");
+        let q = fig.arrows.as_ref().unwrap();
+        assert_eq!((q.u[0], q.v[0]), (0.0, 1.0));
+        let o = &fig.outlines[0];
+        let span = |v: &[f64]| {
+            v.iter().fold(f64::MIN, |a, x| a.max(*x)) - v.iter().fold(f64::MAX, |a, x| a.min(*x))
+        };
+        assert!(
+            (span(&o.y) - 20.0).abs() < 1e-9,
+            "height along y: {:?}",
+            o.y
+        );
+        assert!(span(&o.x) < 20.0 - 1e-9, "width along x: {:?}", o.x);
     }
 
     /// Lines of constant X on maps over Γ or A: decades of X crossing the map, each the curve
