@@ -52,4 +52,4 @@ fi
 
 # --release: the same build as the README's `cargo run --release` (built once, not twice; see
 # the profiles in Cargo.toml). The test harnesses keep debug assertions ([profile.bench]).
-cargo test --release --workspace "$@"
+cargo test --release --workspace --no-fail-fast "$@"

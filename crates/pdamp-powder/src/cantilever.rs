@@ -217,6 +217,8 @@ pub const MAX_PARTICLES: usize = 10_000_000;
 pub const MAX_STEPS: f64 = 1e8;
 /// Most samples of tip.csv.
 pub const MAX_SAMPLES: f64 = 1e7;
+/// Most ParaView frames of a run (`run.vtk_interval_s`), as for DEM scenarios.
+pub const MAX_VTK_FRAMES: f64 = 20_000.0;
 /// Memory per structural element, estimated (Gauss data, mass and stiffness matrices) [B].
 const BYTES_PER_ELEMENT: f64 = 10e3;
 /// Memory per particle, estimated (state, pair list, wall contacts, checkpoint copy) [B].
@@ -432,13 +434,6 @@ impl CantileverScenario {
                 r.vtk_interval_s
             ));
         }
-        if r.vtk_interval_s > 0.0 && r.duration_s / r.vtk_interval_s > 20_000.0 {
-            return Err(format!(
-                "run.vtk_interval_s: {:.3e} ParaView frames over duration_s = {} s, more than 20 000; use a larger interval (or 0 for none)",
-                r.duration_s / r.vtk_interval_s,
-                r.duration_s
-            ));
-        }
         let c = &r.coupling;
         if !(c.tolerance > 0.0 && c.tolerance.is_finite()) {
             return Err(format!(
@@ -551,6 +546,13 @@ impl CantileverScenario {
             return Err(format!(
                 "run.output_interval_s: {:.3e} samples of tip.csv, more than {MAX_SAMPLES:e}; use a larger output_interval_s",
                 est.steps / every
+            ));
+        }
+        if r.vtk_interval_s > 0.0 && r.duration_s / r.vtk_interval_s > MAX_VTK_FRAMES {
+            return Err(format!(
+                "run.vtk_interval_s: {:.3e} ParaView frames over duration_s = {} s, more than {MAX_VTK_FRAMES}; use a larger interval (or 0 for none)",
+                r.duration_s / r.vtk_interval_s,
+                r.duration_s
             ));
         }
         Ok(())

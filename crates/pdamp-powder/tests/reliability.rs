@@ -359,6 +359,16 @@ fn sizes_are_bounded_with_a_cost_estimate() {
         e.contains("run.duration_s") && e.contains("steps") && e.contains("h of one core"),
         "{e}"
     );
+    // ParaView frames: one per µs of a 1 s run
+    let text = with("run", "duration_s", "1.0").replace(
+        "output_interval_s = 1e-5",
+        "output_interval_s = 1e-5\nvtk_interval_s = 1e-6",
+    );
+    let e = CantileverScenario::from_toml(&text).unwrap_err();
+    assert!(
+        e.contains("run.vtk_interval_s") && e.contains("frames"),
+        "{e}"
+    );
     let est = tiny().estimate();
     assert!((20.0..100.0).contains(&est.particles), "{est:?}");
     assert!(est.steps == 200.0, "{est:?}");
