@@ -52,4 +52,8 @@ fi
 
 # --release: the same build as the README's `cargo run --release` (built once, not twice; see
 # the profiles in Cargo.toml). The test harnesses keep debug assertions ([profile.bench]).
-cargo test --release --workspace --no-fail-fast "$@"
+status=0
+cargo test --release --workspace --no-fail-fast "$@" || status=$?
+# Lints are part of the tests: clippy with every warning an error (issue 30).
+cargo clippy --release --workspace --all-targets -- -D warnings || status=$?
+exit $status

@@ -2,6 +2,7 @@
 //!
 //! A thin layer: every command parses its arguments, calls one library function and reports.
 
+#![forbid(unsafe_code)]
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use pdamp_dem::Material;

@@ -112,15 +112,47 @@ impl InteractionTable {
         self.n
     }
 
-    /// Uses `model` for contacts between materials `a` and `b` (both orders).
+    /// Uses `model` for contacts between materials `a` and `b` (both orders). The table keeps
+    /// only the models some pair uses, each once: an identical model is shared, and a model no
+    /// pair uses any more is dropped (the neighbour reach of [`crate::World`] is taken over
+    /// [`Self::models`], so a replaced long-range model must not linger there).
     pub fn set(&mut self, a: u16, b: u16, mut model: ContactModel) {
         model.prepare();
-        let k = self.models.len() as u16;
-        self.models.push(model);
+        let k = match self.models.iter().position(|m| *m == model) {
+            Some(k) => k as u16,
+            None => {
+                self.models.push(model);
+                (self.models.len() - 1) as u16
+            }
+        };
         let (a, b) = (a as usize, b as usize);
         self.model_of[a * self.n + b] = k;
         self.model_of[b * self.n + a] = k;
+        self.drop_unused_models();
         self.update_fast();
+    }
+
+    /// Removes the models no pair refers to and renumbers the rest (order kept).
+    fn drop_unused_models(&mut self) {
+        let mut used = vec![false; self.models.len()];
+        for &k in &self.model_of {
+            used[k as usize] = true;
+        }
+        if used.iter().all(|&u| u) {
+            return;
+        }
+        let mut new_index = vec![u16::MAX; self.models.len()];
+        let mut kept = Vec::with_capacity(self.models.len());
+        for (k, m) in std::mem::take(&mut self.models).into_iter().enumerate() {
+            if used[k] {
+                new_index[k] = kept.len() as u16;
+                kept.push(m);
+            }
+        }
+        self.models = kept;
+        for k in &mut self.model_of {
+            *k = new_index[*k as usize];
+        }
     }
 
     /// Contact model and elastic constants of the pair (`a`, `b`).
@@ -130,8 +162,75 @@ impl InteractionTable {
         (&self.models[self.model_of[k] as usize], &self.elastic[k])
     }
 
-    /// All distinct models in use.
+    /// The distinct models some pair of materials uses, each once.
     pub fn models(&self) -> &[ContactModel] {
         &self.models
+    }
+}
+
+#[cfg(test)]
+mod set_tests {
+    use super::*;
+    use crate::contact::{ContactModel, DmtAdhesion, FrictionLaw, NormalLaw};
+
+    fn linear(restitution: f64) -> ContactModel {
+        ContactModel {
+            normal: NormalLaw::Linear {
+                stiffness_n_m: 1e5,
+                restitution,
+                clip_attractive: false,
+            },
+            friction: FrictionLaw::Frictionless,
+            rolling: None,
+            adhesion: None,
+        }
+    }
+
+    /// `set` keeps each model once and drops a model no pair uses: overriding every pair of an
+    /// adhesive default leaves no adhesive model, so the neighbour reach of a world built on
+    /// the table has no adhesion range left (before, every `set` appended a model and the
+    /// replaced default stayed in `models()` and in the reach).
+    #[test]
+    fn set_keeps_only_models_in_use() {
+        let mats = [
+            crate::Material::new("a", 7800.0, 2e9, 0.3),
+            crate::Material::new("b", 2700.0, 7e10, 0.33),
+        ];
+        let mut sticky = linear(0.5);
+        sticky.adhesion = Some(DmtAdhesion {
+            surface_energy_j_m2: 0.0,
+            hamaker_constant_j: 4e-19,
+            cutoff_ratio: 0.01,
+        });
+        let mut t = InteractionTable::new(&mats, sticky.clone());
+        for _ in 0..1000 {
+            t.set(0, 1, linear(0.7));
+        }
+        assert_eq!(
+            t.models().len(),
+            2,
+            "the default and one override, each once"
+        );
+        t.set(0, 0, linear(0.7));
+        t.set(1, 1, linear(0.7));
+        assert_eq!(t.models(), &[linear(0.7)], "the replaced default is gone");
+        assert!(t.models().iter().all(|m| m.adhesion.is_none()));
+        assert_eq!(t.get(1, 0).0, &linear(0.7));
+        // A second law for one pair, then back: still two, then one.
+        t.set(1, 1, linear(0.2));
+        assert_eq!(t.models().len(), 2);
+        assert_eq!(t.get(1, 1).0, &linear(0.2));
+        assert_eq!(t.get(0, 1).0, &linear(0.7));
+        t.set(1, 1, linear(0.7));
+        assert_eq!(t.models().len(), 1);
+
+        // In a world: the reach after the adhesive default is replaced everywhere is 0.
+        let mut w = crate::World::new(mats.to_vec(), sticky, 1e-6);
+        w.set_contact_model(0, 0, linear(0.7));
+        w.set_contact_model(0, 1, linear(0.7));
+        w.set_contact_model(1, 1, linear(0.7));
+        w.add_particle(crate::Vec3::zeros(), 1e-3, 0);
+        w.initialize();
+        assert_eq!(w.neighbors.extra_range_m, 0.0);
     }
 }

@@ -2,6 +2,7 @@
 //! complex power method [D Sect. 3.2], effective fields over frequency × amplitude, motion modes,
 //! and reference solutions of idealised damper motions.
 
+#![forbid(unsafe_code)]
 pub mod convergence;
 pub mod damper;
 pub mod ensemble;

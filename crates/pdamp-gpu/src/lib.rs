@@ -22,6 +22,7 @@
 //! [`GpuBatch`] takes over its full state, contact histories included, so a run continues
 //! exactly where the CPU left it; [`GpuBatch::snapshot`] brings the state back.
 
+#![forbid(unsafe_code)]
 mod batch;
 mod device;
 mod error;

@@ -16,6 +16,7 @@
 //!
 //! Units are SI throughout. `[D Eq. n]` refers to the dissertation.
 
+#![forbid(unsafe_code)]
 pub mod constitutive;
 pub mod fe;
 pub mod hertz;

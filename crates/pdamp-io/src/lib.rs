@@ -3,6 +3,7 @@
 //! Scenario files (TOML), meshes (STL), results (CSV, JSON) and ParaView output (VTK XML).
 //! Every output file is written atomically (write to a temporary file, then rename).
 
+#![forbid(unsafe_code)]
 pub mod atomic;
 pub mod bed;
 pub mod bed_formats;

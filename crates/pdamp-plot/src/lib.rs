@@ -20,6 +20,7 @@
 //! - [`scatter_field`]: points coloured by a scalar with colour bar, equal
 //!   aspect and optional velocity arrows.
 
+#![forbid(unsafe_code)]
 mod axis;
 mod color;
 mod heatmap;

@@ -18,6 +18,7 @@
 //!
 //! Details and measured results: `docs/powder.md`.
 
+#![forbid(unsafe_code)]
 // Index loops mirror the tensor notation of the equations; validation uses `!(x > 0.0)` on
 // purpose so that NaN is rejected.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]

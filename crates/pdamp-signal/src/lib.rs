@@ -34,6 +34,7 @@
 //! # Ok::<(), pdamp_signal::SignalError>(())
 //! ```
 
+#![forbid(unsafe_code)]
 pub mod complex_power;
 pub mod decay;
 pub mod error;

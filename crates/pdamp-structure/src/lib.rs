@@ -19,6 +19,7 @@
 //!
 //! [D] is the dissertation on the particle damper design toolchain.
 
+#![forbid(unsafe_code)]
 pub mod dem;
 pub mod design;
 pub mod effective;
