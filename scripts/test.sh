@@ -56,4 +56,6 @@ status=0
 cargo test --release --workspace --no-fail-fast "$@" || status=$?
 # Lints are part of the tests: clippy with every warning an error (issue 30).
 cargo clippy --release --workspace --all-targets -- -D warnings || status=$?
+# … and the API documentation builds without a warning (broken links, unclosed tags).
+RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --workspace || status=$?
 exit $status

@@ -3,6 +3,10 @@
 //! A thin layer: every command parses its arguments, calls one library function and reports.
 
 #![forbid(unsafe_code)]
+// The argument docs are the `--help` texts (TOML sections such as [fields], file patterns such
+// as DIR/<param>_<value>), written for the terminal, not for rustdoc.
+#![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
+
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use pdamp_dem::Material;

@@ -302,7 +302,7 @@ impl SizeDistribution {
         self.radius_moment(1)
     }
 
-    /// Mean particle volume (4/3) π E[r³] in m³. Computed in closed form (not by sampling or
+    /// Mean particle volume (4/3) π E\[r³\] in m³. Computed in closed form (not by sampling or
     /// quadrature), see [`radius_moment`](Self::radius_moment).
     pub fn mean_volume_m3(&self) -> f64 {
         4.0 / 3.0 * PI * self.radius_moment(3)

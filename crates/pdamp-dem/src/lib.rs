@@ -4,8 +4,8 @@
 //! laws (Hertz, Gonthier, Lankarani–Nikravesh, linear spring–dashpot, Hertz–Mindlin, regularized
 //! and spring–dashpot friction, rolling resistance, DMT adhesion), cell-grid + Verlet neighbour
 //! lists, velocity-Verlet and Gear predictor–corrector integration, and an energy ledger that
-//! closes. References: [D] = the dissertation on the particle-damper design toolchain (chapter 2),
-//! [P] = the DEM–FEM powder-damper paper (section 2.1). No file I/O lives here.
+//! closes. References: \[D\] = the dissertation on the particle-damper design toolchain (chapter 2),
+//! \[P\] = the DEM–FEM powder-damper paper (section 2.1). No file I/O lives here.
 
 pub mod bed;
 pub mod bed_statistics;

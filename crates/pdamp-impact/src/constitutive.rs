@@ -61,7 +61,7 @@ pub enum Kernel {
         /// Perzyna exponent λ.
         lambda: f64,
     },
-    /// Prony viscoelastic (state: s∞[4], p∞, then 5 values per memory branch).
+    /// Prony viscoelastic (state: s∞\[4\], p∞, then 5 values per memory branch).
     Prony {
         /// Long-term bulk modulus, Pa.
         k_inf: f64,

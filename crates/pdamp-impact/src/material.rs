@@ -91,7 +91,7 @@ pub struct Material {
 }
 
 /// Quasi-static yield curve of S235 used here (equivalent plastic strain, Pa). D Fig. 4.1 gives
-/// it only as a figure (data of [SeifriedEtAl10]); D Tab. 4.1 gives σ_y = 230 MPa. The later
+/// it only as a figure (data of \[SeifriedEtAl10\]); D Tab. 4.1 gives σ_y = 230 MPa. The later
 /// points are our assumption for a mild structural steel (UTS ≈ 450–500 MPa): see docs/cor.md.
 pub const S235_HARDENING_PA: [[f64; 2]; 6] = [
     [0.0, 230e6],

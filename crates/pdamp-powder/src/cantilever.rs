@@ -52,29 +52,29 @@ fn d_mass() -> MassKind {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BeamSpec {
-    /// Beam length [m] (0.132).
+    /// Beam length \[m\] (0.132).
     #[serde(default = "d_len")]
     pub length_m: f64,
-    /// Outer width of the square section [m] (0.020).
+    /// Outer width of the square section \[m\] (0.020).
     #[serde(default = "d_width")]
     pub width_m: f64,
-    /// Wall thickness around the cavity [m] (0.001).
+    /// Wall thickness around the cavity \[m\] (0.001).
     #[serde(default = "d_wall")]
     pub wall_thickness_m: f64,
-    /// Cavity length [m] (0.110).
+    /// Cavity length \[m\] (0.110).
     #[serde(default = "d_cav_len")]
     pub cavity_length_m: f64,
-    /// Distance of the cavity from the clamped face [m] (0.002).
+    /// Distance of the cavity from the clamped face \[m\] (0.002).
     #[serde(default = "d_cav_off")]
     pub cavity_offset_m: f64,
     /// Material (Table A.3: 175 GPa, 0.27, 8000 kg/m³).
     #[serde(default = "d_mat")]
     pub material: SvkMaterial,
-    /// Element size in the walls [m].
+    /// Element size in the walls \[m\].
     pub wall_element_m: f64,
-    /// Element size across the cavity [m].
+    /// Element size across the cavity \[m\].
     pub core_element_m: f64,
-    /// Element size along the beam [m].
+    /// Element size along the beam \[m\].
     pub length_element_m: f64,
     /// Mass matrix (`consistent` or `lumped`).
     #[serde(default = "d_mass")]
@@ -92,7 +92,7 @@ fn d_mat() -> SvkMaterial {
 }
 
 impl BeamSpec {
-    /// Cavity box [m].
+    /// Cavity box \[m\].
     pub fn cavity(&self) -> Aabb {
         let t = self.wall_thickness_m;
         Aabb {
@@ -207,7 +207,7 @@ impl BeamSpec {
     }
 }
 
-/// Longest accepted beam dimension [m].
+/// Longest accepted beam dimension \[m\].
 pub const MAX_LENGTH_M: f64 = 100.0;
 /// Most structural elements a scenario may ask for.
 pub const MAX_ELEMENTS: usize = 1_000_000;
@@ -243,9 +243,9 @@ pub struct CostEstimate {
     pub steps: f64,
     /// Preparation steps (upper bound: settling and relaxation limits).
     pub prep_steps: f64,
-    /// Memory [B].
+    /// Memory \[B\].
     pub memory_bytes: f64,
-    /// CPU time [s] (one core).
+    /// CPU time \[s\] (one core).
     pub cpu_s: f64,
 }
 
@@ -268,11 +268,11 @@ impl std::fmt::Display for CostEstimate {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
-    /// Pressure q [Pa] (0.1 N/mm² = 1e5 Pa), pushing in +x.
+    /// Pressure q \[Pa\] (0.1 N/mm² = 1e5 Pa), pushing in +x.
     pub pressure_pa: f64,
-    /// Linear rise time [s] (5e-3).
+    /// Linear rise time \[s\] (5e-3).
     pub rise_s: f64,
-    /// Hold time [s] (1e-3), then released.
+    /// Hold time \[s\] (1e-3), then released.
     pub hold_s: f64,
 }
 
@@ -297,7 +297,7 @@ pub struct PowderSpec {
     pub density_kg_m3: f64,
     /// Contact law at the reference size `reference_d50_m` (Table A.2 values for 1 mm).
     pub law: PowderLaw,
-    /// Size the law parameters refer to [m]; with f = d50_m / reference_d50_m the stiffness is
+    /// Size the law parameters refer to \[m\]; with f = d50_m / reference_d50_m the stiffness is
     /// scaled k' = f k and the surface energy γ' = f² γ (coarse-graining, Sect. 2.4/3.6).
     #[serde(default = "d_ref_d50")]
     pub reference_d50_m: f64,
@@ -331,9 +331,9 @@ fn d_grav() -> [f64; 3] {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunSpec {
-    /// Simulated time after preparation [s] (paper: 0.03).
+    /// Simulated time after preparation \[s\] (paper: 0.03).
     pub duration_s: f64,
-    /// Time step of DEM and FE [s] (paper: 2.5e-6 for D50 = 1 mm).
+    /// Time step of DEM and FE \[s\] (paper: 2.5e-6 for D50 = 1 mm).
     pub time_step_s: f64,
     /// Gravity [m/s²] in beam coordinates (clamp at z = 0): [0,0,-9.81] upright (default),
     /// [0,0,9.81] upside down, [-9.81,0,0] horizontal with gravity along the excitation.
@@ -342,11 +342,11 @@ pub struct RunSpec {
     /// Coupling settings (ε of eq. 16 = 1e-3).
     #[serde(default)]
     pub coupling: CouplingSettings,
-    /// Sampling interval of tip.csv [s] (0 = every step).
+    /// Sampling interval of tip.csv \[s\] (0 = every step).
     #[serde(default)]
     pub output_interval_s: f64,
     /// Interval of the ParaView frames (particles and deformed structure,
-    /// `particles.pvd`) [s]; 0 = none. Default 1 ms.
+    /// `particles.pvd`) \[s\]; 0 = none. Default 1 ms.
     #[serde(default = "d_vtk_interval")]
     pub vtk_interval_s: f64,
 }
@@ -632,10 +632,10 @@ pub fn cavity_interface(s: &Structure, cavity: &Aabb) -> Interface {
 /// Time series and results of a run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CantileverResult {
-    /// Sample times [s].
+    /// Sample times \[s\].
     #[serde(skip)]
     pub time_s: Vec<f64>,
-    /// Tip displacement in x [m].
+    /// Tip displacement in x \[m\].
     #[serde(skip)]
     pub tip_m: Vec<f64>,
     /// Coupling iterations of the sampled steps.
@@ -646,7 +646,7 @@ pub struct CantileverResult {
     pub energy: Vec<(f64, CoupledEnergy)>,
     /// Table-1 damping ratios.
     pub damping: TableOneRatios,
-    /// Largest tip displacement before release [m].
+    /// Largest tip displacement before release \[m\].
     pub max_tip_before_release_m: f64,
     /// Preparation report (None for an empty beam).
     pub prep: Option<PrepReport>,
@@ -664,11 +664,11 @@ pub struct CantileverResult {
     pub mean_iterations: f64,
     /// Largest iteration count of a step.
     pub max_iterations: usize,
-    /// Wall time of the coupled run (without preparation) [s].
+    /// Wall time of the coupled run (without preparation) \[s\].
     pub wall_time_s: f64,
-    /// Mass of the structure and of the powder [kg].
+    /// Mass of the structure and of the powder \[kg\].
     pub structure_mass_kg: f64,
-    /// Powder mass [kg].
+    /// Powder mass \[kg\].
     pub powder_mass_kg: f64,
     /// Largest |balance − balance(0)| / max stored energy over the run.
     pub energy_closure: f64,
@@ -727,7 +727,7 @@ impl Checkpointing {
 }
 
 /// Decodes a `pdamp powder run` checkpoint of any scenario and returns its phase and
-/// simulated time [s] (for inspection and fuzzing; never panics).
+/// simulated time \[s\] (for inspection and fuzzing; never panics).
 pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), String> {
     Ok(match ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)? {
         Phase::Preparing(p) => ("preparing", p.time_s()),
@@ -1153,7 +1153,7 @@ pub fn write_outputs(
     Ok(())
 }
 
-/// First bending frequencies [Hz] of the empty beam (no powder), `count` lowest modes.
+/// First bending frequencies \[Hz\] of the empty beam (no powder), `count` lowest modes.
 pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, String> {
     let (s, _) = build_structure(
         beam,
@@ -1170,7 +1170,7 @@ pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, Strin
 }
 
 /// First bending frequency of the empty beam from piecewise Timoshenko theory (solid bottom,
-/// hollow cavity part, solid top) [Hz].
+/// hollow cavity part, solid top) \[Hz\].
 pub fn timoshenko_reference(beam: &BeamSpec) -> f64 {
     use crate::fe::beam_theory::{Segment, timoshenko_f1};
     let inner = beam.width_m - 2.0 * beam.wall_thickness_m;

@@ -7,7 +7,7 @@
 //! closest-point projection onto the bilinear interface quads; the reaction on the structure is
 //! distributed to the nodes with the shape functions (eq. 15,
 //! $\mathbf f^{ps}_j = \sum_e\sum_i N^e_j(\xi_i)\mathbf f^e_i$). Fixed-point iterations with
-//! Aitken relaxation (Küttler & Wall 2008, paper ref. [34]) run until eq. 16,
+//! Aitken relaxation (Küttler & Wall 2008, paper ref. \[34\]) run until eq. 16,
 //! $|\Delta\mathbf d^{ps}_{n+1,k+1}|/(\Delta t\sqrt{n^{ps}_{dof}}) < \epsilon$, with the increment
 //! between successive iterates as in Algorithm 1.
 //!
@@ -174,7 +174,7 @@ pub enum CoupleError {
         "coupling did not converge at t = {t_s} s: eq. 16 measure {measure:e} after {iterations} iterations"
     )]
     NotConverged {
-        /// Time [s].
+        /// Time \[s\].
         t_s: f64,
         /// Final value of the eq. 16 measure [m/s].
         measure: f64,
@@ -183,7 +183,7 @@ pub enum CoupleError {
     },
 }
 
-/// Energies of the coupled system [J].
+/// Energies of the coupled system \[J\].
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoupledEnergy {
     /// Structure kinetic energy.
@@ -253,11 +253,11 @@ pub struct Coupled {
     pub max_iterations_seen: usize,
     /// Steps done.
     pub steps: u64,
-    /// Interface force on the structure at the committed state (all dofs) [N].
+    /// Interface force on the structure at the committed state (all dofs) \[N\].
     pub f_ps: Vec<f64>,
-    /// Elastic energy of the particle–wall springs (committed) [J].
+    /// Elastic energy of the particle–wall springs (committed) \[J\].
     pub elastic_pw_j: f64,
-    /// Work of the interface forces on the structure [J].
+    /// Work of the interface forces on the structure \[J\].
     pub interface_work_j: f64,
     /// The closed container of the particles in the reference configuration (the cavity);
     /// when set, a particle centre outside it (enlarged by the largest interface displacement)
@@ -666,7 +666,7 @@ impl Coupled {
     }
 
     /// Sum of the particle wall forces and of the nodal interface forces of the committed step
-    /// (interface equilibrium: their sum vanishes since $\sum_j N_j = 1$) [N].
+    /// (interface equilibrium: their sum vanishes since $\sum_j N_j = 1$) \[N\].
     pub fn interface_force_sums(&self) -> ([f64; 3], [f64; 3]) {
         let mut fp = [0.0; 3];
         for f in &self.powder.wall_force {

@@ -9,7 +9,7 @@ pub fn zeta_from_decrement(delta: f64) -> f64 {
     1.0 / (1.0 + (2.0 * std::f64::consts::PI / delta).powi(2)).sqrt()
 }
 
-/// Indices of strict local minima (x[i-1] > x[i] ≤ x[i+1]) with t ≥ `t_start`.
+/// Indices of strict local minima (x[i-1] > x\[i\] ≤ x[i+1]) with t ≥ `t_start`.
 pub fn local_minima(t: &[f64], x: &[f64], t_start: f64) -> Vec<usize> {
     // series of different lengths (a damaged tip.csv): the common part
     (1..x.len().min(t.len()).saturating_sub(1))
@@ -37,7 +37,7 @@ pub struct TableOneRatios {
     pub zeta_2: Option<f64>,
     /// ζ̄5 (first → sixth minimum, n = 5).
     pub zeta_5: Option<f64>,
-    /// Mean period between the minima used [s].
+    /// Mean period between the minima used \[s\].
     pub period_s: Option<f64>,
 }
 

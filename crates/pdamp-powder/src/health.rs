@@ -50,9 +50,9 @@ pub enum Symptom {
     Escaped {
         /// Particle index.
         particle: usize,
-        /// Its position [m].
+        /// Its position \[m\].
         position: [f64; 3],
-        /// Distance outside the cavity [m].
+        /// Distance outside the cavity \[m\].
         distance_m: f64,
     },
     /// A pair overlaps by more than [`MAX_RELATIVE_OVERLAP`] of the smaller diameter.
@@ -66,16 +66,16 @@ pub enum Symptom {
     },
     /// The cumulative dissipation is negative beyond round-off.
     NegativeDissipation {
-        /// Dissipated energy so far [J].
+        /// Dissipated energy so far \[J\].
         dissipated_j: f64,
-        /// Energy scale [J].
+        /// Energy scale \[J\].
         scale_j: f64,
     },
     /// The energy balance grew: energy was created.
     EnergyCreated {
-        /// Growth of stored + dissipated − work since the start [J].
+        /// Growth of stored + dissipated − work since the start \[J\].
         created_j: f64,
-        /// Energy scale [J].
+        /// Energy scale \[J\].
         scale_j: f64,
     },
 }
@@ -130,13 +130,13 @@ impl std::fmt::Display for Symptom {
 /// What the run looked like when it failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Evidence {
-    /// Time step [s].
+    /// Time step \[s\].
     pub time_step_s: f64,
-    /// Shortest particle–particle contact time $\pi\sqrt{m_{eff}/k_N}$ [s].
+    /// Shortest particle–particle contact time $\pi\sqrt{m_{eff}/k_N}$ \[s\].
     pub contact_time_s: f64,
     /// Largest overlap / smaller diameter over the pair list (finite pairs).
     pub max_relative_overlap: f64,
-    /// Dissipated energy so far [J].
+    /// Dissipated energy so far \[J\].
     pub dissipated_j: f64,
 }
 
@@ -198,7 +198,7 @@ impl Evidence {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("numerical failure at t = {time_s:.6e} s ({stage}): {symptom}; likely cause: {cause}")]
 pub struct HealthError {
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub time_s: f64,
     /// Stage of the run (`settling`, `coupled run`, …).
     pub stage: &'static str,
@@ -226,7 +226,7 @@ impl HealthError {
 }
 
 /// Shortest particle–particle contact time $\pi\sqrt{m_{eff}/k_N}$ of the linear law, with
-/// $m_{eff}$ of the two lightest particles [s] (infinite without particles).
+/// $m_{eff}$ of the two lightest particles \[s\] (infinite without particles).
 pub fn contact_time_s(law: &PowderLaw, p: &Powder) -> f64 {
     let m = p.mass.iter().fold(f64::INFINITY, |a, &b| a.min(b));
     std::f64::consts::PI * (0.5 * m / law.normal_stiffness_n_m).sqrt()

@@ -29,9 +29,9 @@ pub struct PrepSettings {
     pub settling_gravity_factor: f64,
     /// Plate speed during compression [m/s].
     pub plate_speed_m_s: f64,
-    /// Relaxation after compression with the plate held [s].
+    /// Relaxation after compression with the plate held \[s\].
     pub relax_time_s: f64,
-    /// Longest settling time [s].
+    /// Longest settling time \[s\].
     pub max_settling_time_s: f64,
 }
 
@@ -59,15 +59,15 @@ pub struct PrepReport {
     pub packing_density: f64,
     /// Whether the settled bed was higher than the cavity (so the plate compressed it).
     pub compressed: bool,
-    /// Force on the plate at the end [N].
+    /// Force on the plate at the end \[N\].
     pub plate_force_n: f64,
     /// Largest overlap / smaller diameter at the end.
     pub max_relative_overlap: f64,
-    /// Simulated preparation time [s].
+    /// Simulated preparation time \[s\].
     pub simulated_time_s: f64,
     /// DEM steps.
     pub steps: u64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
 }
 
@@ -212,7 +212,7 @@ impl Preparation {
         self.powder.len()
     }
 
-    /// Simulated preparation time so far [s].
+    /// Simulated preparation time so far \[s\].
     pub fn time_s(&self) -> f64 {
         self.powder.t
     }
@@ -282,7 +282,7 @@ impl Preparation {
         Ok(())
     }
 
-    /// Wall-clock time spent in this preparation so far, over all runs [s].
+    /// Wall-clock time spent in this preparation so far, over all runs \[s\].
     pub fn wall_time_s(&self) -> f64 {
         self.wall_time_s
             + self

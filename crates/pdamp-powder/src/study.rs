@@ -28,7 +28,7 @@ pub enum StudyParameter {
     Restitution,
     /// γ [J/m²] at the reference size (Fig. 5).
     SurfaceEnergy,
-    /// D50 [m] (Sect. 3.2); time step scaled ∝ D50.
+    /// D50 \[m\] (Sect. 3.2); time step scaled ∝ D50.
     D50,
     /// Gravity direction (Fig. 6): values 0 = upright, 1 = upside down, 2 = horizontal.
     Orientation,
@@ -119,7 +119,7 @@ pub struct StudyRow {
     pub energy_closure: f64,
     /// Mean fixed-point iterations per coupled step.
     pub mean_iterations: f64,
-    /// Wall time of preparation + coupled run [s].
+    /// Wall time of preparation + coupled run \[s\].
     pub wall_time_s: f64,
 }
 

@@ -17,7 +17,7 @@
 //!   polynomial, half-power bandwidth), efficiency and design formulas ([`design`], D Eq. 3.51–3.52, 5.15–5.23);
 //! - [`scenario`]: the TOML input of `pdamp structure` and `pdamp couple`.
 //!
-//! [D] is the dissertation on the particle damper design toolchain.
+//! \[D\] is the dissertation on the particle damper design toolchain.
 
 #![forbid(unsafe_code)]
 pub mod dem;

@@ -26,7 +26,7 @@ pub struct PowderLaw {
     pub poisson_ratio: f64,
     /// Surface energy $\gamma$ [J/m²] (0 = no adhesion; Sect. 3.6: 0.085 J/m² scaled).
     pub surface_energy_j_m2: f64,
-    /// Hamaker constant $A$ [J] (Table A.2: 40e-20 J).
+    /// Hamaker constant $A$ \[J\] (Table A.2: 40e-20 J).
     pub hamaker_j: f64,
     /// Relative adhesion cut-off $c_{FS0}$ (Table A.2: 0.01).
     pub adhesion_cutoff: f64,
@@ -69,7 +69,7 @@ impl PowderLaw {
         2.0 * l.abs() / (l * l + std::f64::consts::PI.powi(2)).sqrt()
     }
 
-    /// Largest gap at which adhesion acts for the effective radius [m] (0 without adhesion).
+    /// Largest gap at which adhesion acts for the effective radius \[m\] (0 without adhesion).
     pub fn adhesion_range(&self, r_eff: f64) -> f64 {
         if self.surface_energy_j_m2 <= 0.0 {
             return 0.0;
@@ -138,11 +138,11 @@ impl PowderLaw {
 /// Result of one contact evaluation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ContactResult {
-    /// Force on particle i [N].
+    /// Force on particle i \[N\].
     pub force: [f64; 3],
-    /// Elastic energy stored in the normal and tangential springs [J].
+    /// Elastic energy stored in the normal and tangential springs \[J\].
     pub elastic_j: f64,
-    /// Energy dissipated during this step (dashpots and sliding) [J].
+    /// Energy dissipated during this step (dashpots and sliding) \[J\].
     pub dissipated_j: f64,
     /// Whether the contact slid (return mapping active).
     pub sliding: bool,
@@ -155,9 +155,9 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// Evaluates eq. 2–7 for one contact.
 ///
-/// `n`: unit normal from i to the partner; `gap`: $g_N$ [m]; `v_rel`: velocity of i's contact
+/// `n`: unit normal from i to the partner; `gap`: $g_N$ \[m\]; `v_rel`: velocity of i's contact
 /// point relative to the partner's [m/s]; `gt`: tangential spring $\mathbf g_T$ (history, updated
-/// in place; reset to zero when the contact opens); `dt`: time step [s].
+/// in place; reset to zero when the contact opens); `dt`: time step \[s\].
 #[inline]
 #[allow(clippy::too_many_arguments)] // the contact kinematics, all scalars/vectors of one pair
 pub fn evaluate(

@@ -6,7 +6,7 @@
 /// rebuild clears or overwrites before reading, are skipped).
 #[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct NeighborList {
-    /// Skin distance [m].
+    /// Skin distance \[m\].
     pub skin: f64,
     /// `start[i]..start[i+1]`: entries with first particle i.
     pub start: Vec<usize>,
@@ -14,7 +14,7 @@ pub struct NeighborList {
     pub pi: Vec<u32>,
     /// Second particle of each entry (sorted within each i).
     pub pj: Vec<u32>,
-    /// Tangential spring $\mathbf g_T$ of each entry [m].
+    /// Tangential spring $\mathbf g_T$ of each entry \[m\].
     pub gt: Vec<[f64; 3]>,
     /// `rev_start[j]..rev_start[j+1]` indexes `rev` = entries whose second particle is j.
     pub rev_start: Vec<usize>,
@@ -42,7 +42,7 @@ pub struct NeighborList {
 }
 
 impl NeighborList {
-    /// Empty list with the given skin [m].
+    /// Empty list with the given skin \[m\].
     pub fn new(skin: f64) -> Self {
         Self {
             skin,

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::law::{self, PowderLaw};
 use super::neighbor::NeighborList;
 
-/// Energy bookkeeping of the particles [J].
+/// Energy bookkeeping of the particles \[J\].
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PowderLedger {
     /// Dissipated in particle–particle contacts.
@@ -35,27 +35,27 @@ pub struct Powder {
     pub law: PowderLaw,
     /// Gravity [m/s²].
     pub gravity: [f64; 3],
-    /// Time step [s].
+    /// Time step \[s\].
     pub dt: f64,
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// Positions [m].
+    /// Positions \[m\].
     pub pos: Vec<[f64; 3]>,
     /// Velocities [m/s] (half-step values between `predict` and `finish`).
     pub vel: Vec<[f64; 3]>,
     /// Angular velocities [rad/s].
     pub omega: Vec<[f64; 3]>,
-    /// Radii [m].
+    /// Radii \[m\].
     pub radius: Vec<f64>,
-    /// Masses [kg].
+    /// Masses \[kg\].
     pub mass: Vec<f64>,
     /// Moments of inertia [kg m²].
     pub inertia: Vec<f64>,
-    /// Particle–particle force + gravity of the current step [N].
+    /// Particle–particle force + gravity of the current step \[N\].
     pub force: Vec<[f64; 3]>,
     /// Particle–particle torque [N m].
     pub torque: Vec<[f64; 3]>,
-    /// Wall forces of the current step, written by the caller [N].
+    /// Wall forces of the current step, written by the caller \[N\].
     pub wall_force: Vec<[f64; 3]>,
     /// Wall torques [N m].
     pub wall_torque: Vec<[f64; 3]>,
@@ -65,7 +65,7 @@ pub struct Powder {
     pub alpha: Vec<[f64; 3]>,
     /// Pair list.
     pub nl: NeighborList,
-    /// Elastic energy stored in particle–particle springs after the last force pass [J].
+    /// Elastic energy stored in particle–particle springs after the last force pass \[J\].
     pub elastic_pp_j: f64,
     /// Energy ledger.
     pub ledger: PowderLedger,
@@ -391,7 +391,7 @@ impl Powder {
             });
     }
 
-    /// Translational + rotational kinetic energy [J].
+    /// Translational + rotational kinetic energy \[J\].
     pub fn kinetic_energy(&self) -> f64 {
         let mut e = 0.0;
         for p in 0..self.len() {
@@ -403,7 +403,7 @@ impl Powder {
         e
     }
 
-    /// Gravitational potential energy $-\sum m\,\mathbf g\cdot\mathbf x$ [J].
+    /// Gravitational potential energy $-\sum m\,\mathbf g\cdot\mathbf x$ \[J\].
     pub fn potential_energy(&self) -> f64 {
         let g = self.gravity;
         self.pos
@@ -413,7 +413,7 @@ impl Powder {
             .sum()
     }
 
-    /// Total particle volume [m³].
+    /// Total particle volume \[m³\].
     pub fn volume(&self) -> f64 {
         self.radius
             .iter()

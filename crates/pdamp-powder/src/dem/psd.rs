@@ -35,13 +35,13 @@ impl Rng {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LogNormal {
-    /// Median diameter $D_{50}$ [m].
+    /// Median diameter $D_{50}$ \[m\].
     pub d50_m: f64,
     /// Standard deviation of $\ln D$ (Table A.2: 0.2707).
     pub sigma: f64,
-    /// Smallest diameter [m] (Table A.2: 2 r_min = 0.706828 mm for D50 = 1 mm).
+    /// Smallest diameter \[m\] (Table A.2: 2 r_min = 0.706828 mm for D50 = 1 mm).
     pub d_min_m: f64,
-    /// Largest diameter [m] (Table A.2: 2 r_max = 1.41477 mm).
+    /// Largest diameter \[m\] (Table A.2: 2 r_max = 1.41477 mm).
     pub d_max_m: f64,
 }
 
@@ -55,7 +55,7 @@ impl LogNormal {
             d_max_m: d50_m * 1.414_770,
         }
     }
-    /// One diameter [m].
+    /// One diameter \[m\].
     pub fn sample(&self, rng: &mut Rng) -> f64 {
         loop {
             let d = self.d50_m * (self.sigma * rng.normal()).exp();
@@ -100,7 +100,7 @@ impl LogNormal {
         Ok(())
     }
 
-    /// Mean particle volume of the truncated distribution [m³] (midpoint rule in ln D).
+    /// Mean particle volume of the truncated distribution \[m³\] (midpoint rule in ln D).
     pub fn mean_volume_m3(&self) -> f64 {
         let (a, b) = (self.d_min_m.ln(), self.d_max_m.ln());
         let (mu, s) = (self.d50_m.ln(), self.sigma);

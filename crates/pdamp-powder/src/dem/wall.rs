@@ -31,7 +31,7 @@ pub fn slot_put(s: &mut WallSlots, id: u32, g: [f64; 3]) {
 /// A rigid plane: points `x` with $(\mathbf x-\mathbf p)\cdot\mathbf n \ge 0$ are inside.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlaneWall {
-    /// A point on the plane [m].
+    /// A point on the plane \[m\].
     pub point: [f64; 3],
     /// Unit normal pointing into the particle domain.
     pub normal: [f64; 3],
@@ -40,7 +40,7 @@ pub struct PlaneWall {
 }
 
 /// Contact of particle `i` with a wall point: `n` unit normal from the particle centre towards
-/// the wall, `gap` surface gap [m], `v_wall` wall velocity [m/s]. Returns the result and the
+/// the wall, `gap` surface gap \[m\], `v_wall` wall velocity [m/s]. Returns the result and the
 /// torque on the particle.
 #[inline]
 pub fn particle_wall(
@@ -67,7 +67,7 @@ pub fn particle_wall(
 
 /// Writes the forces of the rigid `planes` into `p.wall_force`/`p.wall_torque` (overwriting) and
 /// books the dissipation; `on_wall[w]` receives the total force the particles exert on plane `w`
-/// [N] (no allocation per step).
+/// \[N\] (no allocation per step).
 ///
 /// # Panics
 /// If `on_wall` is shorter than `planes`.

@@ -8,11 +8,11 @@
 /// One axial segment of the beam.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment {
-    /// Segment length [m].
+    /// Segment length \[m\].
     pub length_m: f64,
-    /// Outer width of the square section [m].
+    /// Outer width of the square section \[m\].
     pub outer_m: f64,
-    /// Inner (cavity) width [m]; 0 for a solid section.
+    /// Inner (cavity) width \[m\]; 0 for a solid section.
     pub inner_m: f64,
 }
 
@@ -32,7 +32,7 @@ impl Segment {
     }
 }
 
-/// Euler–Bernoulli first cantilever frequency of a uniform beam [Hz]:
+/// Euler–Bernoulli first cantilever frequency of a uniform beam \[Hz\]:
 /// $f_1 = \frac{(1.875104)^2}{2\pi L^2}\sqrt{EI/(\rho A)}$.
 pub fn euler_bernoulli_f1(s: &Segment, e: f64, rho: f64) -> f64 {
     let b = 1.875_104_068_711_961;
@@ -40,7 +40,7 @@ pub fn euler_bernoulli_f1(s: &Segment, e: f64, rho: f64) -> f64 {
         * (e * s.inertia() / (rho * s.area())).sqrt()
 }
 
-/// First bending frequency [Hz] of a cantilever (clamped at the start of the first segment) of
+/// First bending frequency \[Hz\] of a cantilever (clamped at the start of the first segment) of
 /// Timoshenko segments, `elements` beam elements in total; `extra_mass_per_length` [kg/m] adds
 /// non-structural mass on each segment (e.g. a rigidly moving filling).
 pub fn timoshenko_f1(

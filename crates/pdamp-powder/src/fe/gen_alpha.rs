@@ -1,4 +1,4 @@
-//! Generalized-α time integration (Chung & Hulbert 1993, paper ref. [32]) of eq. 11 with Newton
+//! Generalized-α time integration (Chung & Hulbert 1993, paper ref. \[32\]) of eq. 11 with Newton
 //! iterations and a sparse Cholesky solver.
 //!
 //! Balance at the generalized midpoint (forces averaged, "TR-like"):
@@ -59,7 +59,7 @@ impl GenAlpha {
 pub struct Rayleigh {
     /// Mass-proportional coefficient [1/s].
     pub mass_coeff_per_s: f64,
-    /// Stiffness-proportional coefficient [s].
+    /// Stiffness-proportional coefficient \[s\].
     pub stiffness_coeff_s: f64,
 }
 
@@ -74,7 +74,7 @@ pub enum DynamicsError {
         "Newton did not converge at t = {t_s} s after {iterations} iterations (residual {residual:e})"
     )]
     Newton {
-        /// Time [s].
+        /// Time \[s\].
         t_s: f64,
         /// Iterations done.
         iterations: usize,
@@ -110,9 +110,9 @@ impl Default for NewtonSettings {
 pub struct Dynamics {
     /// Parameters.
     pub params: GenAlpha,
-    /// Time step [s].
+    /// Time step \[s\].
     pub dt: f64,
-    /// Time of the committed state [s].
+    /// Time of the committed state \[s\].
     pub t: f64,
     /// Committed displacement, velocity, acceleration.
     pub d: Vec<f64>,
@@ -130,10 +130,10 @@ pub struct Dynamics {
     fext_n: Vec<f64>,
     fint1: Vec<f64>,
     fext1: Vec<f64>,
-    /// Strain energy of the committed state [J].
+    /// Strain energy of the committed state \[J\].
     pub strain_energy: f64,
     strain_energy1: f64,
-    /// Work of all external forces (loads, gravity, interface) up to `t` [J] (trapezoidal).
+    /// Work of all external forces (loads, gravity, interface) up to `t` \[J\] (trapezoidal).
     pub external_work: f64,
     /// Newton iterations of the last solve.
     pub last_iterations: usize,
@@ -155,15 +155,15 @@ pub struct Dynamics {
 /// [`Dynamics::new`]); with full Newton they are refactorized before every use.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DynamicsState {
-    /// Time step [s] (checked on restore).
+    /// Time step \[s\] (checked on restore).
     pub dt: f64,
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
     /// d, v, a, d1, v1, a1, F_int,n, F_ext,n, F_int,n+1, F_ext,n+1 (all dofs).
     pub vectors: [Vec<f64>; 10],
-    /// Strain energy (committed, trial) [J].
+    /// Strain energy (committed, trial) \[J\].
     pub strain_energy: [f64; 2],
-    /// External work [J].
+    /// External work \[J\].
     pub external_work: f64,
     /// Newton iterations of the last solve.
     pub last_iterations: usize,
@@ -279,7 +279,7 @@ impl Dynamics {
         Ok(())
     }
 
-    /// Kinetic energy of the committed state [J].
+    /// Kinetic energy of the committed state \[J\].
     pub fn kinetic_energy(&self, s: &Structure) -> f64 {
         let vf: Vec<f64> = s.free_dofs.iter().map(|&g| self.v[g]).collect();
         0.5 * s.mass.quad(&vf)

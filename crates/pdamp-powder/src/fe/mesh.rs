@@ -18,10 +18,10 @@ pub const HEX_FACES: [[usize; 4]; 6] = [
     [3, 7, 6, 2],
 ];
 
-/// A mesh of 8-node hexahedra in the reference configuration [m].
+/// A mesh of 8-node hexahedra in the reference configuration \[m\].
 #[derive(Debug, Clone, Default)]
 pub struct HexMesh {
-    /// Node coordinates [m].
+    /// Node coordinates \[m\].
     pub nodes: Vec<[f64; 3]>,
     /// Element connectivity (node indices, order of the module docs).
     pub elements: Vec<[usize; 8]>,
@@ -36,17 +36,17 @@ pub struct Face {
     pub element: usize,
 }
 
-/// An axis-aligned box `[min, max]` [m].
+/// An axis-aligned box `[min, max]` \[m\].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Aabb {
-    /// Lower corner [m].
+    /// Lower corner \[m\].
     pub min: [f64; 3],
-    /// Upper corner [m].
+    /// Upper corner \[m\].
     pub max: [f64; 3],
 }
 
 impl Aabb {
-    /// Volume [m³].
+    /// Volume \[m³\].
     pub fn volume(&self) -> f64 {
         (0..3).map(|k| self.max[k] - self.min[k]).product()
     }
@@ -76,12 +76,12 @@ fn grid_line(breaks: &[f64], divisions: &[usize]) -> Vec<f64> {
 /// Element counts of a structured box-with-cavity mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoxMeshDivisions {
-    /// Target element edge length in the walls and solid parts [m] (at least one element
+    /// Target element edge length in the walls and solid parts \[m\] (at least one element
     /// across every wall).
     pub wall_element_m: f64,
-    /// Target element edge length across the cavity span (x and y) [m].
+    /// Target element edge length across the cavity span (x and y) \[m\].
     pub core_element_m: f64,
-    /// Target element edge length along z over the cavity [m].
+    /// Target element edge length along z over the cavity \[m\].
     pub length_element_m: f64,
 }
 
@@ -223,7 +223,7 @@ impl HexMesh {
             .collect()
     }
 
-    /// Total volume from the 2 × 2 × 2 Gauss rule [m³].
+    /// Total volume from the 2 × 2 × 2 Gauss rule \[m³\].
     pub fn volume(&self) -> f64 {
         super::svk::element_volumes(self).iter().sum()
     }

@@ -54,7 +54,7 @@ pub fn jacobi_eigen(a: &mut [f64], n: usize) -> (Vec<f64>, Vec<f64>) {
     ((0..n).map(|i| a[i * n + i]).collect(), v)
 }
 
-/// Eigenfrequencies [Hz] (ascending) and mode shapes (all dofs) of the `count` lowest modes.
+/// Eigenfrequencies \[Hz\] (ascending) and mode shapes (all dofs) of the `count` lowest modes.
 pub fn lowest_modes(
     s: &Structure,
     count: usize,

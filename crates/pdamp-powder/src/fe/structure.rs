@@ -12,15 +12,15 @@ use super::svk::{self, GaussPoint, SvkMaterial};
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadRamp {
-    /// Linear increase from 0 to 1 over this time [s] (paper Sect. 2.4: 5 ms).
+    /// Linear increase from 0 to 1 over this time \[s\] (paper Sect. 2.4: 5 ms).
     pub rise_s: f64,
-    /// Time held at 1 after the rise [s] (paper: 1 ms); afterwards the load is removed.
+    /// Time held at 1 after the rise \[s\] (paper: 1 ms); afterwards the load is removed.
     /// `inf` keeps it on.
     pub hold_s: f64,
 }
 
 impl LoadRamp {
-    /// Load factor at time `t` [s].
+    /// Load factor at time `t` \[s\].
     pub fn factor(&self, t: f64) -> f64 {
         if t < 0.0 {
             0.0
@@ -39,7 +39,7 @@ impl LoadRamp {
 pub struct SurfaceLoad {
     /// Loaded faces.
     pub faces: Vec<Face>,
-    /// Traction vector [Pa] at load factor 1.
+    /// Traction vector \[Pa\] at load factor 1.
     pub traction_pa: [f64; 3],
     /// Time history.
     pub ramp: LoadRamp,
@@ -73,7 +73,7 @@ pub struct Structure {
     pub k0: CsrMatrix,
     /// Surface loads.
     pub loads: Vec<SurfaceLoad>,
-    /// Constant body-force vector (gravity) on all dofs [N].
+    /// Constant body-force vector (gravity) on all dofs \[N\].
     pub body_force: Vec<f64>,
     /// Per-element triplet positions are rebuilt on demand; the element dof lists.
     elem_free: Vec<[usize; 24]>,
@@ -201,7 +201,7 @@ impl Structure {
         CsrMatrix::from_triplets(self.free_dofs.len(), t)
     }
 
-    /// Internal forces (all dofs) and strain energy [J] at `d`.
+    /// Internal forces (all dofs) and strain energy \[J\] at `d`.
     pub fn internal_force(&mut self, d: &[f64], out: &mut [f64]) -> f64 {
         svk::internal_force(
             &self.mesh,
@@ -213,7 +213,7 @@ impl Structure {
         )
     }
 
-    /// External force at time `t` (surface loads + body force), all dofs [N].
+    /// External force at time `t` (surface loads + body force), all dofs \[N\].
     pub fn external_force(&self, t: f64, out: &mut [f64]) {
         out.copy_from_slice(&self.body_force);
         for load in &self.loads {
@@ -232,13 +232,13 @@ impl Structure {
         }
     }
 
-    /// Total mass [kg].
+    /// Total mass \[kg\].
     pub fn total_mass(&self) -> f64 {
         svk::element_volumes(&self.mesh).iter().sum::<f64>() * self.material.density_kg_m3
     }
 }
 
-/// $\int_A N_a\,dA$ of a bilinear quad face (2 × 2 Gauss) [m²].
+/// $\int_A N_a\,dA$ of a bilinear quad face (2 × 2 Gauss) \[m²\].
 pub fn face_weights(nodes: &[[f64; 3]], f: &Face) -> [f64; 4] {
     let x: [[f64; 3]; 4] = [
         nodes[f.nodes[0]],

@@ -12,7 +12,7 @@ use super::mesh::HexMesh;
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SvkMaterial {
-    /// Young's modulus [Pa] (paper Table A.3: 175 GPa).
+    /// Young's modulus \[Pa\] (paper Table A.3: 175 GPa).
     pub youngs_modulus_pa: f64,
     /// Poisson's ratio (Table A.3: 0.27).
     pub poisson_ratio: f64,
@@ -27,7 +27,7 @@ impl SvkMaterial {
         poisson_ratio: 0.27,
         density_kg_m3: 8000.0,
     };
-    /// Lamé constants (λ, μ) [Pa].
+    /// Lamé constants (λ, μ) \[Pa\].
     pub fn lame(&self) -> (f64, f64) {
         let (e, nu) = (self.youngs_modulus_pa, self.poisson_ratio);
         (
@@ -95,7 +95,7 @@ fn inv3(m: [[f64; 3]; 3]) -> ([[f64; 3]; 3], f64) {
 pub struct GaussPoint {
     /// $\partial N_a / \partial X_K$.
     pub dn: [[f64; 3]; 8],
-    /// Integration weight times Jacobian determinant [m³].
+    /// Integration weight times Jacobian determinant \[m³\].
     pub wdet: f64,
     /// Shape function values (for the mass matrix).
     pub n: [f64; 8],
@@ -146,7 +146,7 @@ pub fn precompute(mesh: &HexMesh) -> Vec<[GaussPoint; 8]> {
         .collect()
 }
 
-/// Element volumes [m³].
+/// Element volumes \[m³\].
 pub fn element_volumes(mesh: &HexMesh) -> Vec<f64> {
     precompute(mesh)
         .iter()
@@ -191,7 +191,7 @@ fn green_pk2(f: &[[f64; 3]; 3], lam: f64, mu: f64) -> ([[f64; 3]; 3], [[f64; 3];
     (e, s)
 }
 
-/// Internal force (24 entries, node-major) and strain energy [J] of one element for nodal
+/// Internal force (24 entries, node-major) and strain energy \[J\] of one element for nodal
 /// displacements `u`.
 #[inline]
 pub fn element_force(
@@ -296,7 +296,7 @@ pub fn element_tangent(gps: &[GaussPoint; 8], u: &[[f64; 3]; 8], lam: f64, mu: f
     k
 }
 
-/// Consistent mass (8 × 8 scalar block, same for each direction) of one element [kg].
+/// Consistent mass (8 × 8 scalar block, same for each direction) of one element \[kg\].
 pub fn element_mass(gps: &[GaussPoint; 8], rho: f64) -> [[f64; 8]; 8] {
     let mut m = [[0.0; 8]; 8];
     for gp in gps {
@@ -309,7 +309,7 @@ pub fn element_mass(gps: &[GaussPoint; 8], rho: f64) -> [[f64; 8]; 8] {
     m
 }
 
-/// Assembled internal force vector (3 per node) and total strain energy [J]. Element forces are
+/// Assembled internal force vector (3 per node) and total strain energy \[J\]. Element forces are
 /// computed in parallel and gathered in element order (deterministic for any thread count).
 pub fn internal_force(
     mesh: &HexMesh,
