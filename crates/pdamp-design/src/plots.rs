@@ -630,7 +630,9 @@ mod tests {
 
     /// A recorder on a 20 × 10 × 6 mm box (one particle, excitation along x, gravity −z) with
     /// 10 cells along the excitation: cells of 2 mm; phase 0 filled with a made-up field.
-    fn recorder() -> MotionRecorder {
+    /// A world with one fixed box of `half_extents_m` around the origin and one sphere
+    /// (r = 1 mm) at `particle_m`.
+    fn box_world(half_extents_m: pdamp_dem::Vec3, particle_m: pdamp_dem::Vec3) -> pdamp_dem::World {
         use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
         use pdamp_dem::walls::{BoxInside, Geometry};
         use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
@@ -648,11 +650,17 @@ mod tests {
         w.add_body(
             RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
                 "box",
-                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(10e-3, 5e-3, 3e-3))),
+                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), half_extents_m)),
                 0,
             ),
         );
-        w.add_particle(Vec3::new(0.0, 0.0, -2e-3), 1e-3, 0);
+        w.add_particle(particle_m, 1e-3, 0);
+        w
+    }
+
+    fn recorder() -> MotionRecorder {
+        use pdamp_dem::Vec3;
+        let w = box_world(Vec3::new(10e-3, 5e-3, 3e-3), Vec3::new(0.0, 0.0, -2e-3));
         let damper = crate::Damper::from_world(w, 0, Vec3::x(), 0.1, 3, 1);
         let mut rec = MotionRecorder::new(&damper, 50.0, 0.25, 2, 10, vec![], 2e4);
         let f = &mut rec.fields[0];
@@ -704,30 +712,10 @@ mod tests {
     /// ("up"), the x axis the horizontal direction, outline and arrows turned with it.
     #[test]
     fn vertical_excitation_is_drawn_upwards() {
-        use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
-        use pdamp_dem::walls::{BoxInside, Geometry};
-        use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World};
-        let model = ContactModel {
-            normal: NormalLaw::Linear {
-                stiffness_n_m: 2e5,
-                restitution: 0.5,
-                clip_attractive: false,
-            },
-            friction: FrictionLaw::Frictionless,
-            rolling: None,
-            adhesion: None,
-        };
-        let mut w = World::new(vec![Material::new("steel", 7800.0, 2e9, 0.3)], model, 1e-6);
+        use pdamp_dem::Vec3;
+        // 20 mm high (z), 8 mm wide (x), 6 mm deep (y)
+        let mut w = box_world(Vec3::new(4e-3, 3e-3, 10e-3), Vec3::new(0.0, 0.0, -8e-3));
         w.gravity_m_s2 = Vec3::new(0.0, 0.0, -9.81);
-        w.add_body(
-            RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
-                "box",
-                // 20 mm high (z), 8 mm wide (x), 6 mm deep (y)
-                Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(4e-3, 3e-3, 10e-3))),
-                0,
-            ),
-        );
-        w.add_particle(Vec3::new(0.0, 0.0, -8e-3), 1e-3, 0);
         let damper = crate::Damper::from_world(w, 0, Vec3::z(), 0.1, 3, 1);
         let mut rec = MotionRecorder::new(&damper, 50.0, 0.25, 1, 10, vec![], 2e4);
         assert_eq!(rec.excitation_up, 1.0);

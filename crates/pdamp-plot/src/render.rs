@@ -292,13 +292,12 @@ pub(crate) struct Frame {
     pub y_label: u32,
 }
 
-/// Width of the y label area needed for the tick labels of `y` and the
-/// axis title.
-pub(crate) fn y_label_width<DB: DrawingBackend>(
+/// Widest tick label of `y` and the height of the (rotated) axis `title` (0 without one), px.
+fn tick_and_title_px<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     y: &AxisLayout,
     title: &str,
-) -> Result<u32, PlotError> {
+) -> Result<(u32, u32), PlotError> {
     let mut w = 0;
     for l in &y.ticks.labels {
         w = w.max(area.estimate_text_size(l, &font(TICK_PT)).map_err(de)?.0);
@@ -309,8 +308,19 @@ pub(crate) fn y_label_width<DB: DrawingBackend>(
         area.estimate_text_size(title, &font(AXIS_TITLE_PT))
             .map_err(de)?
             .1
-            + 12
     };
+    Ok((w, th))
+}
+
+/// Width of the y label area needed for the tick labels of `y` and the
+/// axis title.
+pub(crate) fn y_label_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    y: &AxisLayout,
+    title: &str,
+) -> Result<u32, PlotError> {
+    let (w, th) = tick_and_title_px(area, y, title)?;
+    let th = if title.is_empty() { 0 } else { th + 12 };
     Ok((w + 16 + th).clamp(30, 200))
 }
 
@@ -699,18 +709,8 @@ pub(crate) fn right_axis_width<DB: DrawingBackend>(
     y: &AxisLayout,
     title: &str,
 ) -> Result<u32, PlotError> {
-    let mut w = 0;
-    for l in &y.ticks.labels {
-        w = w.max(area.estimate_text_size(l, &font(TICK_PT)).map_err(de)?.0);
-    }
-    let th = if title.is_empty() {
-        0
-    } else {
-        area.estimate_text_size(title, &font(AXIS_TITLE_PT))
-            .map_err(de)?
-            .1
-            + 14
-    };
+    let (w, th) = tick_and_title_px(area, y, title)?;
+    let th = if title.is_empty() { 0 } else { th + 14 };
     Ok((w + 14 + th + 8).clamp(30, 220))
 }
 
