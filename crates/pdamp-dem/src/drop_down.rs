@@ -15,12 +15,27 @@
 //! time limit is reached. A dense fill thus pours in like a real filling; a bed that fits the
 //! region in one random insertion needs one round.
 //!
+//! **Filling with the lid open** ([`OpenLid`]; D L3085 "particles are filled into the container
+//! from its top and the container's top cover plate is secured", L3093 "particles are poured up
+//! to a marking … then the container cap is adjusted"): a container whose clearance to the lid is
+//! less than a diameter cannot be filled through closed walls, because a sphere can only be
+//! inserted where it fits whole. The drop-down then extends the container walls that end at the
+//! region's top (the top face of a `box_inside` or `cylinder_inside`, a plane facing down) by
+//! `headroom_m`, pours into the taller container under a temporary lid plane, and closes that
+//! lid down to the real top: at once where the bed stays below it, else at `close_speed_m_s`,
+//! pushing with at most the weight of the bed and, where set, while the container is tapped
+//! along −g ([`Tapping`]) so that the spheres sticking out find the pockets below them; the last
+//! 1 % of the smallest radius (the contacts' elastic give) it is pressed home. A bed
+//! that still stands above the lid after `max_close_duration_s` is refused, naming the highest
+//! particle.
+//!
 //! Deterministic for a seed (`ChaCha8Rng::seed_from_u64`) and independent of the thread count
 //! (the DEM is).
 
 use crate::generate::{CellGrid, Region, orthonormal_frame};
 use crate::math::Vec3;
-use crate::{Motion, World};
+use crate::walls::{Geometry, Plane};
+use crate::{BodyState, HarmonicTranslation, Motion, RigidBody, World};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::ops::ControlFlow;
@@ -40,6 +55,33 @@ pub struct DropDownSpec {
     pub max_round_duration_s: f64,
     /// Most insertion rounds before the drop-down gives up.
     pub max_rounds: usize,
+    /// Fill with the lid open and close it afterwards (see the module docs); `None`: fill
+    /// through the closed container.
+    pub open_lid: Option<OpenLid>,
+}
+
+/// Filling with the lid open, then closing it (D L3085, L3093; module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OpenLid {
+    /// How far the walls that end at the region's top are extended while the particles pour
+    /// in, m.
+    pub headroom_m: f64,
+    /// Speed at which the lid closes onto a bed that stands above the real top, m/s.
+    pub close_speed_m_s: f64,
+    /// Longest closing before the drop-down gives up, s.
+    pub max_close_duration_s: f64,
+    /// Tapping of the container while the lid closes onto a bed that stands above it.
+    pub tapping: Option<Tapping>,
+}
+
+/// Harmonic tapping of the container along −g while the lid closes: the spheres that stand
+/// above the lid are lifted a little every cycle and find the pockets below them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tapping {
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Acceleration amplitude over g, Γ = A/g.
+    pub intensity: f64,
 }
 
 /// What a drop-down did.
@@ -51,6 +93,13 @@ pub struct DropDownReport {
     pub simulated_time_s: f64,
     /// Time steps of all falls.
     pub steps: u64,
+    /// Filling with the lid open: how far the highest particle top stood above the real top
+    /// of the container after pouring, m (negative: below it; `None` without an open lid).
+    #[serde(default)]
+    pub bed_top_above_lid_m: Option<f64>,
+    /// Filling with the lid open: simulated time of closing the lid (incl. tapping), s.
+    #[serde(default)]
+    pub lid_closing_time_s: f64,
 }
 
 /// Errors of a drop-down.
@@ -76,6 +125,20 @@ pub enum DropDownError {
         next: usize,
         /// Its radius, m.
         radius_m: f64,
+    },
+    /// The lid could not be closed: the bed stands above the container's top.
+    #[error(
+        "drop-down with the lid open: after closing for {duration_s:.3} s the lid is still \
+         {above_m:.4e} m above the container's top, held up by particle {particle}; raise the \
+         container's top, lower the particle count, or tap while closing (open_lid.tap_intensity)"
+    )]
+    LidNotClosed {
+        /// How far the lid stayed above the real top, m.
+        above_m: f64,
+        /// The particle with the highest top (index among all particles of the world).
+        particle: usize,
+        /// Simulated closing time, s.
+        duration_s: f64,
     },
     /// The simulation of a fall failed its health check.
     #[error("drop-down: {0}")]
@@ -131,6 +194,35 @@ impl DropDownSpec {
         if self.max_rounds == 0 {
             return bad("max_rounds must be > 0".into());
         }
+        if let Some(l) = &self.open_lid {
+            let positive = |v: f64| v.is_finite() && v > 0.0;
+            if !positive(l.headroom_m) {
+                return bad(format!(
+                    "open_lid.headroom_m must be finite and > 0, got {}",
+                    l.headroom_m
+                ));
+            }
+            if !positive(l.close_speed_m_s) {
+                return bad(format!(
+                    "open_lid.close_speed_m_s must be finite and > 0, got {}",
+                    l.close_speed_m_s
+                ));
+            }
+            if !positive(l.max_close_duration_s) {
+                return bad(format!(
+                    "open_lid.max_close_duration_s must be finite and > 0, got {}",
+                    l.max_close_duration_s
+                ));
+            }
+            if let Some(t) = &l.tapping
+                && !(positive(t.frequency_hz) && positive(t.intensity))
+            {
+                return bad(format!(
+                    "open_lid tapping: frequency {} Hz and intensity {} must be finite and > 0",
+                    t.frequency_hz, t.intensity
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -169,15 +261,31 @@ pub fn drop_down(
         b.motion = Motion::Fixed;
     }
     let first = w.particles.len();
-    let ext = [
-        spec.region.extent_along(&e1),
-        spec.region.extent_along(&e2),
-        spec.region.extent_along(&up),
-    ];
     let r_max = radii
         .iter()
         .chain(&w.particles.radius)
         .fold(0.0f64, |a, &b| a.max(b));
+    let r_min = radii
+        .iter()
+        .chain(&w.particles.radius)
+        .fold(f64::INFINITY, |a, &b| a.min(b));
+    // With the lid open: the walls ending at the region's top extended, a temporary lid above.
+    let open = match &spec.open_lid {
+        Some(l) => Some(open_container(
+            &mut w,
+            &spec.region,
+            &up,
+            l.headroom_m,
+            1e-3 * r_min,
+        )?),
+        None => None,
+    };
+    let region = open.as_ref().map_or(&spec.region, |o| &o.fill_region);
+    let ext = [
+        region.extent_along(&e1),
+        region.extent_along(&e2),
+        region.extent_along(&up),
+    ];
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
     let mut report = DropDownReport::default();
     let mut next = 0usize;
@@ -199,7 +307,7 @@ pub fn drop_down(
         let bed_top = (0..p.len())
             .map(|i| p.position[i].dot(&up) + p.radius[i])
             .fold(f64::NEG_INFINITY, f64::max);
-        let (mut lo, mut hi) = spec.region.bounding_box();
+        let (mut lo, mut hi) = region.bounding_box();
         for x in &p.position {
             lo = lo.inf(x);
             hi = hi.sup(x);
@@ -226,7 +334,7 @@ pub fn drop_down(
                     let x = e1 * (x_lo + (x_hi - x_lo) * u)
                         + e2 * (y_lo + (y_hi - y_lo) * v)
                         + up * (z_lo + (z_hi - z_lo) * s);
-                    if spec.region.contains_sphere(&x, r)
+                    if region.contains_sphere(&x, r)
                         && !grid.overlaps(&x, r, &pos, &rad)
                         && w.wall_overlap(&x, r, &mut scratch).is_none()
                     {
@@ -271,6 +379,9 @@ pub fn drop_down(
         report.steps += steps_in_round;
         report.simulated_time_s += w.time_s - t0;
     }
+    if let (Some(o), Some(l)) = (&open, &spec.open_lid) {
+        close_lid(&mut w, o, l, &up, spec, &mut report, &mut hook, next)?;
+    }
     let p = &w.particles;
     Ok(DroppedParticles {
         earlier_position_m: p.position[..first].to_vec(),
@@ -281,6 +392,273 @@ pub fn drop_down(
         angular_velocity_rad_s: p.angular_velocity[first..].to_vec(),
         report,
     })
+}
+
+/// The container opened for a fill with the lid open ([`open_container`]).
+struct OpenContainer {
+    /// The insertion region extended by the headroom.
+    fill_region: Region,
+    /// The real top of the container along −g (world frame), m.
+    top_m: f64,
+    /// The top while pouring, m.
+    raised_m: f64,
+    /// Index of the temporary lid body.
+    lid_body: usize,
+    /// Bodies whose walls were extended (tapped while the lid closes).
+    containers: Vec<usize>,
+}
+
+/// Extends every wall of `w` that ends at the top of `region` along `up` by `headroom_m` and adds
+/// a temporary lid plane at the raised top (a driven body of the first such wall's material).
+fn open_container(
+    w: &mut World,
+    region: &Region,
+    up: &Vec3,
+    headroom_m: f64,
+    tolerance_m: f64,
+) -> Result<OpenContainer, DropDownError> {
+    let fill_region = region.raised(up, headroom_m).ok_or_else(|| {
+        DropDownError::Invalid(
+            "open_lid: the region must be a box with an edge along the filling gravity or a \
+             cylinder with its axis along it"
+                .into(),
+        )
+    })?;
+    let top_m = region.extent_along(up).1;
+    let mut containers = Vec::new();
+    let mut lid_material = None;
+    for (bi, b) in w.bodies.iter_mut().enumerate() {
+        let pose = b.state;
+        for wall in &mut b.walls {
+            if let Some(g) = raised_top(&wall.geometry, &pose, up, top_m, headroom_m, tolerance_m) {
+                if !matches!(g, Geometry::CylinderOutside(_)) {
+                    lid_material.get_or_insert(wall.material);
+                }
+                wall.geometry = g;
+                if !containers.contains(&bi) {
+                    containers.push(bi);
+                }
+            }
+        }
+    }
+    let Some(material) = lid_material else {
+        return Err(DropDownError::Invalid(format!(
+            "open_lid: no wall ends at the region's top ({top_m:.6e} m along the filling \
+             gravity's up direction); the lid must be the top face of a box_inside or \
+             cylinder_inside, or a plane facing down, level with the top of placement.region"
+        )));
+    };
+    let raised_m = top_m + headroom_m;
+    let lid = RigidBody::new(
+        "open-lid fill: lid",
+        BodyState::at_rest(Vec3::zeros()),
+        Motion::Driven,
+    )
+    .with_wall(
+        "lid",
+        Geometry::Plane(Plane::new(up * raised_m, -up, false)),
+        material,
+    );
+    let lid_body = w.add_body(lid);
+    Ok(OpenContainer {
+        fill_region,
+        top_m,
+        raised_m,
+        lid_body,
+        containers,
+    })
+}
+
+/// The geometry `g` of a body at `pose` extended by `h` beyond its face at `top` along `up`
+/// (world frame): the top face of a `box_inside` with an edge along `up`, the top disc of a
+/// `cylinder_inside` with its axis along `up`, the top end of an inner rod (`cylinder_outside`)
+/// along `up` that reaches the lid, a one-sided plane facing down; `None` for any other wall or
+/// a face elsewhere.
+fn raised_top(
+    g: &Geometry,
+    pose: &BodyState,
+    up: &Vec3,
+    top: f64,
+    h: f64,
+    tolerance: f64,
+) -> Option<Geometry> {
+    let up_b = pose.orientation.inverse_transform_vector(up);
+    let top_b = top - pose.position_m.dot(up);
+    let aligned = |c: f64| c.abs() > 1.0 - 1e-9;
+    match g {
+        Geometry::BoxInside(b) => {
+            let k = (0..3).find(|&k| aligned(up_b[k]))?;
+            let sign = up_b[k].signum();
+            let face = b.center_m[k] * sign + b.half_extents_m[k];
+            if (face - top_b).abs() > tolerance {
+                return None;
+            }
+            let mut raised = b.clone();
+            raised.center_m[k] += sign * 0.5 * h;
+            raised.half_extents_m[k] += 0.5 * h;
+            Some(Geometry::BoxInside(raised))
+        }
+        Geometry::CylinderInside(c) => {
+            let a = c.axis.dot(&up_b);
+            if !aligned(a) {
+                return None;
+            }
+            let base = c.base_center_m.dot(&up_b);
+            let face = if a > 0.0 { base + c.length_m } else { base };
+            if (face - top_b).abs() > tolerance {
+                return None;
+            }
+            let mut raised = c.clone();
+            if a < 0.0 {
+                raised.base_center_m += up_b * h;
+            }
+            raised.length_m += h;
+            Some(Geometry::CylinderInside(raised))
+        }
+        Geometry::CylinderOutside(c) => {
+            // An inner rod that reaches the lid reaches the raised lid.
+            let a = c.axis.dot(&up_b);
+            if !aligned(a) {
+                return None;
+            }
+            let base = c.base_center_m.dot(&up_b);
+            let face = if a > 0.0 { base + c.length_m } else { base };
+            if (face - top_b).abs() > tolerance {
+                return None;
+            }
+            let mut raised = c.clone();
+            if a < 0.0 {
+                raised.base_center_m += up_b * h;
+            }
+            raised.length_m += h;
+            Some(Geometry::CylinderOutside(raised))
+        }
+        Geometry::Plane(p) if !p.two_sided && p.normal.dot(&up_b) < -(1.0 - 1e-9) => {
+            if (p.point_m.dot(&up_b) - top_b).abs() > tolerance {
+                return None;
+            }
+            let mut raised = p.clone();
+            raised.point_m += up_b * h;
+            Some(Geometry::Plane(raised))
+        }
+        _ => None,
+    }
+}
+
+/// The particle with the highest top along `up`: `(index, top)`.
+fn highest_top(w: &World, up: &Vec3) -> (usize, f64) {
+    let p = &w.particles;
+    (0..p.len())
+        .map(|i| (i, p.position[i].dot(up) + p.radius[i]))
+        .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
+}
+
+/// Closes the lid of an opened container (module docs): down to the highest particle top at
+/// once, then at `close_speed_m_s` while the particles push on it with less than their weight
+/// (tapping the container where set), to the real top; the containers end at rest in their
+/// reference poses after whole tapping cycles, and the bed falls calm under the closed lid.
+#[allow(clippy::too_many_arguments)]
+fn close_lid(
+    w: &mut World,
+    o: &OpenContainer,
+    l: &OpenLid,
+    up: &Vec3,
+    spec: &DropDownSpec,
+    report: &mut DropDownReport,
+    hook: &mut impl FnMut(&World, usize) -> ControlFlow<()>,
+    placed: usize,
+) -> Result<(), DropDownError> {
+    let (_, bed_top) = highest_top(w, up);
+    report.bed_top_above_lid_m = Some(bed_top - o.top_m);
+    let t0 = w.time_s;
+    let g = w.gravity_m_s2.norm();
+    let hold_n = w.particles.total_mass() * g;
+    // (ω, amplitude, period) of the tapping.
+    let tap = l.tapping.map(|t| {
+        let omega = 2.0 * std::f64::consts::PI * t.frequency_hz;
+        (
+            omega,
+            t.intensity * g / (omega * omega),
+            1.0 / t.frequency_hz,
+        )
+    });
+    let mut level = bed_top.clamp(o.top_m, o.raised_m);
+    let snap_m = 0.01 * w.particles.min_radius();
+    let mut steps = 0u64;
+    let check = |w: &World, steps: u64, hook: &mut dyn FnMut(&World, usize) -> ControlFlow<()>| {
+        if steps.is_multiple_of(200) {
+            w.check_health()
+                .map_err(|e| DropDownError::Health(e.to_string()))?;
+            if hook(w, placed).is_break() {
+                return Err(DropDownError::Interrupted);
+            }
+        }
+        Ok(())
+    };
+    if level > o.top_m {
+        if let Some((omega, amplitude_m, _)) = tap {
+            for &b in &o.containers {
+                w.bodies[b].motion = Motion::Prescribed(std::sync::Arc::new(HarmonicTranslation {
+                    direction: [up.x, up.y, up.z],
+                    amplitude_m,
+                    frequency_hz: omega / (2.0 * std::f64::consts::PI),
+                    phase_rad: -omega * t0,
+                }));
+            }
+        }
+        let mut end_s = f64::INFINITY;
+        while w.time_s < end_s - 0.5 * w.dt_s {
+            let t1 = w.time_s + w.dt_s;
+            let shake = tap.map_or(0.0, |(omega, a, _)| a * (omega * (t1 - t0)).sin());
+            w.bodies[o.lid_body].state.position_m = up * (level - o.raised_m + shake);
+            w.step();
+            steps += 1;
+            check(w, steps, hook)?;
+            if w.bodies[o.lid_body].contact_force_n.dot(up) < hold_n {
+                level = (level - l.close_speed_m_s * w.dt_s).max(o.top_m);
+            }
+            if level - o.top_m <= snap_m {
+                // Within the contacts' elastic give: the lid is screwed home.
+                level = o.top_m;
+            }
+            let elapsed = w.time_s - t0;
+            if level <= o.top_m && end_s.is_infinite() {
+                // Closed: finish the tapping cycle so that the container ends at rest in place.
+                end_s = match tap {
+                    Some((_, _, period)) => t0 + (elapsed / period - 1e-9).ceil() * period,
+                    None => w.time_s,
+                };
+            }
+            if end_s.is_infinite() && elapsed > l.max_close_duration_s {
+                return Err(DropDownError::LidNotClosed {
+                    above_m: level - o.top_m,
+                    particle: highest_top(w, up).0,
+                    duration_s: elapsed,
+                });
+            }
+        }
+        for &b in &o.containers {
+            w.bodies[b].motion = Motion::Fixed;
+        }
+    }
+    // The lid in its place; the bed falls calm under it.
+    w.bodies[o.lid_body].state.position_m = up * (o.top_m - o.raised_m);
+    let t_calm = w.time_s;
+    let n = w.particles.len().max(1) as f64;
+    loop {
+        w.step();
+        steps += 1;
+        check(w, steps, hook)?;
+        if w.time_s - t_calm >= spec.max_round_duration_s
+            || w.ledger.kinetic_j / n < spec.kinetic_energy_per_particle_j
+        {
+            break;
+        }
+    }
+    report.steps += steps;
+    report.simulated_time_s += w.time_s - t0;
+    report.lid_closing_time_s = w.time_s - t0;
+    Ok(())
 }
 
 impl World {

@@ -552,6 +552,48 @@ impl Region {
         }
     }
 
+    /// The region extended by `h` beyond its top along the unit vector `up`: a box with an edge
+    /// along `up`, a cylinder with its axis along `up`; `None` for other orientations.
+    pub fn raised(&self, up: &Vec3, h: f64) -> Option<Region> {
+        let aligned = |c: f64| c.abs() > 1.0 - 1e-9;
+        match self {
+            Region::Box { min_m, max_m } => {
+                let k = (0..3).find(|&k| aligned(up[k]))?;
+                let (mut lo, mut hi) = (*min_m, *max_m);
+                if up[k] > 0.0 {
+                    hi[k] += h;
+                } else {
+                    lo[k] -= h;
+                }
+                Some(Region::Box {
+                    min_m: lo,
+                    max_m: hi,
+                })
+            }
+            Region::Cylinder {
+                base_center_m,
+                axis,
+                radius_m,
+                length_m,
+            } => {
+                let c = axis.normalize().dot(up);
+                if !aligned(c) {
+                    return None;
+                }
+                Some(Region::Cylinder {
+                    base_center_m: if c > 0.0 {
+                        *base_center_m
+                    } else {
+                        base_center_m + up * h
+                    },
+                    axis: *axis,
+                    radius_m: *radius_m,
+                    length_m: length_m + h,
+                })
+            }
+        }
+    }
+
     /// Axis-aligned bounding box `(min, max)` in m.
     pub fn bounding_box(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::zeros();

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 
 /// Format version of the checkpoint file; bumped when the layout changes.
-pub const CHECKPOINT_FORMAT: u32 = 2;
+pub const CHECKPOINT_FORMAT: u32 = 3;
 
 static STOP: AtomicBool = AtomicBool::new(false);
 static STOPPABLE: AtomicBool = AtomicBool::new(false);

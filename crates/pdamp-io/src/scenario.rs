@@ -850,6 +850,82 @@ pub struct PlacementSpec {
     /// J (default: 1 % of m g r of the mean particle).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub round_kinetic_energy_per_particle_j: Option<f64>,
+    /// For `drop_down`: fill with the lid open and close it afterwards (D L3085, L3093), for
+    /// containers whose clearance to the lid is less than a diameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub open_lid: Option<OpenLidSpec>,
+}
+
+/// `placement.open_lid` of a `drop_down` group: the walls that end at the region's top are
+/// extended by `headroom_m` while the particles pour in; then the lid closes onto the bed at
+/// `close_speed_m_s`, pushing with at most the bed's weight, while the container is tapped
+/// along −g at `tap_frequency_hz` with Γ = `tap_intensity` where given
+/// ([`pdamp_dem::drop_down::OpenLid`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpenLidSpec {
+    /// How far the container is extended above its top while pouring, m.
+    pub headroom_m: f64,
+    /// Closing speed of the lid onto a bed that stands above the top, m/s (default 0.02).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub close_speed_m_s: Option<f64>,
+    /// Longest closing before the preparation gives up, s (default 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_close_duration_s: Option<f64>,
+    /// Tapping frequency while the lid closes, Hz (with `tap_intensity`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tap_frequency_hz: Option<f64>,
+    /// Tapping acceleration amplitude over g, Γ (with `tap_frequency_hz`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tap_intensity: Option<f64>,
+}
+
+impl OpenLidSpec {
+    /// Checks ranges; the message names the key under `key`.
+    fn validate(&self, key: &str) -> Result<(), String> {
+        let check = |name: &str, v: f64, hi: f64, unit: &str| {
+            if v.is_finite() && v > 0.0 && v <= hi {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{key}.open_lid.{name} must be in (0, {hi}] {unit}, got {v}"
+                ))
+            }
+        };
+        check("headroom_m", self.headroom_m, 100.0, "m")?;
+        if let Some(v) = self.close_speed_m_s {
+            check("close_speed_m_s", v, 100.0, "m/s")?;
+        }
+        if let Some(v) = self.max_close_duration_s {
+            check("max_close_duration_s", v, 1e3, "s")?;
+        }
+        match (self.tap_frequency_hz, self.tap_intensity) {
+            (Some(f), Some(i)) => {
+                check("tap_frequency_hz", f, 1e5, "Hz")?;
+                check("tap_intensity", i, 1e3, "(Γ = A/g)")
+            }
+            (None, None) => Ok(()),
+            _ => Err(format!(
+                "{key}.open_lid.tap_frequency_hz: give tap_frequency_hz and tap_intensity together (or neither)"
+            )),
+        }
+    }
+
+    /// The drop-down's settings.
+    pub fn to_open_lid(&self) -> pdamp_dem::drop_down::OpenLid {
+        pdamp_dem::drop_down::OpenLid {
+            headroom_m: self.headroom_m,
+            close_speed_m_s: self.close_speed_m_s.unwrap_or(0.02),
+            max_close_duration_s: self.max_close_duration_s.unwrap_or(2.0),
+            tapping: match (self.tap_frequency_hz, self.tap_intensity) {
+                (Some(frequency_hz), Some(intensity)) => Some(pdamp_dem::drop_down::Tapping {
+                    frequency_hz,
+                    intensity,
+                }),
+                _ => None,
+            },
+        }
+    }
 }
 
 impl PlacementSpec {
@@ -866,6 +942,7 @@ impl PlacementSpec {
             max_rounds: None,
             max_round_duration_s: None,
             round_kinetic_energy_per_particle_j: None,
+            open_lid: None,
         }
     }
 }
@@ -1141,11 +1218,15 @@ impl Scenario {
         if !is_drop
             && (pl.max_rounds.is_some()
                 || pl.max_round_duration_s.is_some()
-                || pl.round_kinetic_energy_per_particle_j.is_some())
+                || pl.round_kinetic_energy_per_particle_j.is_some()
+                || pl.open_lid.is_some())
         {
             return Err(format!(
-                "{key}.max_rounds: max_rounds, max_round_duration_s and round_kinetic_energy_per_particle_j belong to method = \"drop_down\""
+                "{key}.max_rounds: max_rounds, max_round_duration_s, round_kinetic_energy_per_particle_j and open_lid belong to method = \"drop_down\""
             ));
+        }
+        if let Some(l) = &pl.open_lid {
+            l.validate(&key)?;
         }
         if pl.max_rounds == Some(0) {
             return Err(format!("{key}.max_rounds must be >= 1"));
@@ -1993,6 +2074,7 @@ impl Scenario {
                 .unwrap_or(0.01 * m_mean * gravity.norm() * r_mean),
             max_round_duration_s: pl.max_round_duration_s.unwrap_or(0.5),
             max_rounds: pl.max_rounds.unwrap_or(200),
+            open_lid: pl.open_lid.as_ref().map(OpenLidSpec::to_open_lid),
         };
         let mut w = world.clone();
         w.gravity_m_s2 = gravity;

@@ -406,3 +406,124 @@ fn two_drop_down_groups_stack() {
         mean_z(1.75e-3)
     );
 }
+
+/// 58 spheres r = 5 mm in a 40 mm cube (D Sect. 8.1.1's cube: four diameters wide, n_max = 65,
+/// clearance to the lid less than a diameter; μ = 0.1 as D Tab. 8.1), filled along −z.
+fn cube58(placement: &str) -> String {
+    cube(placement, true)
+        .replace("count = 1000", "count = 58")
+        .replace("radius_m = 1.75e-3", "radius_m = 5e-3")
+        .replace("youngs_modulus_pa = 1e8", "youngs_modulus_pa = 1e9")
+        .replace("friction_coefficient = 0.3", "friction_coefficient = 0.1")
+}
+
+/// Filling with the lid open (D L3085, L3093): the closed-container drop-down cannot fill D's
+/// 58-sphere cube (each sphere must fit whole below the lid); poured into the container raised
+/// by 20 mm, the bed stands above the real top, and closing the lid while tapping (50 Hz,
+/// Γ = 2) presses it in. Every sphere ends inside the real cube, without overlap beyond contact
+/// deformation, the lid closed, the bed a random packing (not the 4 × 4 × 4 lattice).
+#[test]
+fn open_lid_fills_a_cube_with_less_than_a_diameter_of_clearance() {
+    let closed = Scenario::from_toml(&cube58(CUBE_DROP)).expect("parse");
+    closed.validate().expect("valid");
+    let Err(err) = prepare_bed(&closed, Path::new("."), &mut |_, _| {}) else {
+        panic!("the closed cube cannot be filled")
+    };
+    assert!(err.contains("drop-down placed only"), "{err}");
+
+    let open = format!(
+        "{}, open_lid = {{ headroom_m = 0.02, tap_frequency_hz = 50.0, tap_intensity = 2.0 }} }}",
+        CUBE_DROP.strip_suffix(" }").unwrap()
+    );
+    let sc = Scenario::from_toml(&cube58(&open)).expect("parse");
+    sc.validate().expect("valid");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("open-lid fill");
+    let report = &bed.drop_down[0];
+    eprintln!("open lid: {report:?}");
+    let p = &bed.world.particles;
+    assert_eq!(p.len(), 58);
+    let above = report.bed_top_above_lid_m.expect("open lid reported");
+    assert!(above > 0.0, "the poured bed stood above the top: {above}");
+    assert!(report.lid_closing_time_s > 0.0);
+    // Inside the real cube (the world has the container's own walls again).
+    let (pp, pw) = max_overlaps(&bed.world);
+    assert!(pp < 1e-2 && pw < 1e-2, "overlaps {pp} {pw}");
+    let top = (0..p.len())
+        .map(|i| p.position[i].z + p.radius[i])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(top <= 0.04 + 1e-2 * 5e-3, "highest top {top}");
+    // Not a lattice: the sphere heights do not fall on four levels.
+    let levels = (0..p.len())
+        .filter(|&i| {
+            let z = (p.position[i].z - 5e-3) / 1e-2;
+            (z - z.round()).abs() > 0.1
+        })
+        .count();
+    assert!(levels > 10, "{levels} spheres off the lattice levels");
+}
+
+/// Open lid on a cylinder whose axis points down (its base disc is the lid), the bed below the
+/// top after pouring: the lid closes at once; and the errors: a lid that is not a wall, and a
+/// bed that cannot be pressed in without tapping.
+#[test]
+fn open_lid_cylinder_and_errors() {
+    let can = |count: usize, open_lid: &str| {
+        cylinder_with_rod("drop_down")
+            .replace("count = 1000", &format!("count = {count}"))
+            .replace(
+                "base_center_m = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius_m = 0.02, length_m = 0.06 }}",
+                "base_center_m = [0.0, 0.0, 0.06], axis = [0.0, 0.0, -1.0], radius_m = 0.02, length_m = 0.06 }",
+            )
+            .replace(
+                "base_center_m = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius_m = 0.02, length_m = 0.06 } }",
+                &format!("base_center_m = [0.0, 0.0, 0.06], axis = [0.0, 0.0, -1.0], radius_m = 0.02, length_m = 0.06 }}{open_lid} }}"),
+            )
+    };
+    let text = can(300, ", open_lid = { headroom_m = 0.01 }");
+    assert!(text.contains("open_lid"), "{text}");
+    let sc = Scenario::from_toml(&text).expect("parse");
+    sc.validate().expect("valid");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("open-lid fill");
+    let report = &bed.drop_down[0];
+    assert!(report.bed_top_above_lid_m.unwrap() < 0.0, "{report:?}");
+    assert_eq!(bed.world.particles.len(), 300);
+    let (pp, pw) = max_overlaps(&bed.world);
+    assert!(pp < 1e-2 && pw < 1e-2, "overlaps {pp} {pw}");
+
+    // The region's top 5 mm below the can's: no wall ends there.
+    let low = can(300, ", open_lid = { headroom_m = 0.01 }").replace(
+        "base_center_m = [0.0, 0.0, 0.06], axis = [0.0, 0.0, -1.0], radius_m = 0.02, length_m = 0.06 }, open_lid",
+        "base_center_m = [0.0, 0.0, 0.055], axis = [0.0, 0.0, -1.0], radius_m = 0.02, length_m = 0.055 }, open_lid",
+    );
+    let sc = Scenario::from_toml(&low).expect("parse");
+    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
+        panic!("no lid wall")
+    };
+    assert!(err.contains("no wall ends at the region's top"), "{err}");
+
+    // Too many spheres to press in without tapping in 20 ms.
+    let full = can(
+        3000,
+        ", open_lid = { headroom_m = 0.03, max_close_duration_s = 0.02 }",
+    );
+    let sc = Scenario::from_toml(&full).expect("parse");
+    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
+        panic!("the lid cannot close")
+    };
+    assert!(
+        err.contains("the lid is still") && err.contains("held up by particle"),
+        "{err}"
+    );
+
+    // Keys belong to drop_down and are checked.
+    let bad = can(
+        300,
+        ", open_lid = { headroom_m = 0.01, tap_intensity = 2.0 }",
+    );
+    let err = Scenario::from_toml(&bad).unwrap().validate().unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("tap_frequency_hz and tap_intensity together"),
+        "{err}"
+    );
+}
