@@ -37,6 +37,15 @@ fn settle_writes_the_bed_and_its_fill_clearance() {
     assert!((h - (length - bed_length)).abs() < 1e-12);
     // 300 spheres of 2.5 mm in a 16 mm cylinder: a random packing leaves a few mm.
     assert!(h > 1e-3 && h < 1e-2, "h = {h}");
+    // The volumetric h of D Eq. 8.1 (to the mean surface), larger than the gap to the highest
+    // sphere by less than two diameters (a rough poured surface).
+    let h_surface = fill["clearance_to_surface_m"].as_f64().unwrap();
+    let height = fill["bed_height_m"].as_f64().unwrap();
+    assert!((h_surface - (length - height)).abs() < 1e-12);
+    assert!(
+        h_surface > h && h_surface - h < 5e-3,
+        "h to the surface {h_surface}, to the highest sphere {h}"
+    );
     let bulk = s["bed"]["packing_fraction_bulk"].as_f64().unwrap();
     assert!((0.55..0.66).contains(&bulk), "bulk packing fraction {bulk}");
     for f in [

@@ -14,7 +14,13 @@
 //! * **Coordination number** Z = 2 C / N with C the touching particle–particle pairs
 //!   (centre distance < r_i + r_j); `rattler_fraction` is the share without any contact.
 //! * **Clearance** along a direction e: the free length of the container on the line through the
-//!   bed's centroid along e, minus the bed's span along e.
+//!   bed's centroid along e, minus the bed's span along e (from the highest particle top: the
+//!   smallest gap). Where e lies along −g (a bed filled along the excitation, as D's cylinders
+//!   with the axis vertical), also **clearance to the surface**: the free length minus the bed
+//!   height (bottom to the mean surface), the volumetric gap of D Eq. 8.1
+//!   h = L (1 − n_p/n_p^max) — the cap set at h above the mark the bed was poured to (D L3093)
+//!   and the h of X_opt = h/π (D Eq. 8.2). A poured surface is rough: the two differ by about a
+//!   diameter (D L3091 finds h_min ≈ r "due to the irregular surface of the particle bed").
 
 use crate::generate::{CellGrid, orthonormal_frame};
 use crate::math::Vec3;
@@ -62,8 +68,12 @@ pub struct BedStatistics {
     pub bed_span_along_direction_m: Option<[f64; 2]>,
     /// Free length of the container through the bed's centroid along the direction, m.
     pub container_length_along_direction_m: Option<f64>,
-    /// Clearance h = free length − bed span along the direction [D Eq. 8.1], m.
+    /// Clearance h = free length − bed span along the direction (from the highest particle), m.
     pub clearance_m: Option<f64>,
+    /// Clearance to the bed's mean surface, free length − bed height, where the direction lies
+    /// along −g [D Eq. 8.1], m (module docs).
+    #[serde(default)]
+    pub clearance_to_surface_m: Option<f64>,
 }
 
 /// Statistics of the bed of `world` (bodies at their current poses, at rest; gravity gives
@@ -101,6 +111,7 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
         bed_span_along_direction_m: None,
         container_length_along_direction_m: None,
         clearance_m: None,
+        clearance_to_surface_m: None,
     };
     if n == 0 {
         return s;
@@ -254,6 +265,9 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
         s.bed_span_along_direction_m = Some([s_lo, s_hi]);
         s.container_length_along_direction_m = Some(length);
         s.clearance_m = Some(length - (s_hi - s_lo));
+        if e.dot(&up).abs() > 1.0 - 1e-6 {
+            s.clearance_to_surface_m = Some(length - s.bed_height_m);
+        }
     }
     s
 }

@@ -35,10 +35,12 @@
 use crate::generate::{CellGrid, Region, orthonormal_frame};
 use crate::math::Vec3;
 use crate::walls::{Geometry, Plane};
-use crate::{BodyState, HarmonicTranslation, Motion, RigidBody, World};
+use crate::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, World};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::ops::ControlFlow;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Settings of a drop-down.
 #[derive(Debug, Clone, PartialEq)]
@@ -408,8 +410,9 @@ struct OpenContainer {
     containers: Vec<usize>,
 }
 
-/// Extends every wall of `w` that ends at the top of `region` along `up` by `headroom_m` and adds
-/// a temporary lid plane at the raised top (a driven body of the first such wall's material).
+/// Extends every wall of `w` that closes the container between the top of `region` along `up`
+/// and `headroom_m` above it to the raised top ([`raised_top`]) and adds a temporary lid plane
+/// there (a driven body of the first such wall's material).
 fn open_container(
     w: &mut World,
     region: &Region,
@@ -452,7 +455,7 @@ fn open_container(
     let lid = RigidBody::new(
         "open-lid fill: lid",
         BodyState::at_rest(Vec3::zeros()),
-        Motion::Driven,
+        Motion::Fixed,
     )
     .with_wall(
         "lid",
@@ -469,11 +472,12 @@ fn open_container(
     })
 }
 
-/// The geometry `g` of a body at `pose` extended by `h` beyond its face at `top` along `up`
-/// (world frame): the top face of a `box_inside` with an edge along `up`, the top disc of a
-/// `cylinder_inside` with its axis along `up`, the top end of an inner rod (`cylinder_outside`)
-/// along `up` that reaches the lid, a one-sided plane facing down; `None` for any other wall or
-/// a face elsewhere.
+/// The geometry `g` of a body at `pose` extended to `top + h` along `up` (world frame) if one
+/// of its faces closes the container between `top` and `top + h` (a `box_inside` cover, the
+/// cap wall of a coated container a little behind its coating): the top face of a `box_inside`
+/// with an edge along `up`, the top disc of a `cylinder_inside` with its axis along `up`, the
+/// top end of an inner rod (`cylinder_outside`) along `up`, a one-sided plane facing down;
+/// `None` for any other wall or a face elsewhere.
 fn raised_top(
     g: &Geometry,
     pose: &BodyState,
@@ -485,17 +489,17 @@ fn raised_top(
     let up_b = pose.orientation.inverse_transform_vector(up);
     let top_b = top - pose.position_m.dot(up);
     let aligned = |c: f64| c.abs() > 1.0 - 1e-9;
+    // How far a face at `face` moves: up to `top + h`, if it closes the container there.
+    let lift =
+        |face: f64| (face >= top_b - tolerance && face < top_b + h).then(|| top_b + h - face);
     match g {
         Geometry::BoxInside(b) => {
             let k = (0..3).find(|&k| aligned(up_b[k]))?;
             let sign = up_b[k].signum();
-            let face = b.center_m[k] * sign + b.half_extents_m[k];
-            if (face - top_b).abs() > tolerance {
-                return None;
-            }
+            let d = lift(b.center_m[k] * sign + b.half_extents_m[k])?;
             let mut raised = b.clone();
-            raised.center_m[k] += sign * 0.5 * h;
-            raised.half_extents_m[k] += 0.5 * h;
+            raised.center_m[k] += sign * 0.5 * d;
+            raised.half_extents_m[k] += 0.5 * d;
             Some(Geometry::BoxInside(raised))
         }
         Geometry::CylinderInside(c) => {
@@ -504,15 +508,12 @@ fn raised_top(
                 return None;
             }
             let base = c.base_center_m.dot(&up_b);
-            let face = if a > 0.0 { base + c.length_m } else { base };
-            if (face - top_b).abs() > tolerance {
-                return None;
-            }
+            let d = lift(if a > 0.0 { base + c.length_m } else { base })?;
             let mut raised = c.clone();
             if a < 0.0 {
-                raised.base_center_m += up_b * h;
+                raised.base_center_m += up_b * d;
             }
-            raised.length_m += h;
+            raised.length_m += d;
             Some(Geometry::CylinderInside(raised))
         }
         Geometry::CylinderOutside(c) => {
@@ -522,26 +523,45 @@ fn raised_top(
                 return None;
             }
             let base = c.base_center_m.dot(&up_b);
-            let face = if a > 0.0 { base + c.length_m } else { base };
-            if (face - top_b).abs() > tolerance {
-                return None;
-            }
+            let d = lift(if a > 0.0 { base + c.length_m } else { base })?;
             let mut raised = c.clone();
             if a < 0.0 {
-                raised.base_center_m += up_b * h;
+                raised.base_center_m += up_b * d;
             }
-            raised.length_m += h;
+            raised.length_m += d;
             Some(Geometry::CylinderOutside(raised))
         }
         Geometry::Plane(p) if !p.two_sided && p.normal.dot(&up_b) < -(1.0 - 1e-9) => {
-            if (p.point_m.dot(&up_b) - top_b).abs() > tolerance {
-                return None;
-            }
+            let d = lift(p.point_m.dot(&up_b))?;
             let mut raised = p.clone();
-            raised.point_m += up_b * h;
+            raised.point_m += up_b * d;
             Some(Geometry::Plane(raised))
         }
         _ => None,
+    }
+}
+
+/// Motion of the temporary lid: `offset_m` (f64 bits, set by [`close_lid`] between steps) along
+/// `up` from its raised place, plus the tapping `(ω, amplitude, start)` of the container.
+#[derive(Debug)]
+struct LidMotion {
+    up: Vec3,
+    offset_m: Arc<AtomicU64>,
+    tap: Option<(f64, f64, f64)>,
+}
+
+impl PrescribedMotion for LidMotion {
+    fn offset(&self, t_s: f64) -> BodyState {
+        let (shake, shake_v) = self.tap.map_or((0.0, 0.0), |(omega, a, t0)| {
+            let arg = omega * (t_s - t0);
+            (a * arg.sin(), a * omega * arg.cos())
+        });
+        BodyState {
+            position_m: self.up * (f64::from_bits(self.offset_m.load(Ordering::Relaxed)) + shake),
+            orientation: crate::math::Rotation::identity(),
+            velocity_m_s: self.up * shake_v,
+            angular_velocity_rad_s: Vec3::zeros(),
+        }
     }
 }
 
@@ -595,10 +615,18 @@ fn close_lid(
         }
         Ok(())
     };
+    // The lid follows `level` (shared with its motion law) and the tapping of the container, so
+    // that its step velocity matches its displacement (the energy ledger books its work).
+    let lid_level = Arc::new(AtomicU64::new((level - o.raised_m).to_bits()));
+    w.bodies[o.lid_body].motion = Motion::Prescribed(Arc::new(LidMotion {
+        up: *up,
+        offset_m: lid_level.clone(),
+        tap: tap.map(|(omega, a, _)| (omega, a, t0)),
+    }));
     if level > o.top_m {
         if let Some((omega, amplitude_m, _)) = tap {
             for &b in &o.containers {
-                w.bodies[b].motion = Motion::Prescribed(std::sync::Arc::new(HarmonicTranslation {
+                w.bodies[b].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
                     direction: [up.x, up.y, up.z],
                     amplitude_m,
                     frequency_hz: omega / (2.0 * std::f64::consts::PI),
@@ -608,9 +636,7 @@ fn close_lid(
         }
         let mut end_s = f64::INFINITY;
         while w.time_s < end_s - 0.5 * w.dt_s {
-            let t1 = w.time_s + w.dt_s;
-            let shake = tap.map_or(0.0, |(omega, a, _)| a * (omega * (t1 - t0)).sin());
-            w.bodies[o.lid_body].state.position_m = up * (level - o.raised_m + shake);
+            lid_level.store((level - o.raised_m).to_bits(), Ordering::Relaxed);
             w.step();
             steps += 1;
             check(w, steps, hook)?;
@@ -642,7 +668,11 @@ fn close_lid(
         }
     }
     // The lid in its place; the bed falls calm under it.
-    w.bodies[o.lid_body].state.position_m = up * (o.top_m - o.raised_m);
+    w.bodies[o.lid_body].motion = Motion::Prescribed(Arc::new(LidMotion {
+        up: *up,
+        offset_m: Arc::new(AtomicU64::new((o.top_m - o.raised_m).to_bits())),
+        tap: None,
+    }));
     let t_calm = w.time_s;
     let n = w.particles.len().max(1) as f64;
     loop {

@@ -233,12 +233,16 @@ impl Damper {
     }
 
     /// The clearance h of D Eq. 8.1/8.2 along the excitation: of the bed as filled when it was
-    /// turned afterwards, else of the settled bed, m.
+    /// turned afterwards, else of the settled bed; to the bed's mean surface where the bed lies
+    /// along the excitation (the volumetric h of D Eq. 8.1), else to its highest particle, m.
     pub fn clearance_m(&self) -> Option<f64> {
+        let h = |s: &pdamp_dem::bed_statistics::BedStatistics| {
+            s.clearance_to_surface_m.or(s.clearance_m)
+        };
         self.fill_statistics
             .as_ref()
-            .and_then(|s| s.clearance_m)
-            .or_else(|| self.bed_statistics().clearance_m)
+            .and_then(h)
+            .or_else(|| h(&self.bed_statistics()))
     }
 
     /// Statistics of the settled bed, with the clearance along the excitation direction.
