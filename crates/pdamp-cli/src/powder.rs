@@ -36,6 +36,11 @@ enum PowderAction {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Run on K independently prepared powder beds (seeds seed + 1 000 003 k) in
+        /// DIR/packing_KKK/ and write DIR/ensemble.json (mean, std and 95 % CI of ζ1, ζ2, ζ̄5)
+        /// and DIR/table.csv; resumable.
+        #[arg(long, default_value_t = 1)]
+        packings: usize,
         #[command(flatten)]
         ck: CheckpointArgs,
     },
@@ -53,6 +58,11 @@ enum PowderAction {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+        /// Run every value on K independently prepared powder beds (DIR/<param>_<value>/
+        /// packing_KKK/); DIR/ensemble.csv gets the mean, std and 95 % CI of ζ1, ζ2, ζ̄5 per
+        /// value.
+        #[arg(long, default_value_t = 1)]
+        packings: usize,
         #[command(flatten)]
         ck: CheckpointArgs,
     },
@@ -84,7 +94,7 @@ struct CheckpointArgs {
 }
 
 /// What `pdamp powder run` and `study` write (checked for links and inputs).
-const OUTPUTS: [&str; 14] = [
+const OUTPUTS: [&str; 16] = [
     "particles.pvd",
     "vtk",
     "tip.csv",
@@ -94,6 +104,8 @@ const OUTPUTS: [&str; 14] = [
     "tip.png",
     "tip.svg",
     "table.csv",
+    "ensemble.json",
+    "ensemble.csv",
     "decay.png",
     "envelope.png",
     "checkpoint.bin",
@@ -131,7 +143,39 @@ pub fn run(args: PowderArgs) -> Result<()> {
     let bar = crate::progress::Progress::new();
     let mut progress = |stage: &str, f: f64| bar.set(stage, f);
     match args.action {
-        PowderAction::Run { scenario, out, ck } => {
+        PowderAction::Run {
+            scenario,
+            out,
+            packings,
+            ck,
+        } if packings != 1 => {
+            let sc = load(&scenario)?;
+            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
+            let options = ck.options()?;
+            // An ensemble continues its finished packings (each checked against its scenario).
+            let mut dir = pdamp_io::output_dir::OutputDir::open(
+                &out,
+                if ck.overwrite {
+                    pdamp_io::output_dir::OutputMode::Overwrite
+                } else {
+                    pdamp_io::output_dir::OutputMode::Continue
+                },
+                &OUTPUTS,
+                &[scenario.as_path()],
+            )?;
+            let e = study::run_ensemble(&sc, packings, &out, options, &mut progress)
+                .map_err(|e| anyhow!(e))
+                .and_then(|r| traced.write(&out).map(|()| r));
+            dir.set_outcome(&e);
+            dir.close()?;
+            let e = e?;
+            bar.finish();
+            println!("{}", serde_json::to_string_pretty(&e)?);
+            eprintln!("wrote {}", out.join("ensemble.json").display());
+        }
+        PowderAction::Run {
+            scenario, out, ck, ..
+        } => {
             let sc = load(&scenario)?;
             let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
             let options = ck.options()?;
@@ -158,6 +202,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             parameter,
             values,
             out,
+            packings,
             ck,
         } => {
             let sc = load(&scenario)?;
@@ -183,9 +228,10 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 &OUTPUTS,
                 &[scenario.as_path()],
             )?;
-            let rows = study::run_study(&sc, p, &values, &out, options, &mut progress)
-                .map_err(|e| anyhow!(e))
-                .and_then(|r| traced.write(&out).map(|()| r));
+            let rows =
+                study::run_study_packings(&sc, p, &values, packings, &out, options, &mut progress)
+                    .map_err(|e| anyhow!(e))
+                    .and_then(|r| traced.write(&out).map(|()| r));
             dir.set_outcome(&rows);
             dir.close()?;
             let rows = rows?;

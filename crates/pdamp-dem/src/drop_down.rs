@@ -491,7 +491,7 @@ fn raised_top(
     let aligned = |c: f64| c.abs() > 1.0 - 1e-9;
     // How far a face at `face` moves: up to `top + h`, if it closes the container there.
     let lift =
-        |face: f64| (face >= top_b - tolerance && face < top_b + h).then(|| top_b + h - face);
+        |face: f64| (face >= top_b - tolerance && face < top_b + h).then_some(top_b + h - face);
     match g {
         Geometry::BoxInside(b) => {
             let k = (0..3).find(|&k| aligned(up_b[k]))?;

@@ -9,11 +9,21 @@
 //! scenario is refused before anything runs ([`StudyError::ForeignRun`]). Each run
 //! checkpoints into `<dir>/checkpoint.bin` and, with `resume`, an interrupted run continues
 //! from its checkpoint ([`cantilever::run_in_dir`]).
+//!
+//! **Ensembles** (`packings` > 1): a powder bed is one random packing, and a chaotic granular
+//! damper gives another decay on every packing, so a damping ratio is reported as the mean
+//! over K independently prepared beds with its 95 % confidence interval (Student's t,
+//! [`pdamp_design::ensemble::EnsembleStat`]). Packing k is prepared with the seed
+//! [`pdamp_io::prepare::packing_seed`]`(seed, k)` (packing 0 is the scenario's own seed) and
+//! runs in `packing_KKK/` ([`run_ensemble`]; in a study, below each value's folder), resumable
+//! like every run.
 
 use std::path::{Path, PathBuf};
 
 use crate::cantilever::{self, CantileverScenario};
 use crate::damping;
+use pdamp_design::ensemble::EnsembleStat;
+use serde::Serialize;
 
 /// The varied parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,6 +119,8 @@ impl StudyParameter {
 pub struct StudyRow {
     /// Parameter value.
     pub value: f64,
+    /// Packing (0 without an ensemble).
+    pub packing: usize,
     /// Table-1 ratios.
     pub damping: damping::TableOneRatios,
     /// Particles.
@@ -125,9 +137,10 @@ pub struct StudyRow {
 
 impl StudyRow {
     /// The row of a finished run.
-    fn of(value: f64, r: &cantilever::CantileverResult) -> Self {
+    fn of(value: f64, packing: usize, r: &cantilever::CantileverResult) -> Self {
         StudyRow {
             value,
+            packing,
             damping: r.damping,
             particles: r.particles,
             prep: r.prep.clone(),
@@ -157,13 +170,14 @@ pub const TABLE_COLUMNS: [&str; 15] = [
     "wall_time_s",
 ];
 
-/// One line of `table.csv`: the parameter value, then [`TABLE_COLUMNS`].
-fn table_line(r: &StudyRow) -> [f64; 16] {
+/// One line of `table.csv`: the parameter value (or, in an ensemble, the packing), then
+/// [`TABLE_COLUMNS`].
+fn table_line(first: f64, r: &StudyRow) -> [f64; 16] {
     let nan = f64::NAN;
     let prep = r.prep.as_ref();
     let prep_wall = prep.map_or(0.0, |p| p.wall_time_s);
     [
-        r.value,
+        first,
         r.damping.zeta_1.unwrap_or(nan),
         r.damping.zeta_2.unwrap_or(nan),
         r.damping.zeta_5.unwrap_or(nan),
@@ -292,6 +306,208 @@ fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), String> {
     ))
 }
 
+/// The scenario of packing `k`: the powder prepared with [`pdamp_io::prepare::packing_seed`].
+pub fn with_packing(base: &CantileverScenario, k: usize) -> Result<CantileverScenario, String> {
+    let mut s = base.clone();
+    let p = s
+        .powder
+        .as_mut()
+        .ok_or("packings: an ensemble needs a [powder] section (the empty beam has no bed)")?;
+    p.prep.seed = pdamp_io::prepare::packing_seed(p.prep.seed, k);
+    Ok(s)
+}
+
+/// Folder of packing `k` below an ensemble's directory.
+pub fn packing_dir(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("packing_{k:03}"))
+}
+
+/// Mean, spread and 95 % confidence interval of the Table-1 ratios and the packing density
+/// over the members of an ensemble.
+#[derive(Debug, Clone, Serialize)]
+pub struct PowderEnsemble {
+    /// Number of packings K.
+    pub packings: usize,
+    /// Preparation seed of every packing.
+    pub seeds: Vec<u64>,
+    /// ζ1 over the packings.
+    pub zeta_1: EnsembleStat,
+    /// ζ2 over the packings.
+    pub zeta_2: EnsembleStat,
+    /// ζ̄5 over the packings.
+    pub zeta_5: EnsembleStat,
+    /// Settled packing density of the preparations.
+    pub settled_packing_density: EnsembleStat,
+    /// Final packing density of the preparations.
+    pub packing_density: EnsembleStat,
+    /// Every member, in packing order.
+    pub members: Vec<StudyRow>,
+}
+
+impl PowderEnsemble {
+    /// The statistics of `members` (packing order).
+    pub fn of(members: Vec<StudyRow>, seeds: Vec<u64>) -> Self {
+        let stat = |f: &dyn Fn(&StudyRow) -> Option<f64>| {
+            EnsembleStat::of(
+                &members
+                    .iter()
+                    .map(|r| f(r).unwrap_or(f64::NAN))
+                    .collect::<Vec<_>>(),
+            )
+        };
+        PowderEnsemble {
+            packings: members.len(),
+            seeds,
+            zeta_1: stat(&|r| r.damping.zeta_1),
+            zeta_2: stat(&|r| r.damping.zeta_2),
+            zeta_5: stat(&|r| r.damping.zeta_5),
+            settled_packing_density: stat(&|r| r.prep.as_ref().map(|p| p.settled_packing_density)),
+            packing_density: stat(&|r| r.prep.as_ref().map(|p| p.packing_density)),
+            members,
+        }
+    }
+}
+
+/// Columns of `ensemble.csv` of a study with packings: per value, K and for ζ1, ζ2, ζ̄5 the
+/// mean, the standard deviation and the 95 % CI half-width.
+pub const ENSEMBLE_COLUMNS: [&str; 10] = [
+    "packings",
+    "zeta_1_mean",
+    "zeta_1_std",
+    "zeta_1_ci95_half_width",
+    "zeta_2_mean",
+    "zeta_2_std",
+    "zeta_2_ci95_half_width",
+    "zeta_5_mean",
+    "zeta_5_std",
+    "zeta_5_ci95_half_width",
+];
+
+fn ensemble_line(value: f64, e: &PowderEnsemble) -> [f64; 11] {
+    let s = |x: &EnsembleStat| [x.mean, x.std, x.ci95_half_width];
+    let (a, b, c) = (s(&e.zeta_1), s(&e.zeta_2), s(&e.zeta_5));
+    [
+        value,
+        e.packings as f64,
+        a[0],
+        a[1],
+        a[2],
+        b[0],
+        b[1],
+        b[2],
+        c[0],
+        c[1],
+        c[2],
+    ]
+}
+
+/// One planned run: scenario, folder, whether it has finished, its label.
+struct PlannedRun {
+    value: f64,
+    packing: usize,
+    scenario: CantileverScenario,
+    dir: PathBuf,
+    finished: bool,
+    label: String,
+}
+
+/// Checks `dir` against `sc` ([`check_run_dir`]).
+fn plan_run(
+    value: f64,
+    packing: usize,
+    sc: CantileverScenario,
+    dir: PathBuf,
+    label: String,
+) -> Result<PlannedRun, String> {
+    let digest = cantilever::scenario_digest(&sc)?;
+    let finished = check_run_dir(&dir, &digest).map_err(|e| e.to_string())?;
+    Ok(PlannedRun {
+        value,
+        packing,
+        scenario: sc,
+        dir,
+        finished,
+        label,
+    })
+}
+
+/// Runs (or reads back, when finished) the planned runs in order; returns their tip histories
+/// and rows, and draws them into the decay and envelope plots of `out`.
+fn run_planned(
+    plan: Vec<PlannedRun>,
+    out: &Path,
+    options: cantilever::RunOptions,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<Vec<StudyRow>, String> {
+    if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
+        return Err(format!(
+            "--checkpoint-interval-s: must be finite and ≥ 0, got {}",
+            options.checkpoint_interval_s
+        ));
+    }
+    let mut rows = Vec::new();
+    let mut decay = pdamp_plot::LinePlot::new(
+        pdamp_plot::Axis::linear("time (ms)"),
+        pdamp_plot::Axis::linear("tip displacement x (mm)"),
+    );
+    let mut env = pdamp_plot::LinePlot::new(
+        pdamp_plot::Axis::linear("time (ms)"),
+        pdamp_plot::Axis::linear("peak |x| (mm)"),
+    );
+    let n = plan.len();
+    for (q, run) in plan.into_iter().enumerate() {
+        let sc = &run.scenario;
+        let t_rel = sc.load.rise_s + sc.load.hold_s;
+        let (t, x, row) = if run.finished {
+            let (t, x) = read_tip(&run.dir)?;
+            let js: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(run.dir.join("summary.json"))
+                    .map_err(|e| e.to_string())?,
+            )
+            .map_err(|e| e.to_string())?;
+            let res = &js["result"];
+            let f = |k: &str| res[k].as_f64().unwrap_or(f64::NAN);
+            let prep: Option<crate::prep::PrepReport> =
+                serde_json::from_value(res["prep"].clone()).unwrap_or(None);
+            let row = StudyRow {
+                value: run.value,
+                packing: run.packing,
+                damping: damping::table_one(&t, &x, t_rel),
+                particles: res["particles"].as_u64().unwrap_or(0) as usize,
+                energy_closure: f("energy_closure"),
+                mean_iterations: f("mean_iterations"),
+                wall_time_s: f("wall_time_s") + prep.as_ref().map_or(0.0, |p| p.wall_time_s),
+                prep,
+            };
+            (t, x, row)
+        } else {
+            // the stage names the run; the fraction is the stage's own (stages restart at 0)
+            let mut prog = |stage: &str, f: f64| {
+                let label = format!("run {}/{n} ({}): {stage}", q + 1, run.label);
+                progress(&label, f)
+            };
+            let r = cantilever::run_in_dir(sc, &run.dir, options, &mut prog)?;
+            let row = StudyRow::of(run.value, run.packing, &r);
+            (r.time_s, r.tip_m, row)
+        };
+        decay.series.push(pdamp_plot::Series::new(
+            run.label.clone(),
+            t.iter().map(|s| s * 1e3).collect(),
+            x.iter().map(|s| s * 1e3).collect(),
+        ));
+        let ext = damping::local_extrema(&t, &x, t_rel);
+        env.series.push(pdamp_plot::Series::new(
+            run.label,
+            ext.iter().map(|&i| t[i] * 1e3).collect(),
+            ext.iter().map(|&i| x[i].abs() * 1e3).collect(),
+        ));
+        rows.push(row);
+    }
+    pdamp_plot::line_plot(out.join("decay"), &decay).map_err(|e| e.to_string())?;
+    pdamp_plot::line_plot(out.join("envelope"), &env).map_err(|e| e.to_string())?;
+    Ok(rows)
+}
+
 /// Runs the study into `out` and returns the table; `options` are passed to every run that
 /// is not finished yet (checkpoint interval; `resume` continues an interrupted run from its
 /// checkpoint).
@@ -303,85 +519,127 @@ pub fn run_study(
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<Vec<StudyRow>, String> {
-    let mut rows = Vec::new();
-    let mut decay = pdamp_plot::LinePlot::new(
-        pdamp_plot::Axis::linear("time (ms)"),
-        pdamp_plot::Axis::linear("tip displacement x (mm)"),
-    );
-    let mut env = pdamp_plot::LinePlot::new(
-        pdamp_plot::Axis::linear("time (ms)"),
-        pdamp_plot::Axis::linear("peak |x| (mm)"),
-    );
+    run_study_packings(base, param, values, 1, out, options, progress)
+}
+
+/// [`run_study`] on `packings` beds per value (module docs): with `packings` > 1 each value's
+/// folder holds `packing_KKK/`, `table.csv` has a `packing` column after the value, and
+/// `ensemble.csv` ([`ENSEMBLE_COLUMNS`]) the mean and 95 % CI of ζ1, ζ2, ζ̄5 per value.
+pub fn run_study_packings(
+    base: &CantileverScenario,
+    param: StudyParameter,
+    values: &[f64],
+    packings: usize,
+    out: &Path,
+    options: cantilever::RunOptions,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<Vec<StudyRow>, String> {
     // every value is validated and every existing run directory checked before any run
     if values.is_empty() {
         return Err("--values: give at least one value".into());
     }
-    if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
-        return Err(format!(
-            "--checkpoint-interval-s: must be finite and ≥ 0, got {}",
-            options.checkpoint_interval_s
-        ));
+    if packings == 0 {
+        return Err("--packings must be at least 1".into());
     }
-    let mut plan = Vec::with_capacity(values.len());
+    let mut plan = Vec::with_capacity(values.len() * packings);
     for &v in values {
         let sc = param.apply(base, v)?;
         let dir = out.join(format!("{}_{}", param.name(), v));
-        let digest = cantilever::scenario_digest(&sc)?;
-        let finished = check_run_dir(&dir, &digest).map_err(|e| e.to_string())?;
-        plan.push((v, sc, dir, finished));
-    }
-    for (q, (v, sc, dir, finished)) in plan.into_iter().enumerate() {
-        let t_rel = sc.load.rise_s + sc.load.hold_s;
-        let (t, x, row) = if finished {
-            let (t, x) = read_tip(&dir)?;
-            let js: serde_json::Value = serde_json::from_str(
-                &std::fs::read_to_string(dir.join("summary.json")).map_err(|e| e.to_string())?,
-            )
-            .map_err(|e| e.to_string())?;
-            let res = &js["result"];
-            let f = |k: &str| res[k].as_f64().unwrap_or(f64::NAN);
-            let prep: Option<crate::prep::PrepReport> =
-                serde_json::from_value(res["prep"].clone()).unwrap_or(None);
-            let row = StudyRow {
-                value: v,
-                damping: damping::table_one(&t, &x, t_rel),
-                particles: res["particles"].as_u64().unwrap_or(0) as usize,
-                energy_closure: f("energy_closure"),
-                mean_iterations: f("mean_iterations"),
-                wall_time_s: f("wall_time_s") + prep.as_ref().map_or(0.0, |p| p.wall_time_s),
-                prep,
-            };
-            (t, x, row)
-        } else {
-            // the stage names the run; the fraction is the stage's own (stages restart at 0)
-            let n = values.len();
-            let mut prog = |stage: &str, f: f64| {
-                let label = format!("run {}/{n} ({} = {v}): {stage}", q + 1, param.name());
-                progress(&label, f)
-            };
-            let r = cantilever::run_in_dir(&sc, &dir, options, &mut prog)?;
-            let row = StudyRow::of(v, &r);
-            (r.time_s, r.tip_m, row)
-        };
         let label = format!("{} = {v}", param.name());
-        decay.series.push(pdamp_plot::Series::new(
-            label.clone(),
-            t.iter().map(|s| s * 1e3).collect(),
-            x.iter().map(|s| s * 1e3).collect(),
-        ));
-        let ext = damping::local_extrema(&t, &x, t_rel);
-        env.series.push(pdamp_plot::Series::new(
-            label,
-            ext.iter().map(|&i| t[i] * 1e3).collect(),
-            ext.iter().map(|&i| x[i].abs() * 1e3).collect(),
-        ));
-        rows.push(row);
+        if packings == 1 {
+            plan.push(plan_run(v, 0, sc, dir, label)?);
+        } else {
+            for k in 0..packings {
+                plan.push(plan_run(
+                    v,
+                    k,
+                    with_packing(&sc, k)?,
+                    packing_dir(&dir, k),
+                    format!("{label}, packing {k}"),
+                )?);
+            }
+        }
     }
+    let rows = run_planned(plan, out, options, progress)?;
     let mut header = vec![param.name()];
+    if packings > 1 {
+        header.push("packing");
+    }
     header.extend(TABLE_COLUMNS);
-    pdamp_io::csv::write_csv_atomic(out.join("table.csv"), &header, rows.iter().map(table_line))
+    let lines = rows.iter().map(|r| {
+        let line = table_line(r.value, r);
+        if packings > 1 {
+            let mut l = vec![r.value, r.packing as f64];
+            l.extend_from_slice(&line[1..]);
+            l
+        } else {
+            line.to_vec()
+        }
+    });
+    pdamp_io::csv::write_csv_atomic(out.join("table.csv"), &header, lines)
         .map_err(|e| e.to_string())?;
-    pdamp_plot::line_plot(out.join("decay"), &decay).map_err(|e| e.to_string())?;
-    pdamp_plot::line_plot(out.join("envelope"), &env).map_err(|e| e.to_string())?;
+    if packings > 1 {
+        let mut header = vec![param.name()];
+        header.extend(ENSEMBLE_COLUMNS);
+        let lines: Vec<[f64; 11]> = rows
+            .chunks(packings)
+            .map(|c| {
+                let seeds = (0..packings)
+                    .map(|k| with_packing(base, k).map_or(0, |s| seed_of(&s)))
+                    .collect();
+                ensemble_line(c[0].value, &PowderEnsemble::of(c.to_vec(), seeds))
+            })
+            .collect();
+        pdamp_io::csv::write_csv_atomic(out.join("ensemble.csv"), &header, lines)
+            .map_err(|e| e.to_string())?;
+    }
     Ok(rows)
+}
+
+fn seed_of(sc: &CantileverScenario) -> u64 {
+    sc.powder.as_ref().map_or(0, |p| p.prep.seed)
+}
+
+/// `pdamp powder run --packings K`: the scenario on K independently prepared beds in
+/// `out/packing_KKK/` (module docs); writes `table.csv` (`packing` and [`TABLE_COLUMNS`]),
+/// `ensemble.json` ([`PowderEnsemble`]), `decay` and `envelope` plots. Resumable.
+pub fn run_ensemble(
+    base: &CantileverScenario,
+    packings: usize,
+    out: &Path,
+    options: cantilever::RunOptions,
+    progress: &mut dyn FnMut(&str, f64),
+) -> Result<PowderEnsemble, String> {
+    if packings < 2 {
+        return Err(format!(
+            "--packings: an ensemble needs at least 2 packings, got {packings}"
+        ));
+    }
+    let mut plan = Vec::with_capacity(packings);
+    let mut seeds = Vec::with_capacity(packings);
+    for k in 0..packings {
+        let sc = with_packing(base, k)?;
+        seeds.push(seed_of(&sc));
+        plan.push(plan_run(
+            k as f64,
+            k,
+            sc,
+            packing_dir(out, k),
+            format!("packing {k}"),
+        )?);
+    }
+    let rows = run_planned(plan, out, options, progress)?;
+    let mut header = vec!["packing"];
+    header.extend(TABLE_COLUMNS);
+    pdamp_io::csv::write_csv_atomic(
+        out.join("table.csv"),
+        &header,
+        rows.iter().map(|r| table_line(r.packing as f64, r)),
+    )
+    .map_err(|e| e.to_string())?;
+    let e = PowderEnsemble::of(rows, seeds);
+    let json = serde_json::to_string_pretty(&e).map_err(|e| e.to_string())?;
+    pdamp_io::atomic::write_atomic(out.join("ensemble.json"), json.as_bytes())
+        .map_err(|e| e.to_string())?;
+    Ok(e)
 }
