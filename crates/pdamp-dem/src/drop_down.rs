@@ -15,6 +15,10 @@
 //! time limit is reached. A dense fill thus pours in like a real filling; a bed that fits the
 //! region in one random insertion needs one round.
 //!
+//! **Pouring from an inlet** ([`Inlet`], D Fig. 2.2c's "inlet" insertion): instead of rounds,
+//! the particles enter through an inlet region at a given rate while the world runs, and pile
+//! up below it.
+//!
 //! **Filling with the lid open** ([`OpenLid`]; D L3085 "particles are filled into the container
 //! from its top and the container's top cover plate is secured", L3093 "particles are poured up
 //! to a marking … then the container cap is adjusted"): a container whose clearance to the lid is
@@ -60,6 +64,23 @@ pub struct DropDownSpec {
     /// Fill with the lid open and close it afterwards (see the module docs); `None`: fill
     /// through the closed container.
     pub open_lid: Option<OpenLid>,
+    /// Pour from an inlet over time instead of inserting in rounds (see [`Inlet`]).
+    pub inlet: Option<Inlet>,
+}
+
+/// Pouring from an inlet (a funnel, a filling tube): the particles are inserted at random into
+/// the inlet region at `rate_per_s` with the velocity `velocity_m_s` while the world runs, and
+/// pile up below it, like a real filling; a particle that finds no free place in the inlet
+/// waits for the next insertion. When the pile has reached the inlet and nothing has gone in
+/// for 0.1 s (at least ten insertion intervals), the pour stops with [`DropDownError::InletBlocked`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inlet {
+    /// The inlet region (inside the container, above the bed), m.
+    pub region: Region,
+    /// Particles inserted per second of simulated time.
+    pub rate_per_s: f64,
+    /// Velocity of the inserted particles, m/s.
+    pub velocity_m_s: Vec3,
 }
 
 /// Filling with the lid open, then closing it (D L3085, L3093; module docs).
@@ -102,6 +123,9 @@ pub struct DropDownReport {
     /// Filling with the lid open: simulated time of closing the lid (incl. tapping), s.
     #[serde(default)]
     pub lid_closing_time_s: f64,
+    /// Pouring from an inlet: simulated time until the last particle was inserted, s.
+    #[serde(default)]
+    pub inlet_pour_time_s: f64,
 }
 
 /// Errors of a drop-down.
@@ -141,6 +165,22 @@ pub enum DropDownError {
         particle: usize,
         /// Simulated closing time, s.
         duration_s: f64,
+    },
+    /// The pile under the inlet has reached it: no particle went in for a while.
+    #[error(
+        "drop-down from the inlet placed only {placed} of {total} particles: nothing found a \
+         free place in the inlet region for {blocked_s:.3} s (at t = {time_s:.3} s), so the pile \
+         has reached the inlet; raise the inlet, enlarge the container, or lower the count"
+    )]
+    InletBlocked {
+        /// Particles placed.
+        placed: usize,
+        /// Particles asked for.
+        total: usize,
+        /// How long nothing went in, s.
+        blocked_s: f64,
+        /// Simulated time of the pour, s.
+        time_s: f64,
     },
     /// The simulation of a fall failed its health check.
     #[error("drop-down: {0}")]
@@ -225,6 +265,20 @@ impl DropDownSpec {
                 ));
             }
         }
+        if let Some(i) = &self.inlet {
+            i.region
+                .validate()
+                .map_err(|m| DropDownError::Invalid(format!("inlet.region: {m}")))?;
+            if !(i.rate_per_s.is_finite() && i.rate_per_s > 0.0) {
+                return bad(format!(
+                    "inlet.rate_per_s must be finite and > 0, got {}",
+                    i.rate_per_s
+                ));
+            }
+            if !i.velocity_m_s.iter().all(|v| v.is_finite()) {
+                return bad("inlet.velocity_m_s must be finite".into());
+            }
+        }
         Ok(())
     }
 }
@@ -294,6 +348,20 @@ pub fn drop_down(
     let mut scratch = Vec::new();
     let mut empty_rounds = 0;
     let n_total = radii.len();
+    if let Some(inlet) = &spec.inlet {
+        pour_from_inlet(
+            &mut w,
+            radii,
+            material,
+            inlet,
+            spec,
+            &mut rng,
+            &mut report,
+            &mut hook,
+            r_max,
+        )?;
+        next = n_total;
+    }
     while next < n_total {
         if report.inserted_per_round.len() >= spec.max_rounds || empty_rounds >= 2 {
             return Err(DropDownError::Full {
@@ -394,6 +462,129 @@ pub fn drop_down(
         angular_velocity_rad_s: p.angular_velocity[first..].to_vec(),
         report,
     })
+}
+
+/// Pours `radii` from the inlet ([`Inlet`]) into `w` while it runs, then lets the pile fall
+/// calm (at least the free-fall time from the inlet's top to its lowest particle).
+#[allow(clippy::too_many_arguments)]
+fn pour_from_inlet(
+    w: &mut World,
+    radii: &[f64],
+    material: u16,
+    inlet: &Inlet,
+    spec: &DropDownSpec,
+    rng: &mut ChaCha8Rng,
+    report: &mut DropDownReport,
+    hook: &mut impl FnMut(&World, usize) -> ControlFlow<()>,
+    r_max: f64,
+) -> Result<(), DropDownError> {
+    let n_total = radii.len();
+    let t0 = w.time_s;
+    let dt = w.dt_s;
+    // Insert in batches: every 1/rate, but not more often than every 20 steps.
+    let interval_steps = ((1.0 / (inlet.rate_per_s * dt)).round() as u64).max(20);
+    let blocked_limit_s = (10.0 * interval_steps as f64 * dt).max(0.1);
+    let (ilo, ihi) = inlet.region.bounding_box();
+    let reach = Vec3::repeat(2.0 * r_max);
+    let (glo, ghi) = (ilo - reach, ihi + reach);
+    let mut next = 0usize;
+    let mut last_insert_s = t0;
+    let mut steps = 0u64;
+    let mut scratch = Vec::new();
+    while next < n_total {
+        if steps.is_multiple_of(interval_steps) {
+            let due = ((inlet.rate_per_s * (w.time_s - t0 + dt)).ceil() as usize).min(n_total);
+            if due > next {
+                // The particles near the inlet, in a grid.
+                let p = &w.particles;
+                let near: Vec<usize> = (0..p.len())
+                    .filter(|&i| {
+                        let x = &p.position[i];
+                        (0..3).all(|k| x[k] >= glo[k] && x[k] <= ghi[k])
+                    })
+                    .collect();
+                let mut pos: Vec<Vec3> = near.iter().map(|&i| p.position[i]).collect();
+                let mut rad: Vec<f64> = near.iter().map(|&i| p.radius[i]).collect();
+                let mut grid = CellGrid::new(glo, ghi, 2.0 * r_max, pos.len() + due - next);
+                for (k, x) in pos.iter().enumerate() {
+                    grid.insert(k as u32, x);
+                }
+                while next < due {
+                    let r = radii[next];
+                    let mut found = None;
+                    for _ in 0..spec.max_attempts_per_particle {
+                        let Some(x) = inlet.region.sample_center(r, rng) else {
+                            break;
+                        };
+                        if !grid.overlaps(&x, r, &pos, &rad)
+                            && w.wall_overlap(&x, r, &mut scratch).is_none()
+                        {
+                            found = Some(x);
+                            break;
+                        }
+                    }
+                    let Some(x) = found else { break };
+                    grid.insert(pos.len() as u32, &x);
+                    pos.push(x);
+                    rad.push(r);
+                    let id = w.add_particle(x, r, material);
+                    w.particles.velocity[id] = inlet.velocity_m_s;
+                    next += 1;
+                    last_insert_s = w.time_s;
+                }
+                if next < due && w.time_s - last_insert_s > blocked_limit_s {
+                    return Err(DropDownError::InletBlocked {
+                        placed: next,
+                        total: n_total,
+                        blocked_s: w.time_s - last_insert_s,
+                        time_s: w.time_s - t0,
+                    });
+                }
+            }
+        }
+        w.step();
+        steps += 1;
+        if steps.is_multiple_of(200) {
+            w.check_health()
+                .map_err(|e| DropDownError::Health(e.to_string()))?;
+            if hook(w, next).is_break() {
+                return Err(DropDownError::Interrupted);
+            }
+        }
+    }
+    report.inserted_per_round.push(n_total);
+    report.inlet_pour_time_s = w.time_s - t0;
+    // The last particles fall from the inlet onto the pile, then the pile falls calm.
+    let g = w.gravity_m_s2.norm();
+    let up = -w.gravity_m_s2 / g;
+    let p = &w.particles;
+    let bottom = (0..p.len())
+        .map(|i| p.position[i].dot(&up))
+        .fold(f64::INFINITY, f64::min);
+    let height = (inlet.region.extent_along(&up).1 - bottom).max(0.0);
+    let t_fall = (2.0 * height / g).sqrt();
+    let t_calm = w.time_s;
+    let n = w.particles.len().max(1) as f64;
+    loop {
+        w.step();
+        steps += 1;
+        if steps.is_multiple_of(200) {
+            w.check_health()
+                .map_err(|e| DropDownError::Health(e.to_string()))?;
+            if hook(w, next).is_break() {
+                return Err(DropDownError::Interrupted);
+            }
+        }
+        let t = w.time_s - t_calm;
+        if t >= spec.max_round_duration_s
+            || (t >= t_fall && w.ledger.kinetic_j / n < spec.kinetic_energy_per_particle_j)
+        {
+            break;
+        }
+    }
+    report.steps += steps;
+    report.simulated_time_s += w.time_s - t0;
+    Ok(())
 }
 
 /// The container opened for a fill with the lid open ([`open_container`]).

@@ -854,6 +854,23 @@ pub struct PlacementSpec {
     /// containers whose clearance to the lid is less than a diameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub open_lid: Option<OpenLidSpec>,
+    /// For `drop_down`: pour from an inlet over time instead of inserting in rounds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inlet: Option<InletSpec>,
+}
+
+/// `placement.inlet` of a `drop_down` group ([`pdamp_dem::drop_down::Inlet`]): the particles
+/// are inserted into `region` at `rate_per_s` with `velocity_m_s` while the world runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InletSpec {
+    /// The inlet region inside the container, above the bed, m.
+    pub region: Region,
+    /// Particles per second of simulated time.
+    pub rate_per_s: f64,
+    /// Velocity of the inserted particles, m/s (default at rest).
+    #[serde(default)]
+    pub velocity_m_s: [f64; 3],
 }
 
 /// `placement.open_lid` of a `drop_down` group: the walls that end at the region's top are
@@ -943,6 +960,7 @@ impl PlacementSpec {
             max_round_duration_s: None,
             round_kinetic_energy_per_particle_j: None,
             open_lid: None,
+            inlet: None,
         }
     }
 }
@@ -1219,11 +1237,33 @@ impl Scenario {
             && (pl.max_rounds.is_some()
                 || pl.max_round_duration_s.is_some()
                 || pl.round_kinetic_energy_per_particle_j.is_some()
-                || pl.open_lid.is_some())
+                || pl.open_lid.is_some()
+                || pl.inlet.is_some())
         {
             return Err(format!(
-                "{key}.max_rounds: max_rounds, max_round_duration_s, round_kinetic_energy_per_particle_j and open_lid belong to method = \"drop_down\""
+                "{key}.max_rounds: max_rounds, max_round_duration_s, round_kinetic_energy_per_particle_j, open_lid and inlet belong to method = \"drop_down\""
             ));
+        }
+        if let Some(i) = &pl.inlet {
+            i.region
+                .validate()
+                .map_err(|e| format!("{key}.inlet.region.{e}"))?;
+            if !(i.rate_per_s.is_finite() && i.rate_per_s > 0.0 && i.rate_per_s <= 1e9) {
+                return Err(format!(
+                    "{key}.inlet.rate_per_s must be in (0, 1e9] particles per second, got {}",
+                    i.rate_per_s
+                ));
+            }
+            if !i
+                .velocity_m_s
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= 1e3)
+            {
+                return Err(format!(
+                    "{key}.inlet.velocity_m_s must be finite and at most 1000 m/s, got {:?}",
+                    i.velocity_m_s
+                ));
+            }
         }
         if let Some(l) = &pl.open_lid {
             l.validate(&key)?;
@@ -2084,6 +2124,11 @@ impl Scenario {
             max_round_duration_s: pl.max_round_duration_s.unwrap_or(0.5),
             max_rounds: pl.max_rounds.unwrap_or(200),
             open_lid: pl.open_lid.as_ref().map(OpenLidSpec::to_open_lid),
+            inlet: pl.inlet.as_ref().map(|i| pdamp_dem::drop_down::Inlet {
+                region: i.region.clone(),
+                rate_per_s: i.rate_per_s,
+                velocity_m_s: Vec3::from(i.velocity_m_s),
+            }),
         };
         let mut w = world.clone();
         w.gravity_m_s2 = gravity;
