@@ -1043,7 +1043,39 @@ fn scenario_warnings(sc: &pdamp_io::scenario::Scenario, world: &pdamp_dem::World
     w
 }
 
+/// For a TOML file that is not a DEM scenario (no `[simulation]`), the command that reads it.
+fn other_scenario_kind(path: &std::path::Path) -> Option<&'static str> {
+    let table = std::fs::read_to_string(path)
+        .ok()?
+        .parse::<toml::Table>()
+        .ok()?;
+    if table.contains_key("simulation") {
+        return None;
+    }
+    let has = |k: &str| table.contains_key(k);
+    Some(
+        if has("beam") && has("powder") || has("beam") && has("run") {
+            "a powder cantilever scenario: run it with `pdamp powder run FILE --out DIR` (docs/powder.md)"
+        } else if has("dampers") || has("analysis") {
+            "a structure-with-dampers scenario: run it with `pdamp couple FILE --out DIR` (docs/structure.md)"
+        } else if has("study") {
+            "a layer study: run it with `pdamp structure optimize-layers FILE --out DIR` (docs/structure.md)"
+        } else if has("structure") {
+            "a structure: see its modes with `pdamp structure modes FILE --out DIR` (docs/structure.md)"
+        } else {
+            return None;
+        },
+    )
+}
+
 fn cmd_check(scenario: &std::path::Path) -> Result<()> {
+    if let Some(kind) = other_scenario_kind(scenario) {
+        bail!(
+            "{} is not a DEM scenario (it has no [simulation] table) but {kind}; `pdamp check` \
+             checks DEM scenarios (beds, dampers, plain runs)",
+            scenario.display()
+        );
+    }
     let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
     let p = &world.particles;
     let bed_mass: f64 = p.mass.iter().sum();

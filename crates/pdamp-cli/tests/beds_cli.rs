@@ -94,3 +94,26 @@ fn check_warns_about_crystal_beds() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("damper.packings must be in 1..=1000"));
     assert!(!out.exists());
 }
+
+/// `pdamp check` on a file of another command names that command instead of a TOML key error.
+#[test]
+fn check_names_the_command_of_other_scenario_files() {
+    for (file, command) in [
+        ("couple_ch5_forced_u2mm.toml", "pdamp couple"),
+        ("powder_cantilever_small.toml", "pdamp powder run"),
+        ("structure_ch5_beam.toml", "pdamp structure modes"),
+        ("study_ch5_layers.toml", "pdamp structure optimize-layers"),
+    ] {
+        let o = pdamp()
+            .arg("check")
+            .arg(examples().join(file))
+            .output()
+            .unwrap();
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("is not a DEM scenario") && err.contains(command),
+            "{file}: {err}"
+        );
+    }
+}
