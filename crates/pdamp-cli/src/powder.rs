@@ -133,9 +133,23 @@ fn load(path: &PathBuf) -> Result<CantileverScenario> {
     CantileverScenario::from_toml(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
-/// Seed of the powder preparation (0 without powder).
-fn seed_of(sc: &CantileverScenario) -> u64 {
-    sc.powder.as_ref().map_or(0, |p| p.prep.seed)
+/// Opens the output directory of a command that continues its finished runs (a study, an
+/// ensemble) unless `--overwrite` starts again.
+fn open_continuing(
+    out: &std::path::Path,
+    ck: CheckpointArgs,
+    scenario: &std::path::Path,
+) -> Result<pdamp_io::output_dir::OutputDir> {
+    Ok(pdamp_io::output_dir::OutputDir::open(
+        out,
+        if ck.overwrite {
+            pdamp_io::output_dir::OutputMode::Overwrite
+        } else {
+            pdamp_io::output_dir::OutputMode::Continue
+        },
+        &OUTPUTS,
+        &[scenario],
+    )?)
 }
 
 /// Runs `pdamp powder …`.
@@ -150,19 +164,10 @@ pub fn run(args: PowderArgs) -> Result<()> {
             ck,
         } if packings != 1 => {
             let sc = load(&scenario)?;
-            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
+            let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
             let options = ck.options()?;
             // An ensemble continues its finished packings (each checked against its scenario).
-            let mut dir = pdamp_io::output_dir::OutputDir::open(
-                &out,
-                if ck.overwrite {
-                    pdamp_io::output_dir::OutputMode::Overwrite
-                } else {
-                    pdamp_io::output_dir::OutputMode::Continue
-                },
-                &OUTPUTS,
-                &[scenario.as_path()],
-            )?;
+            let mut dir = open_continuing(&out, ck, &scenario)?;
             let e = study::run_ensemble(&sc, packings, &out, options, &mut progress)
                 .map_err(|e| anyhow!(e))
                 .and_then(|r| traced.write(&out).map(|()| r));
@@ -177,7 +182,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             scenario, out, ck, ..
         } => {
             let sc = load(&scenario)?;
-            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
+            let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
             let options = ck.options()?;
             let mut dir = crate::open_out(
                 &out,
@@ -206,7 +211,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             ck,
         } => {
             let sc = load(&scenario)?;
-            let traced = crate::Traced::start(Some(&scenario), seed_of(&sc));
+            let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
             let options = ck.options()?;
             let p = match parameter {
                 ParamArg::PackingDensity => StudyParameter::PackingDensity,
@@ -218,16 +223,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 ParamArg::Orientation => StudyParameter::Orientation,
             };
             // A study continues its finished runs (each checked against its scenario).
-            let mut dir = pdamp_io::output_dir::OutputDir::open(
-                &out,
-                if ck.overwrite {
-                    pdamp_io::output_dir::OutputMode::Overwrite
-                } else {
-                    pdamp_io::output_dir::OutputMode::Continue
-                },
-                &OUTPUTS,
-                &[scenario.as_path()],
-            )?;
+            let mut dir = open_continuing(&out, ck, &scenario)?;
             let rows =
                 study::run_study_packings(&sc, p, &values, packings, &out, options, &mut progress)
                     .map_err(|e| anyhow!(e))

@@ -38,7 +38,7 @@
 
 use crate::generate::{CellGrid, Region, orthonormal_frame};
 use crate::math::Vec3;
-use crate::walls::{Geometry, Plane};
+use crate::walls::{CylinderInside, CylinderOutside, Geometry, Plane};
 use crate::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, World};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -683,6 +683,18 @@ fn raised_top(
     // How far a face at `face` moves: up to `top + h`, if it closes the container there.
     let lift =
         |face: f64| (face >= top_b - tolerance && face < top_b + h).then_some(top_b + h - face);
+    // A cylinder (base centre, unit axis, length) along `up` whose upper end closes the
+    // container: the base centre and length that reach the raised top.
+    let cylinder_raised = |base: &Vec3, axis: &Vec3, length: f64| {
+        let a = axis.dot(&up_b);
+        if !aligned(a) {
+            return None;
+        }
+        let b = base.dot(&up_b);
+        let d = lift(if a > 0.0 { b + length } else { b })?;
+        let base = if a < 0.0 { base + up_b * d } else { *base };
+        Some((base, length + d))
+    };
     match g {
         Geometry::BoxInside(b) => {
             let k = (0..3).find(|&k| aligned(up_b[k]))?;
@@ -694,33 +706,21 @@ fn raised_top(
             Some(Geometry::BoxInside(raised))
         }
         Geometry::CylinderInside(c) => {
-            let a = c.axis.dot(&up_b);
-            if !aligned(a) {
-                return None;
-            }
-            let base = c.base_center_m.dot(&up_b);
-            let d = lift(if a > 0.0 { base + c.length_m } else { base })?;
-            let mut raised = c.clone();
-            if a < 0.0 {
-                raised.base_center_m += up_b * d;
-            }
-            raised.length_m += d;
-            Some(Geometry::CylinderInside(raised))
+            let (base_center_m, length_m) = cylinder_raised(&c.base_center_m, &c.axis, c.length_m)?;
+            Some(Geometry::CylinderInside(CylinderInside {
+                base_center_m,
+                length_m,
+                ..c.clone()
+            }))
         }
         Geometry::CylinderOutside(c) => {
             // An inner rod that reaches the lid reaches the raised lid.
-            let a = c.axis.dot(&up_b);
-            if !aligned(a) {
-                return None;
-            }
-            let base = c.base_center_m.dot(&up_b);
-            let d = lift(if a > 0.0 { base + c.length_m } else { base })?;
-            let mut raised = c.clone();
-            if a < 0.0 {
-                raised.base_center_m += up_b * d;
-            }
-            raised.length_m += d;
-            Some(Geometry::CylinderOutside(raised))
+            let (base_center_m, length_m) = cylinder_raised(&c.base_center_m, &c.axis, c.length_m)?;
+            Some(Geometry::CylinderOutside(CylinderOutside {
+                base_center_m,
+                length_m,
+                ..c.clone()
+            }))
         }
         Geometry::Plane(p) if !p.two_sided && p.normal.dot(&up_b) < -(1.0 - 1e-9) => {
             let d = lift(p.point_m.dot(&up_b))?;

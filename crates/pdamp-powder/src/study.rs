@@ -581,14 +581,12 @@ pub fn run_study_packings(
     if packings > 1 {
         let mut header = vec![param.name()];
         header.extend(ENSEMBLE_COLUMNS);
+        let seeds: Vec<u64> = (0..packings)
+            .map(|k| with_packing(base, k).map_or(0, |s| seed_of(&s)))
+            .collect();
         let lines: Vec<[f64; 11]> = rows
             .chunks(packings)
-            .map(|c| {
-                let seeds = (0..packings)
-                    .map(|k| with_packing(base, k).map_or(0, |s| seed_of(&s)))
-                    .collect();
-                ensemble_line(c[0].value, &PowderEnsemble::of(c.to_vec(), seeds))
-            })
+            .map(|c| ensemble_line(c[0].value, &PowderEnsemble::of(c.to_vec(), seeds.clone())))
             .collect();
         pdamp_io::csv::write_csv_atomic(out.join("ensemble.csv"), &header, lines)
             .map_err(|e| e.to_string())?;
@@ -596,7 +594,8 @@ pub fn run_study_packings(
     Ok(rows)
 }
 
-fn seed_of(sc: &CantileverScenario) -> u64 {
+/// Seed of the powder preparation (0 without powder).
+pub fn seed_of(sc: &CantileverScenario) -> u64 {
     sc.powder.as_ref().map_or(0, |p| p.prep.seed)
 }
 
