@@ -54,6 +54,16 @@ impl WorldState {
     pub fn time_s(&self) -> f64 {
         self.time_s
     }
+
+    /// Number of particles of the snapshot.
+    pub fn len(&self) -> usize {
+        self.radius.len()
+    }
+
+    /// True when the snapshot holds no particles.
+    pub fn is_empty(&self) -> bool {
+        self.radius.is_empty()
+    }
 }
 
 impl World {
@@ -93,6 +103,35 @@ impl World {
             gear: self.gear.clone(),
             initialized: self.initialized,
         }
+    }
+
+    /// Replaces the world's particles by the particles of `s` (radius, material and id; masses
+    /// and inertias from the world's materials, positions at the origin until
+    /// [`World::restore_state`] puts the state back). Rebuilds a world whose bed was prepared
+    /// elsewhere — by another process of a sweep — from its scenario's bodies and walls, so that
+    /// the restored world continues bit for bit. A material index outside the world's table is
+    /// refused.
+    pub fn set_particles_of(&mut self, s: &WorldState) -> Result<(), String> {
+        if s.material.len() != s.radius.len() || s.id.len() != s.radius.len() {
+            return Err("state: particle columns of different lengths".into());
+        }
+        if let Some((i, &m)) = s
+            .material
+            .iter()
+            .enumerate()
+            .find(|(_, m)| **m as usize >= self.materials.len())
+        {
+            return Err(format!(
+                "state: particle {i} has material index {m}, the world has {} materials",
+                self.materials.len()
+            ));
+        }
+        self.particles = crate::particles::ParticleSet::default();
+        for (&r, &m) in s.radius.iter().zip(&s.material) {
+            self.add_particle(Vec3::zeros(), r, m);
+        }
+        self.particles.id.clone_from(&s.id);
+        Ok(())
     }
 
     /// Puts a snapshot back. The world must have been built from the same scenario: same

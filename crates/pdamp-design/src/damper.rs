@@ -196,6 +196,20 @@ pub fn harmonic_amplitude(t_s: &[f64], x: &[f64], frequency_hz: f64) -> (f64, f6
     (2.0 * re / span, 2.0 * im / span)
 }
 
+/// The `[damper]` section of a scenario and the index of its container body.
+fn container_of(scenario: &Scenario) -> Result<(&pdamp_io::scenario::DamperSpec, usize), String> {
+    let spec = scenario
+        .damper
+        .as_ref()
+        .ok_or("scenario has no [damper] section")?;
+    let container = scenario
+        .bodies
+        .iter()
+        .position(|b| b.name == spec.container_body)
+        .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
+    Ok((spec, container))
+}
+
 impl Damper {
     /// Builds the world of a damper scenario and prepares its bed (drop-down, settling) as the
     /// scenario says ([`pdamp_io::prepare::prepare_bed`]); `progress` gets the fraction done.
@@ -204,16 +218,19 @@ impl Damper {
         base_dir: &Path,
         mut progress: impl FnMut(f64),
     ) -> Result<Self, String> {
-        let spec = scenario
-            .damper
-            .as_ref()
-            .ok_or("scenario has no [damper] section")?;
-        let container = scenario
-            .bodies
-            .iter()
-            .position(|b| b.name == spec.container_body)
-            .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
+        // The damper section is checked before the (costly) bed preparation.
+        container_of(scenario)?;
         let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))?;
+        Self::from_prepared(scenario, prepared)
+    }
+
+    /// The damper of `scenario` on a bed prepared already ([`pdamp_io::prepare::prepare_bed`],
+    /// or one saved by another process and read with [`pdamp_io::prepare::load_prepared`]).
+    pub fn from_prepared(
+        scenario: &Scenario,
+        prepared: pdamp_io::prepare::PreparedBed,
+    ) -> Result<Self, String> {
+        let (spec, container) = container_of(scenario)?;
         let mut world = prepared.world;
         world.bodies[container].motion = Motion::Fixed;
         let bed_mass_kg = world.particles.mass.iter().sum();

@@ -208,16 +208,94 @@ pub fn field_row(r: &PointResult) -> Vec<f64> {
     ]
 }
 
-fn point_path(dir: &Path, i: usize, j: usize) -> PathBuf {
+/// File of the finished point (frequency index `i`, amplitude index `j`) of the field in `dir`:
+/// `dir/points/fIII_aJJJ.json`, written atomically when the point ends.
+pub fn point_path(dir: &Path, i: usize, j: usize) -> PathBuf {
     dir.join("points").join(format!("f{i:03}_a{j:03}.json"))
 }
 
+/// File with the error of a point that failed, next to its slot: `dir/points/fIII_aJJJ.error.txt`
+/// (removed when the point later succeeds).
+pub fn point_error_path(dir: &Path, i: usize, j: usize) -> PathBuf {
+    dir.join("points")
+        .join(format!("f{i:03}_a{j:03}.error.txt"))
+}
+
+/// What the store holds for one point of a field.
+#[derive(Debug, Clone)]
+pub enum StoredPoint {
+    /// Finished: its result.
+    Done(Box<PointResult>),
+    /// Failed: the error it left next to its slot.
+    Failed(String),
+    /// A point file that cannot be read or belongs to another excitation (a damaged or foreign
+    /// file): the reason. It is recomputed like a missing point.
+    Corrupt(String),
+    /// Nothing stored yet.
+    Missing,
+}
+
+/// Reads what the store in `dir` holds for grid point (`i`, `j`) at frequency `f`, amplitude `x`.
+pub fn stored_point(dir: &Path, i: usize, j: usize, f: f64, x: f64) -> StoredPoint {
+    let path = point_path(dir, i, j);
+    match std::fs::read_to_string(&path) {
+        Ok(text) => match serde_json::from_str::<PointResult>(&text) {
+            Ok(r) => {
+                let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+                if same(r.frequency_hz, f) && same(r.amplitude_m, x) {
+                    StoredPoint::Done(Box::new(r))
+                } else {
+                    StoredPoint::Corrupt(format!(
+                        "{} holds f = {} Hz, X = {:e} m instead of f = {f} Hz, X = {x:e} m",
+                        path.display(),
+                        r.frequency_hz,
+                        r.amplitude_m
+                    ))
+                }
+            }
+            Err(e) => StoredPoint::Corrupt(format!("{} is damaged: {e}", path.display())),
+        },
+        Err(_) => match std::fs::read_to_string(point_error_path(dir, i, j)) {
+            Ok(e) => StoredPoint::Failed(e.trim().to_string()),
+            Err(_) => StoredPoint::Missing,
+        },
+    }
+}
+
 /// A stored point is reused only if it belongs to the same excitation.
-fn load_point(path: &Path, f: f64, x: f64) -> Option<PointResult> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let r: PointResult = serde_json::from_str(&text).ok()?;
-    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
-    (same(r.frequency_hz, f) && same(r.amplitude_m, x)).then_some(r)
+fn load_point(dir: &Path, i: usize, j: usize, f: f64, x: f64) -> Option<PointResult> {
+    match stored_point(dir, i, j, f, x) {
+        StoredPoint::Done(r) => Some(*r),
+        _ => None,
+    }
+}
+
+/// Stores the outcome of point (`i`, `j`) in `dir`: the result (and the error file of an
+/// earlier failure removed), or the error next to its slot. Interruptions are not stored.
+/// Returns the outcome, or an `output:` error when the store cannot be written.
+pub fn store_point(
+    dir: &Path,
+    i: usize,
+    j: usize,
+    r: Result<PointResult, String>,
+) -> Result<PointResult, String> {
+    match r {
+        Ok(r) => {
+            let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
+            pdamp_io::atomic::write_atomic(point_path(dir, i, j), json.as_bytes())
+                .map_err(|e| format!("output: {e}"))?;
+            let _ = std::fs::remove_file(point_error_path(dir, i, j));
+            Ok(r)
+        }
+        Err(e) if e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => {
+            Err(e)
+        }
+        Err(e) => {
+            pdamp_io::atomic::write_atomic(point_error_path(dir, i, j), e.as_bytes())
+                .map_err(|e| format!("output: {e}"))?;
+            Err(e)
+        }
+    }
 }
 
 /// Outcome of [`run_fields`].
@@ -288,6 +366,10 @@ pub enum PointEngine<'a> {
     /// [`GPU_BATCH_PARTICLES`] particles a batch).
     #[cfg(feature = "gpu")]
     Gpu(&'a pdamp_gpu::GpuDevice),
+    /// Nothing runs: the field is collected from its store (a sweep's `collect`). Points that
+    /// failed come out as NaN rows with their stored error; a point still missing (not run
+    /// yet, running, or its file damaged) is an error that names how many and which.
+    Stored,
     #[doc(hidden)]
     _Lifetime(std::marker::PhantomData<&'a ()>),
 }
@@ -322,7 +404,7 @@ pub fn run_fields_on(
     let total = points.len();
     let mut results: Vec<Option<PointResult>> = points
         .iter()
-        .map(|&(i, j, f, x)| load_point(&point_path(out_dir, i, j), f, x))
+        .map(|&(i, j, f, x)| load_point(out_dir, i, j, f, x))
         .collect();
     let reused = results.iter().filter(|r| r.is_some()).count();
     let done = std::sync::atomic::AtomicUsize::new(reused);
@@ -335,12 +417,7 @@ pub fn run_fields_on(
     let particles = damper.settled.particles.len();
     let store = |k: usize, r: Result<PointResult, String>| {
         let (i, j, _, _) = points[k];
-        let stored = r.and_then(|r| {
-            let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
-            pdamp_io::atomic::write_atomic(point_path(out_dir, i, j), json.as_bytes())
-                .map_err(|e| format!("output: {e}"))?;
-            Ok(r)
-        });
+        let stored = store_point(out_dir, i, j, r);
         let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         on_point(n, total);
         stored
@@ -371,6 +448,35 @@ pub fn run_fields_on(
                         }
                     }
                 }
+            }
+            fresh
+        }
+        PointEngine::Stored => {
+            let mut fresh = Vec::with_capacity(pending.len());
+            let mut missing = Vec::new();
+            for &k in &pending {
+                let (i, j, f, x) = points[k];
+                match stored_point(out_dir, i, j, f, x) {
+                    StoredPoint::Failed(e) => fresh.push((k, Err(e))),
+                    StoredPoint::Corrupt(why) => missing.push(why),
+                    StoredPoint::Missing | StoredPoint::Done(_) => {
+                        missing.push(format!("f = {f} Hz, X = {x:.4e} m (f{i:03}_a{j:03})"))
+                    }
+                }
+            }
+            if !missing.is_empty() {
+                let shown: Vec<&str> = missing.iter().take(5).map(|s| s.as_str()).collect();
+                return Err(format!(
+                    "{}: {} of {total} points are not finished: {}{}",
+                    out_dir.join("points").display(),
+                    missing.len(),
+                    shown.join("; "),
+                    if missing.len() > shown.len() {
+                        "; …"
+                    } else {
+                        ""
+                    }
+                ));
             }
             fresh
         }
@@ -408,6 +514,57 @@ pub fn run_fields_on(
         failed,
         bed_span_along_direction_m: [lo, hi],
     })
+}
+
+/// Runs the grid points `indices` (positions in [`FieldGrid::points`], frequency-major) of the
+/// field stored in `out_dir` that are not finished yet — a task of a sweep — with the threads
+/// shared as `split` says, storing each point as it ends (its result, or its error next to its
+/// slot). Returns, per index, `Ok(true)` when it ran, `Ok(false)` when it was already finished,
+/// or the error of a failed point; an `output:` error or an interruption ends the call.
+pub fn run_field_points(
+    damper: &Damper,
+    grid: &FieldGrid,
+    out_dir: &Path,
+    indices: &[usize],
+    split: ThreadSplit,
+) -> Result<Vec<(usize, Result<bool, String>)>, String> {
+    let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
+    std::fs::create_dir_all(out_dir.join("points")).map_err(|e| format!("output: {e}"))?;
+    let points = grid.points();
+    if let Some(&k) = indices.iter().find(|&&k| k >= points.len()) {
+        return Err(format!(
+            "grid point {k} does not exist: the grid has {} points",
+            points.len()
+        ));
+    }
+    let mut out: Vec<(usize, Result<bool, String>)> = Vec::with_capacity(indices.len());
+    let mut pending = Vec::new();
+    for &k in indices {
+        let (i, j, f, x) = points[k];
+        if load_point(out_dir, i, j, f, x).is_some() {
+            out.push((k, Ok(false)));
+        } else {
+            pending.push(k);
+        }
+    }
+    let particles = damper.settled.particles.len();
+    let ran = run_split(&pending, split, particles, |k| {
+        let (i, j, f, x) = points[k];
+        store_point(out_dir, i, j, damper.run_point(f, x, &mut ()))
+    });
+    for (k, r) in ran {
+        match r {
+            Ok(_) => out.push((k, Ok(true))),
+            Err(e)
+                if e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED) =>
+            {
+                return Err(e);
+            }
+            Err(e) => out.push((k, Err(e))),
+        }
+    }
+    out.sort_by_key(|(k, _)| *k);
+    Ok(out)
 }
 
 /// Writes `fields.csv` atomically.

@@ -504,6 +504,72 @@ pub fn run_fields_scenario_on(
     base_dir: &Path,
     out: &Path,
     engine: crate::fields::PointEngine<'_>,
+    settle_progress: impl FnMut(f64),
+    on_point: impl Fn(usize, usize) + Sync,
+) -> Result<FieldsOutcome, String> {
+    run_fields_scenario_from(
+        sc,
+        base_dir,
+        out,
+        engine,
+        BedSource::Prepare,
+        settle_progress,
+        on_point,
+    )
+}
+
+/// Where the beds of a field's packings come from.
+#[derive(Debug, Clone, Copy)]
+pub enum BedSource<'a> {
+    /// Prepared here (drop-down, settling) as the scenario says.
+    Prepare,
+    /// Read from [`prepared_bed_path`] in the given directory where a process saved it, else
+    /// prepared here and saved there for the others: every task of a sweep, on whatever node,
+    /// starts from the same bits and no bed is prepared twice.
+    Saved(&'a Path),
+}
+
+/// File of the saved bed of packing `k` of a field or sweep in `dir`:
+/// `dir/beds/packing_KKK.pdprep` ([`pdamp_io::prepare::save_prepared`]).
+pub fn prepared_bed_path(dir: &Path, k: usize) -> std::path::PathBuf {
+    dir.join("beds").join(format!("packing_{k:03}.pdprep"))
+}
+
+/// The damper of packing `k` of the field of `sc` (packing 0: the scenario's own seed; see
+/// [`pdamp_io::prepare::scenario_for_packing`]), its bed taken from `beds`.
+pub fn field_damper(
+    sc: &Scenario,
+    base_dir: &Path,
+    k: usize,
+    beds: BedSource<'_>,
+    progress: impl FnMut(f64),
+) -> Result<Damper, String> {
+    let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
+    let BedSource::Saved(dir) = beds else {
+        return Damper::from_scenario(&sk, base_dir, progress);
+    };
+    let path = prepared_bed_path(dir, k);
+    if let Some(prepared) = pdamp_io::prepare::load_prepared(&path, &sk, base_dir)? {
+        return Damper::from_prepared(&sk, prepared);
+    }
+    let mut progress = progress;
+    let prepared = pdamp_io::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))?;
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|e| format!("output: {e}"))?;
+    }
+    pdamp_io::prepare::save_prepared(&path, &prepared, &sk, base_dir)
+        .map_err(|e| format!("output: {e}"))?;
+    Damper::from_prepared(&sk, prepared)
+}
+
+/// [`run_fields_scenario_on`] with the beds from `beds` (a sweep's collect step reads the
+/// beds its tasks saved and, with [`crate::fields::PointEngine::Stored`], only its store).
+pub fn run_fields_scenario_from(
+    sc: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    engine: crate::fields::PointEngine<'_>,
+    beds: BedSource<'_>,
     mut settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, String> {
@@ -546,7 +612,7 @@ pub fn run_fields_scenario_on(
     }
     let packings = sc.damper.as_ref().map_or(1, |d| d.packings);
     if packings == 1 {
-        let damper = Damper::from_scenario(sc, base_dir, &mut settle_progress)?;
+        let damper = field_damper(sc, base_dir, 0, beds, &mut settle_progress)?;
         let bed = damper.bed_statistics();
         write_bed_statistics(
             out,
@@ -562,8 +628,7 @@ pub fn run_fields_scenario_on(
     let mut clearances = Vec::with_capacity(packings);
     let total = grid.points().len() * packings;
     for k in 0..packings {
-        let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
-        let damper = Damper::from_scenario(&sk, base_dir, |f| {
+        let damper = field_damper(sc, base_dir, k, beds, |f| {
             settle_progress((k as f64 + f) / packings as f64)
         })?;
         let dir = out.join("packings").join(format!("packing_{k:03}"));

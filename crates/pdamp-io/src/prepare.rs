@@ -95,6 +95,79 @@ pub fn prepare_bed(
     })
 }
 
+/// Kind tag of prepared-bed files ([`save_prepared`]).
+pub const PREPARED_KIND: &str = "prepared-bed";
+
+/// What [`save_prepared`] stores: the full dynamic state of the prepared world and what the
+/// preparation did.
+#[derive(Serialize, serde::Deserialize)]
+struct PreparedFile {
+    state: pdamp_dem::WorldState,
+    settling_time_s: f64,
+    drop_down: Vec<DropDownReport>,
+    fill_statistics: Option<BedStatistics>,
+}
+
+/// Saves a prepared bed to `path` (atomic; the checkpoint framing of [`crate::checkpoint`],
+/// kind [`PREPARED_KIND`], keyed by [`crate::run::scenario_content_digest`] of `scenario`),
+/// so that another process — a task of a sweep on another node — continues from the same bits
+/// with [`load_prepared`] instead of preparing the bed again.
+pub fn save_prepared(
+    path: &Path,
+    prepared: &PreparedBed,
+    scenario: &Scenario,
+    base_dir: &Path,
+) -> Result<(), String> {
+    let digest = crate::run::scenario_content_digest(scenario, base_dir);
+    crate::checkpoint::save(
+        path,
+        &crate::checkpoint::CheckpointHeader::new(PREPARED_KIND, &digest),
+        &PreparedFile {
+            state: prepared.world.save_state(),
+            settling_time_s: prepared.settling_time_s,
+            drop_down: prepared.drop_down.clone(),
+            fill_statistics: prepared.fill_statistics.clone(),
+        },
+    )
+}
+
+/// Reads a bed saved by [`save_prepared`] for `scenario` (paths relative to `base_dir`): the
+/// world is built from the scenario's bodies and walls without its particles, then the saved
+/// particles and their state are put in, so that it equals bit for bit the world
+/// [`prepare_bed`] made. `Ok(None)` when there is no file; a file of another scenario (or a
+/// changed mesh or table), another pdamp format or a damaged file is refused with the reason.
+pub fn load_prepared(
+    path: &Path,
+    scenario: &Scenario,
+    base_dir: &Path,
+) -> Result<Option<PreparedBed>, String> {
+    let digest = crate::run::scenario_content_digest(scenario, base_dir);
+    let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest)
+        .map_err(|e| e.replace("checkpoint ", "prepared bed "))?
+    else {
+        return Ok(None);
+    };
+    let mut world = scenario.build_world_with(
+        base_dir,
+        crate::scenario::Preparation::Check,
+        &mut |_, _| {},
+    )?;
+    let why = |e: String| format!("prepared bed {}: {e}", path.display());
+    world.set_particles_of(&f.state).map_err(why)?;
+    world.restore_state(f.state).map_err(why)?;
+    if let Some(d) = &scenario.damper
+        && let Some(b) = world.bodies.iter_mut().find(|b| b.name == d.container_body)
+    {
+        b.motion = pdamp_dem::Motion::Fixed;
+    }
+    Ok(Some(PreparedBed {
+        world,
+        settling_time_s: f.settling_time_s,
+        drop_down: f.drop_down,
+        fill_statistics: f.fill_statistics,
+    }))
+}
+
 /// The excitation direction of a damper scenario (for the clearance), if it has one.
 pub fn excitation_direction(scenario: &Scenario) -> Option<Vec3> {
     scenario.damper.as_ref().map(|d| Vec3::from(d.direction))
