@@ -20,6 +20,7 @@ mod gpu;
 mod powder;
 mod progress;
 mod structure;
+mod sweep;
 
 #[derive(Parser)]
 #[command(
@@ -79,6 +80,16 @@ enum Command {
         /// Start again: remove the points and maps of an earlier run in DIR first.
         #[arg(long)]
         overwrite: bool,
+        /// `--backend slurm`: the field as a sweep of Slurm array jobs (docs/cluster.md);
+        /// `pdamp sweep status|collect DIR` follow and collect it.
+        #[command(flatten)]
+        backend: sweep::BackendArgs,
+    },
+    /// Sweeps: a field's points (and packings) as tasks run here or as Slurm array jobs —
+    /// new, submit, status, resubmit, collect (docs/cluster.md).
+    Sweep {
+        #[command(subcommand)]
+        command: sweep::SweepCommand,
     },
     /// Prepare the bed of a scenario (drop-down and settling) and save it: DIR/bed.pdbed (exact
     /// continuation, `placement = { method = "file", path = "DIR/bed.pdbed" }`), bed.csv,
@@ -421,7 +432,27 @@ fn dispatch(command: Command) -> Result<()> {
             out,
             device,
             overwrite,
-        } => cmd_fields(&scenario, &out, device, overwrite),
+            backend,
+        } => match backend.backend {
+            Some(sweep::Backend::Slurm) => {
+                if device != Device::Cpu || overwrite {
+                    bail!(
+                        "--backend slurm runs the points on the CPUs of the cluster's nodes and continues a sweep in DIR; --device gpu and --overwrite do not apply (delete DIR to start again)"
+                    );
+                }
+                sweep::create(&scenario, &out)?;
+                sweep::submit(&out, &backend)
+            }
+            _ => {
+                if backend.any_slurm_option() {
+                    bail!(
+                        "the Slurm options (--partition, --time, --throttle, …) need --backend slurm"
+                    );
+                }
+                cmd_fields(&scenario, &out, device, overwrite)
+            }
+        },
+        Command::Sweep { command } => sweep::dispatch(command),
         Command::Check { scenario } => cmd_check(&scenario),
         Command::Completions { shell } => {
             // Into a buffer first: a closed pipe (`| head`) is not an error worth a panic.
@@ -622,8 +653,11 @@ fn dispatch(command: Command) -> Result<()> {
 
 /// Files and folders the DEM commands write into their output directory (checked for
 /// symbolic links and for inputs they would replace before anything is written).
-const RUN_OUTPUTS: [&str; 22] = [
+const RUN_OUTPUTS: [&str; 25] = [
     "input.toml",
+    "sweep.json",
+    "sweep",
+    "beds",
     "energy.png",
     "energy.svg",
     "scenario.toml",

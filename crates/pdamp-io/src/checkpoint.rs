@@ -162,6 +162,20 @@ pub fn load<T: for<'de> Deserialize<'de>>(
         .map_err(|why| format!("checkpoint {}: {why}", path.display()))
 }
 
+/// Checks only the framing of a checkpoint file — the magic and the trailing digest of
+/// everything before it — without decoding the body: a quick test that a stored file is
+/// complete and undamaged (a sweep's status over thousands of files).
+pub fn verify_framing(bytes: &[u8]) -> Result<(), String> {
+    if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err("not a pdamp checkpoint".into());
+    }
+    let (data, sum) = bytes.split_at(bytes.len() - 16);
+    if digest(data).as_bytes() != sum {
+        return Err("damaged (digest mismatch)".into());
+    }
+    Ok(())
+}
+
 /// Decodes the bytes of a checkpoint file (see [`load`]; `scenario_digest = None` skips that
 /// check). Never panics and never allocates more than the input length suggests, whatever the
 /// bytes are.

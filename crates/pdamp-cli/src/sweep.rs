@@ -1,0 +1,674 @@
+//! `pdamp sweep …` and `pdamp fields --backend slurm`: an effective field (with its packings)
+//! as a sweep of independent tasks — one per packing's bed, one per grid point and packing —
+//! run here or as Slurm array jobs, and collected into exactly the outputs of a local
+//! `pdamp fields` run (see [`pdamp_sweep`] and docs/cluster.md).
+
+use anyhow::{Context, Result, bail};
+use pdamp_design::FieldGrid;
+use pdamp_design::fields::{StoredPoint, stored_point};
+use pdamp_design::report::{BedSource, field_damper, prepared_bed_path};
+use pdamp_io::scenario::Scenario;
+use pdamp_sweep::slurm::SlurmOptions;
+use pdamp_sweep::status::{Stored, TaskState};
+use pdamp_sweep::{SweepManifest, Task};
+use std::path::{Path, PathBuf};
+
+/// Kind name of effective-field sweeps.
+const FIELDS_KIND: &str = "fields";
+
+/// Where the tasks of a sweep run.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Backend {
+    /// Here, the tasks in parallel on this machine's threads (what `pdamp fields` does).
+    Local,
+    /// As Slurm array jobs (`sbatch --array`), each element running `pdamp sweep task`.
+    Slurm,
+}
+
+/// How and where to submit (the Slurm options are sbatch's).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub(crate) struct BackendArgs {
+    /// Where the tasks run: `local` (this machine) or `slurm` (array jobs; run this on the
+    /// cluster's login node, DIR on the shared file system).
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    /// Slurm partition (sbatch --partition).
+    #[arg(long)]
+    partition: Option<String>,
+    /// Wall-clock limit of one array element (sbatch --time: MM, HH:MM:SS, D-HH).
+    #[arg(long)]
+    time: Option<String>,
+    /// Slurm account to charge (sbatch --account).
+    #[arg(long)]
+    account: Option<String>,
+    /// Quality of service (sbatch --qos).
+    #[arg(long)]
+    qos: Option<String>,
+    /// Memory per CPU (sbatch --mem-per-cpu, e.g. 2G).
+    #[arg(long)]
+    mem_per_cpu: Option<String>,
+    /// CPUs of one array element: the threads of its pdamp (sbatch --cpus-per-task).
+    #[arg(long, default_value_t = 1)]
+    cpus_per_task: usize,
+    /// Most elements in one array (the site's MaxArraySize; default: from `scontrol show
+    /// config`): more tasks are submitted as several arrays.
+    #[arg(long)]
+    array_limit: Option<usize>,
+    /// Most sweep tasks (grid points) one array element runs, one after the other or in
+    /// parallel on its CPUs: more than one when points are short.
+    #[arg(long, default_value_t = 1)]
+    max_tasks_per_job: usize,
+    /// Elements of one array running at once (Slurm's `--array=…%N`).
+    #[arg(long)]
+    throttle: Option<usize>,
+    /// A further sbatch option, verbatim (repeatable), e.g. `--sbatch-arg=--constraint=skylake`.
+    #[arg(long = "sbatch-arg", allow_hyphen_values = true)]
+    sbatch_arg: Vec<String>,
+    /// The pdamp executable on the compute nodes (default: this one; it must be on the shared
+    /// file system).
+    #[arg(long)]
+    pdamp: Option<PathBuf>,
+    /// Write the batch scripts into DIR/sweep/slurm and print the plan; submit nothing.
+    #[arg(long)]
+    dry_run: bool,
+}
+
+impl BackendArgs {
+    fn slurm_options(&self) -> SlurmOptions {
+        SlurmOptions {
+            partition: self.partition.clone(),
+            time: self.time.clone(),
+            account: self.account.clone(),
+            qos: self.qos.clone(),
+            mem_per_cpu: self.mem_per_cpu.clone(),
+            cpus_per_task: self.cpus_per_task,
+            array_limit: self.array_limit,
+            max_tasks_per_job: self.max_tasks_per_job,
+            throttle: self.throttle,
+            extra: self.sbatch_arg.clone(),
+            pdamp: self.pdamp.clone(),
+        }
+    }
+
+    /// Whether a Slurm option was given (they mean nothing to the local backend).
+    pub(crate) fn any_slurm_option(&self) -> bool {
+        self.partition.is_some()
+            || self.time.is_some()
+            || self.account.is_some()
+            || self.qos.is_some()
+            || self.mem_per_cpu.is_some()
+            || self.cpus_per_task != 1
+            || self.array_limit.is_some()
+            || self.max_tasks_per_job != 1
+            || self.throttle.is_some()
+            || !self.sbatch_arg.is_empty()
+            || self.pdamp.is_some()
+            || self.dry_run
+    }
+}
+
+/// `pdamp sweep …`.
+#[derive(clap::Subcommand)]
+pub(crate) enum SweepCommand {
+    /// Make the sweep of a scenario's [fields] grid (and its packings) in DIR without running
+    /// anything: DIR/sweep.json lists the tasks.
+    New {
+        /// Scenario file (TOML) with [damper] and [fields].
+        scenario: PathBuf,
+        /// Sweep (output) directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Submit the tasks of DIR that are not finished (missing, failed, damaged), not those
+    /// queued or running; default backend: slurm.
+    Submit {
+        /// Sweep directory.
+        dir: PathBuf,
+        #[command(flatten)]
+        backend: BackendArgs,
+    },
+    /// Submit again only the tasks that are missing or failed (cancelled, killed, preempted
+    /// past their requeue, or never submitted); finished ones are never recomputed.
+    Resubmit {
+        /// Sweep directory.
+        dir: PathBuf,
+        #[command(flatten)]
+        backend: BackendArgs,
+    },
+    /// State of every task: done, running, pending (from squeue), failed (with its error),
+    /// corrupt, missing.
+    Status {
+        /// Sweep directory.
+        dir: PathBuf,
+        /// Print JSON instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Build the outputs of a local run (fields.csv, maps, bed statistics) from the finished
+    /// tasks; failed points become NaN rows with their message.
+    Collect {
+        /// Sweep directory.
+        dir: PathBuf,
+    },
+    /// Run tasks of the sweep (what each Slurm array element runs).
+    Task {
+        /// Sweep directory.
+        dir: PathBuf,
+        /// Task indices (comma-separated; see DIR/sweep.json).
+        #[arg(long, value_delimiter = ',', required = true)]
+        index: Vec<usize>,
+    },
+}
+
+/// Runs a `pdamp sweep` command.
+pub(crate) fn dispatch(command: SweepCommand) -> Result<()> {
+    match command {
+        SweepCommand::New { scenario, out } => {
+            let (m, _) = create(&scenario, &out)?;
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "sweep": out, "kind": m.kind, "tasks": m.tasks.len(),
+                    "next": format!("pdamp sweep submit {} --backend slurm [--partition …]", out.display()),
+                }))?
+            );
+            Ok(())
+        }
+        SweepCommand::Submit { dir, backend } | SweepCommand::Resubmit { dir, backend } => {
+            submit(&dir, &backend)
+        }
+        SweepCommand::Status { dir, json } => status(&dir, json),
+        SweepCommand::Collect { dir } => collect(&dir),
+        SweepCommand::Task { dir, index } => run_tasks(&dir, &index),
+    }
+}
+
+/// The sweep's scenario, validated, with the directory its relative paths resolve against.
+fn load_scenario(dir: &Path, m: &SweepManifest) -> Result<Scenario> {
+    let copy = dir.join(pdamp_sweep::SCENARIO_COPY);
+    let text =
+        std::fs::read_to_string(&copy).with_context(|| format!("reading {}", copy.display()))?;
+    let sc = Scenario::from_toml_in(&text, &m.base_dir)
+        .and_then(|s| s.validate().map(|_| s))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
+    let digest = pdamp_io::run::scenario_content_digest(&sc, &m.base_dir);
+    if digest != m.scenario_digest {
+        bail!(
+            "{}: the scenario or a file it reads (relative to {}) changed since the sweep was made (digest {} now, {} then); finished tasks would not match new ones — make a new sweep in another directory",
+            dir.display(),
+            m.base_dir.display(),
+            digest,
+            m.scenario_digest
+        );
+    }
+    Ok(sc)
+}
+
+/// Output directory of packing `k` of a field with `packings` packings.
+fn packing_dir(dir: &Path, packings: usize, k: usize) -> PathBuf {
+    if packings == 1 {
+        dir.to_path_buf()
+    } else {
+        dir.join("packings").join(format!("packing_{k:03}"))
+    }
+}
+
+/// A task of a field sweep: the bed of a packing, or a grid point of a packing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum FieldTask {
+    Bed { packing: usize },
+    Point { packing: usize, grid_index: usize },
+}
+
+/// Tasks of the field of `sc`: the beds first (tasks 0 … K−1), then packing by packing the
+/// grid points in grid order.
+fn field_tasks(sc: &Scenario) -> Result<(Vec<FieldTask>, FieldGrid, usize)> {
+    let spec = sc.fields.as_ref().context(
+        "a sweep needs a scenario with [damper] and [fields] (an effective field); other grids run with their own commands",
+    )?;
+    if sc.damper.is_none() {
+        bail!("a field sweep needs a [damper] section");
+    }
+    let grid = FieldGrid::from_spec(spec).map_err(anyhow::Error::msg)?;
+    let packings = sc.damper.as_ref().map_or(1, |d| d.packings).max(1);
+    let n = grid.points().len();
+    let mut tasks: Vec<FieldTask> = (0..packings)
+        .map(|k| FieldTask::Bed { packing: k })
+        .collect();
+    for k in 0..packings {
+        tasks.extend((0..n).map(|g| FieldTask::Point {
+            packing: k,
+            grid_index: g,
+        }));
+    }
+    Ok((tasks, grid, packings))
+}
+
+fn describe(
+    grid: &FieldGrid,
+    packings: usize,
+    t: FieldTask,
+) -> (String, Vec<usize>, PathBuf, PathBuf) {
+    let rel = |p: PathBuf, dir: &Path| p.strip_prefix(dir).map(|r| r.to_path_buf()).unwrap_or(p);
+    let root = Path::new("");
+    match t {
+        FieldTask::Bed { packing } => {
+            let result = prepared_bed_path(root, packing);
+            let error = result.with_extension("error.txt");
+            (
+                format!("bed of packing {packing}"),
+                vec![],
+                rel(result, root),
+                error,
+            )
+        }
+        FieldTask::Point {
+            packing,
+            grid_index,
+        } => {
+            let (i, j, f, x) = grid.points()[grid_index];
+            let d = packing_dir(root, packings, packing);
+            let amp = grid.amplitude_values[j];
+            let label = format!(
+                "{}f = {f} Hz, {} = {amp:.4e} (X = {x:.4e} m)",
+                if packings > 1 {
+                    format!("packing {packing}: ")
+                } else {
+                    String::new()
+                },
+                match grid.amplitude_axis {
+                    pdamp_io::scenario::AmplitudeAxis::Displacement => "X",
+                    pdamp_io::scenario::AmplitudeAxis::Acceleration => "A",
+                    pdamp_io::scenario::AmplitudeAxis::Intensity => "Γ",
+                }
+            );
+            (
+                label,
+                vec![packing],
+                pdamp_design::fields::point_path(&d, i, j),
+                pdamp_design::fields::point_error_path(&d, i, j),
+            )
+        }
+    }
+}
+
+/// Makes (or opens, when it is of the same scenario) the sweep of `scenario` in `out`.
+pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scenario)> {
+    let sc = Scenario::load(scenario)?;
+    let (tasks, grid, packings) = field_tasks(&sc)?;
+    let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let source = abs(scenario);
+    let base_dir = source.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let manifest = SweepManifest {
+        format: pdamp_sweep::SWEEP_FORMAT,
+        pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+        kind: FIELDS_KIND.into(),
+        title: sc.title.clone(),
+        scenario_source: source,
+        scenario_digest: pdamp_io::run::scenario_content_digest(&sc, &base_dir),
+        base_dir,
+        tasks: tasks
+            .iter()
+            .enumerate()
+            .map(|(index, &t)| {
+                let (label, needs, result, error) = describe(&grid, packings, t);
+                Task {
+                    index,
+                    label,
+                    needs,
+                    result,
+                    error,
+                }
+            })
+            .collect(),
+    };
+    // A sweep writes into a directory another command may have used: refused as `fields`
+    // refuses it (results of another kind of run), and an input file is never replaced.
+    let inputs = crate::scenario_inputs(scenario, &sc);
+    let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let dir = pdamp_io::output_dir::OutputDir::open(
+        out,
+        pdamp_io::output_dir::OutputMode::Continue,
+        &crate::RUN_OUTPUTS,
+        &inputs,
+    )?;
+    let text = std::fs::read_to_string(scenario)?;
+    let m = SweepManifest::create_or_open(out, manifest, &text)?;
+    crate::copy_input(out, scenario)?;
+    dir.close()?;
+    Ok((m, sc))
+}
+
+/// What the store holds for task `t` of the sweep in `dir`.
+fn stored(dir: &Path, grid: &FieldGrid, packings: usize, ft: FieldTask, t: &Task) -> Stored {
+    match ft {
+        FieldTask::Bed { .. } => match std::fs::read(dir.join(&t.result)) {
+            Ok(bytes) => match pdamp_io::checkpoint::verify_framing(&bytes) {
+                Ok(()) => Stored::Done,
+                Err(e) => Stored::Corrupt(format!("{}: {e}", t.result.display())),
+            },
+            Err(_) => match std::fs::read_to_string(dir.join(&t.error)) {
+                Ok(e) => Stored::Failed(e.trim().to_string()),
+                Err(_) => Stored::Missing,
+            },
+        },
+        FieldTask::Point {
+            packing,
+            grid_index,
+        } => {
+            let (i, j, f, x) = grid.points()[grid_index];
+            match stored_point(&packing_dir(dir, packings, packing), i, j, f, x) {
+                StoredPoint::Done(_) => Stored::Done,
+                StoredPoint::Failed(e) => Stored::Failed(e),
+                StoredPoint::Corrupt(e) => Stored::Corrupt(e),
+                StoredPoint::Missing => Stored::Missing,
+            }
+        }
+    }
+}
+
+/// State of every task of the sweep in `dir` (the queue asked only when something was submitted
+/// to Slurm).
+fn states(dir: &Path) -> Result<(SweepManifest, Vec<TaskState>)> {
+    let m = SweepManifest::load(dir)?;
+    let sc = load_scenario(dir, &m)?;
+    let (tasks, grid, packings) = field_tasks(&sc)?;
+    let submissions = pdamp_sweep::load_submissions(dir)?;
+    let queued = pdamp_sweep::status::queued_tasks(&submissions)?;
+    let st = pdamp_sweep::status::task_states(
+        &m,
+        |t| stored(dir, &grid, packings, tasks[t.index], t),
+        &queued,
+    );
+    Ok((m, st))
+}
+
+fn status(dir: &Path, json: bool) -> Result<()> {
+    let (m, st) = states(dir)?;
+    if json {
+        let counts: serde_json::Map<String, serde_json::Value> = pdamp_sweep::status::counts(&st)
+            .iter()
+            .map(|(k, n)| (k.to_string(), serde_json::json!(n)))
+            .collect();
+        let tasks: Vec<serde_json::Value> = m
+            .tasks
+            .iter()
+            .zip(&st)
+            .map(|(t, s)| {
+                let mut v = serde_json::to_value(s).unwrap_or_default();
+                v["index"] = serde_json::json!(t.index);
+                v["label"] = serde_json::json!(t.label);
+                v
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "sweep": dir, "kind": m.kind, "tasks": m.tasks.len(), "counts": counts, "task_states": tasks,
+            }))?
+        );
+    } else {
+        print!("{}", pdamp_sweep::status::render(dir, &m, &st));
+    }
+    Ok(())
+}
+
+/// Submits the unfinished tasks of the sweep in `dir` to the chosen backend.
+pub(crate) fn submit(dir: &Path, args: &BackendArgs) -> Result<()> {
+    let backend = args.backend.unwrap_or(Backend::Slurm);
+    let (m, st) = states(dir)?;
+    let wanted: Vec<usize> = m
+        .tasks
+        .iter()
+        .zip(&st)
+        .filter(|(_, s)| s.wants_run())
+        .map(|(t, _)| t.index)
+        .collect();
+    let busy = st
+        .iter()
+        .filter(|s| matches!(s, TaskState::Running | TaskState::Pending))
+        .count();
+    if backend == Backend::Local {
+        if args.any_slurm_option() {
+            bail!("the Slurm options (--partition, --time, --throttle, …) need --backend slurm");
+        }
+        if busy > 0 {
+            bail!(
+                "{busy} tasks of {} are queued or running in Slurm; wait for them (`pdamp sweep status`) or cancel them (scancel) before running the rest here",
+                dir.display()
+            );
+        }
+        run_tasks(dir, &wanted)?;
+        pdamp_sweep::record_submission(
+            dir,
+            pdamp_sweep::Submission {
+                backend: "local".into(),
+                time_unix_s: pdamp_sweep::now_unix_s(),
+                arrays: vec![],
+            },
+        )?;
+        return collect(dir);
+    }
+    if wanted.is_empty() {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "sweep": dir, "submitted_tasks": 0, "queued_or_running": busy,
+                "next": format!("pdamp sweep collect {}", dir.display()),
+            }))?
+        );
+        return Ok(());
+    }
+    let options = args.slurm_options();
+    let pdamp = match &options.pdamp {
+        Some(p) => p.clone(),
+        None => std::env::current_exe().context("locating this pdamp executable")?,
+    };
+    let dir_abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    // Beds first (the points need them), then the points.
+    let (first, rest): (Vec<usize>, Vec<usize>) = wanted
+        .iter()
+        .partition(|&&t| m.tasks.iter().any(|o| o.needs.contains(&t)));
+    let number = pdamp_sweep::load_submissions(dir)?
+        .iter()
+        .map(|s| s.arrays.len())
+        .sum();
+    let planned = pdamp_sweep::slurm::write_arrays(
+        &dir_abs, &m.kind, &first, &rest, &options, &pdamp, number,
+    )?;
+    let rel = |p: &Path| {
+        p.strip_prefix(&dir_abs)
+            .map(|r| r.to_path_buf())
+            .unwrap_or(p.to_path_buf())
+    };
+    if args.dry_run {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "sweep": dir, "dry_run": true, "tasks": wanted.len(),
+                "arrays": planned.iter().map(|p| serde_json::json!({
+                    "script": rel(&p.script), "elements": p.elements.len(), "after_beds": p.after_first,
+                })).collect::<Vec<_>>(),
+            }))?
+        );
+        return Ok(());
+    }
+    let ids = pdamp_sweep::slurm::submit_arrays(&planned)?;
+    pdamp_sweep::record_submission(
+        dir,
+        pdamp_sweep::Submission {
+            backend: "slurm".into(),
+            time_unix_s: pdamp_sweep::now_unix_s(),
+            arrays: planned
+                .iter()
+                .zip(&ids)
+                .map(|(p, id)| pdamp_sweep::SubmittedArray {
+                    job_id: id.clone(),
+                    script: rel(&p.script),
+                    elements: p.elements.clone(),
+                })
+                .collect(),
+        },
+    )?;
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "sweep": dir, "submitted_tasks": wanted.len(), "arrays": ids,
+            "status": format!("pdamp sweep status {}", dir.display()),
+            "collect": format!("pdamp sweep collect {}", dir.display()),
+        }))?
+    );
+    Ok(())
+}
+
+/// Runs the tasks `indices` of the sweep in `dir` here: beds first, then the points packing by
+/// packing on this process's threads. Each finished task is stored at once; a failed one
+/// leaves its error next to its slot. Fails (exit status ≠ 0) when a task failed.
+pub(crate) fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
+    let m = SweepManifest::load(dir)?;
+    for &i in indices {
+        m.task(dir, i)?;
+    }
+    let sc = load_scenario(dir, &m)?;
+    let (tasks, grid, packings) = field_tasks(&sc)?;
+    let mut failed: Vec<String> = Vec::new();
+    let mut ran = 0usize;
+    // The beds asked for, then those the points need.
+    let mut beds: Vec<usize> = indices
+        .iter()
+        .filter_map(|&i| match tasks[i] {
+            FieldTask::Bed { packing } => Some(packing),
+            FieldTask::Point { packing, .. } => Some(packing),
+        })
+        .collect();
+    beds.sort_unstable();
+    beds.dedup();
+    for k in beds {
+        let bed_task = &m.tasks[k];
+        let bed_file = dir.join(&bed_task.result);
+        if let Ok(bytes) = std::fs::read(&bed_file)
+            && let Err(e) = pdamp_io::checkpoint::verify_framing(&bytes)
+        {
+            eprintln!(
+                "warning: {} is damaged ({e}); preparing the bed of packing {k} again",
+                bed_file.display()
+            );
+            let _ = std::fs::remove_file(&bed_file);
+        }
+        let damper = field_damper(&sc, &m.base_dir, k, BedSource::Saved(dir), |_| {});
+        let points: Vec<usize> = indices
+            .iter()
+            .filter_map(|&i| match tasks[i] {
+                FieldTask::Point {
+                    packing,
+                    grid_index,
+                } if packing == k => Some(grid_index),
+                _ => None,
+            })
+            .collect();
+        let damper = match damper {
+            Ok(d) => {
+                let _ = std::fs::remove_file(dir.join(&bed_task.error));
+                d
+            }
+            Err(e) if e.starts_with("output:") => bail!("{e}"),
+            Err(e) => {
+                let msg = format!("the bed of packing {k} could not be prepared: {e}");
+                pdamp_io::atomic::write_atomic(dir.join(&bed_task.error), msg.as_bytes())?;
+                failed.push(format!("task {k} ({}): {msg}", bed_task.label));
+                continue;
+            }
+        };
+        if points.is_empty() {
+            continue;
+        }
+        let out = packing_dir(dir, packings, k);
+        let results = pdamp_design::fields::run_field_points(
+            &damper,
+            &grid,
+            &out,
+            &points,
+            pdamp_design::ThreadSplit::default(),
+        )
+        .map_err(anyhow::Error::msg)?;
+        for (g, r) in results {
+            match r {
+                Ok(true) => ran += 1,
+                Ok(false) => {}
+                Err(e) => {
+                    let t = tasks
+                        .iter()
+                        .position(|&t| {
+                            t == FieldTask::Point {
+                                packing: k,
+                                grid_index: g,
+                            }
+                        })
+                        .unwrap_or(0);
+                    failed.push(format!("task {t} ({}): {e}", m.tasks[t].label));
+                }
+            }
+        }
+    }
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "sweep": dir, "tasks": indices, "points_run": ran, "failed": failed,
+        }))?
+    );
+    if !failed.is_empty() {
+        bail!(
+            "{} of {} tasks failed (their errors are stored next to their slots; `pdamp sweep status {}` lists them)",
+            failed.len(),
+            indices.len(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Builds fields.csv, the maps and the bed statistics from the store of the sweep in `dir`.
+pub(crate) fn collect(dir: &Path) -> Result<()> {
+    let m = SweepManifest::load(dir)?;
+    let sc = load_scenario(dir, &m)?;
+    let mut out_dir = pdamp_io::output_dir::OutputDir::open(
+        dir,
+        pdamp_io::output_dir::OutputMode::Continue,
+        &crate::RUN_OUTPUTS,
+        &[],
+    )?;
+    let start = std::time::Instant::now();
+    let outcome = pdamp_design::report::run_fields_scenario_from(
+        &sc,
+        &m.base_dir,
+        dir,
+        pdamp_design::PointEngine::Stored,
+        BedSource::Saved(dir),
+        |_| {},
+        |_, _| {},
+    );
+    out_dir.set_outcome(&outcome);
+    out_dir.close()?;
+    let outcome = outcome.map_err(|e| {
+        anyhow::anyhow!(
+            "{e}\n`pdamp sweep status {0}` shows every task; `pdamp sweep resubmit {0}` runs the missing ones",
+            dir.display()
+        )
+    })?;
+    for (f, x, e) in &outcome.failed {
+        eprintln!("warning: point f = {f} Hz, X = {x:.4e} m failed (NaN in fields.csv): {e}");
+    }
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "sweep": dir,
+            "points": outcome.points.len(),
+            "failed_points": outcome.failed.iter().map(|(f, x, e)| serde_json::json!({
+                "frequency_hz": f, "amplitude_m": x, "error": e
+            })).collect::<Vec<_>>(),
+            "fields_csv": dir.join("fields.csv"),
+            "wall_time_s": start.elapsed().as_secs_f64(),
+        }))?
+    );
+    Ok(())
+}
