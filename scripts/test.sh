@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # All tests of the project (what CI runs, see README.md): Rust, the GPU kernels on a CPU Vulkan
-# driver, ParaView output read back by VTK. The GPU kernels' tests need a Vulkan
-# driver with 64-bit float shaders: on a machine without a GPU that is Mesa's lavapipe (CPU
-# Vulkan, Debian package mesa-vulkan-drivers), installed here when missing. Where lavapipe (or a
+# driver, ParaView output read back by VTK, sweeps submitted through a real local Slurm. The
+# GPU kernels' tests need a Vulkan driver with 64-bit float shaders: on a machine without a
+# GPU that is Mesa's lavapipe (CPU Vulkan, Debian package mesa-vulkan-drivers), installed here
+# when missing. Where lavapipe (or a
 # GPU) is present the GPU tests are required to run (PDAMP_REQUIRE_GPU_TESTS=1), not skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,6 +49,17 @@ fi
 if has_vtk; then
   export PDAMP_TEST_PYTHON="$PWD/$venv/bin/python"
   export PDAMP_REQUIRE_VTK_TESTS=1
+fi
+
+# A real one-node Slurm cluster on localhost for the sweep tests (crates/pdamp-cli/tests/
+# sweep_slurm.rs): Debian's slurm-wlm and munge, installed when missing, started here and
+# stopped when the tests end. Where it comes up the Slurm tests are required to run.
+if slurm_env=$(bash scripts/slurm-local.sh start); then
+  eval "$slurm_env"
+  export PDAMP_REQUIRE_SLURM_TESTS=1
+  trap 'bash scripts/slurm-local.sh stop' EXIT
+else
+  echo "WARNING: no Slurm cluster could be started: the Slurm sweep tests will be skipped" >&2
 fi
 
 # --release: the same build as the README's `cargo run --release` (built once, not twice; see

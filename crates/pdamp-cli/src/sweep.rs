@@ -322,6 +322,20 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scen
             })
             .collect(),
     };
+    // Another scenario's sweep in `out` is refused before anything there is touched.
+    if let Ok(existing) = SweepManifest::load(out)
+        && (existing.scenario_digest != manifest.scenario_digest
+            || existing.tasks != manifest.tasks)
+    {
+        return Err(pdamp_sweep::SweepError::OtherScenario {
+            dir: out.to_path_buf(),
+            existing: existing.scenario_source,
+            existing_digest: existing.scenario_digest,
+            new: manifest.scenario_source,
+            new_digest: manifest.scenario_digest,
+        }
+        .into());
+    }
     // A sweep writes into a directory another command may have used: refused as `fields`
     // refuses it (results of another kind of run), and an input file is never replaced.
     let inputs = crate::scenario_inputs(scenario, &sc);
@@ -438,7 +452,10 @@ pub(crate) fn submit(dir: &Path, args: &BackendArgs) -> Result<()> {
                 dir.display()
             );
         }
-        run_tasks(dir, &wanted)?;
+        let run = execute_tasks(dir, &wanted)?;
+        for f in &run.failed {
+            eprintln!("warning: {f}");
+        }
         pdamp_sweep::record_submission(
             dir,
             pdamp_sweep::Submission {
@@ -523,8 +540,8 @@ pub(crate) fn submit(dir: &Path, args: &BackendArgs) -> Result<()> {
 
 /// Runs the tasks `indices` of the sweep in `dir` here: beds first, then the points packing by
 /// packing on this process's threads. Each finished task is stored at once; a failed one
-/// leaves its error next to its slot. Fails (exit status ≠ 0) when a task failed.
-pub(crate) fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
+/// leaves its error next to its slot.
+fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
     let m = SweepManifest::load(dir)?;
     for &i in indices {
         m.task(dir, i)?;
@@ -610,6 +627,21 @@ pub(crate) fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
             }
         }
     }
+    Ok(TasksRun { ran, failed })
+}
+
+/// What [`execute_tasks`] did.
+struct TasksRun {
+    /// Points computed now (not those found finished).
+    ran: usize,
+    /// Failed tasks with their errors.
+    failed: Vec<String>,
+}
+
+/// `pdamp sweep task`: runs the tasks, prints what happened, fails when one failed (so that a
+/// Slurm array waiting for a bed is not started on a bed that failed).
+fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
+    let TasksRun { ran, failed } = execute_tasks(dir, indices)?;
     println!(
         "{}",
         serde_json::to_string_pretty(&serde_json::json!({
@@ -629,7 +661,33 @@ pub(crate) fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
 
 /// Builds fields.csv, the maps and the bed statistics from the store of the sweep in `dir`.
 pub(crate) fn collect(dir: &Path) -> Result<()> {
-    let m = SweepManifest::load(dir)?;
+    let (m, st) = states(dir)?;
+    let open: Vec<String> = m
+        .tasks
+        .iter()
+        .zip(&st)
+        .filter(|(_, s)| !matches!(s, TaskState::Done | TaskState::Failed(_)))
+        .map(|(t, s)| match s {
+            TaskState::Corrupt(e) => format!("task {} ({}): corrupt: {e}", t.index, t.label),
+            _ => format!("task {} ({}): {}", t.index, t.label, s.name()),
+        })
+        .collect();
+    if !open.is_empty() {
+        let counts: Vec<String> = pdamp_sweep::status::counts(&st)
+            .iter()
+            .filter(|(_, n)| *n > 0)
+            .map(|(k, n)| format!("{n} {k}"))
+            .collect();
+        bail!(
+            "{}: {} of {} tasks are not finished ({}): {}{}\n`pdamp sweep status {0}` shows every task; `pdamp sweep resubmit {0}` runs the missing ones",
+            dir.display(),
+            open.len(),
+            m.tasks.len(),
+            counts.join(", "),
+            open.iter().take(5).cloned().collect::<Vec<_>>().join("; "),
+            if open.len() > 5 { "; …" } else { "" }
+        );
+    }
     let sc = load_scenario(dir, &m)?;
     let mut out_dir = pdamp_io::output_dir::OutputDir::open(
         dir,

@@ -358,7 +358,10 @@ pub fn queue(job_ids: &[String]) -> Result<HashMap<(String, usize), QueueState>,
             "PENDING" | "REQUEUED" | "REQUEUE_HOLD" | "REQUEUE_FED" | "SUSPENDED" => {
                 QueueState::Pending
             }
-            _ => QueueState::Running,
+            "RUNNING" | "COMPLETING" | "CONFIGURING" | "RESIZING" | "SIGNALING" | "STAGE_OUT"
+            | "STOPPED" => QueueState::Running,
+            // Ended (completed, cancelled, failed, timed out, preempted …): the store tells.
+            _ => continue,
         };
         out.insert((job.trim().to_string(), element), state);
     }
