@@ -553,9 +553,8 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
     // The beds asked for, then those the points need.
     let mut beds: Vec<usize> = indices
         .iter()
-        .filter_map(|&i| match tasks[i] {
-            FieldTask::Bed { packing } => Some(packing),
-            FieldTask::Point { packing, .. } => Some(packing),
+        .map(|&i| match tasks[i] {
+            FieldTask::Bed { packing } | FieldTask::Point { packing, .. } => packing,
         })
         .collect();
     beds.sort_unstable();

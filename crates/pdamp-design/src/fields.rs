@@ -516,6 +516,10 @@ pub fn run_fields_on(
     })
 }
 
+/// Outcome of one point of [`run_field_points`]: `Ok(true)` computed now, `Ok(false)` found
+/// finished in the store, `Err` the error of a failed point (stored next to its slot).
+pub type PointRun = Result<bool, String>;
+
 /// Runs the grid points `indices` (positions in [`FieldGrid::points`], frequency-major) of the
 /// field stored in `out_dir` that are not finished yet — a task of a sweep — with the threads
 /// shared as `split` says, storing each point as it ends (its result, or its error next to its
@@ -527,7 +531,7 @@ pub fn run_field_points(
     out_dir: &Path,
     indices: &[usize],
     split: ThreadSplit,
-) -> Result<Vec<(usize, Result<bool, String>)>, String> {
+) -> Result<Vec<(usize, PointRun)>, String> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
     std::fs::create_dir_all(out_dir.join("points")).map_err(|e| format!("output: {e}"))?;
     let points = grid.points();
@@ -537,7 +541,7 @@ pub fn run_field_points(
             points.len()
         ));
     }
-    let mut out: Vec<(usize, Result<bool, String>)> = Vec::with_capacity(indices.len());
+    let mut out: Vec<(usize, PointRun)> = Vec::with_capacity(indices.len());
     let mut pending = Vec::new();
     for &k in indices {
         let (i, j, f, x) = points[k];

@@ -48,18 +48,19 @@ fn a_saved_prepared_bed_continues_bit_for_bit() {
     // The saved bed belongs to its scenario: another seed's packing, a changed material or a
     // damaged file is refused with the reason, never silently used.
     let other = pdamp_io::prepare::scenario_for_packing(&sc, 2);
-    let e = pdamp_io::prepare::load_prepared(&prepared_bed_path(&dir, 1), &other, &base)
-        .err()
-        .expect("another packing's scenario must be refused");
+    let Err(e) = pdamp_io::prepare::load_prepared(&prepared_bed_path(&dir, 1), &other, &base)
+    else {
+        panic!("another packing's scenario must be refused");
+    };
     assert!(e.contains("different scenario"), "{e}");
     let path = prepared_bed_path(&dir, 1);
     let mut bytes = std::fs::read(&path).unwrap();
     let mid = bytes.len() / 2;
     bytes[mid] ^= 0xff;
     std::fs::write(&path, &bytes).unwrap();
-    let e = field_damper(&sc, &base, 1, BedSource::Saved(&dir), |_| {})
-        .err()
-        .expect("a damaged bed must be refused");
+    let Err(e) = field_damper(&sc, &base, 1, BedSource::Saved(&dir), |_| {}) else {
+        panic!("a damaged bed must be refused");
+    };
     assert!(
         e.contains("damaged") && e.contains("packing_001.pdprep"),
         "{e}"

@@ -11,7 +11,7 @@
 //!   or preempted task loses nothing that was finished and a task that runs again skips what is
 //!   stored; a task that fails writes its error next to its slot;
 //! * `sweep/submissions.json` ([`Submission`]): what was submitted where (Slurm array jobs
-//!   and which tasks each array element runs), for [`status`](crate::status) and resubmission;
+//!   and which tasks each array element runs), for [`status`] and resubmission;
 //! * `sweep/slurm/*.sh` and `sweep/logs/` of the Slurm backend ([`slurm`]).
 //!
 //! The crate knows nothing of the physics: the command that owns a sweep kind builds the task
