@@ -43,6 +43,10 @@ enum PowderAction {
         packings: usize,
         #[command(flatten)]
         ck: CheckpointArgs,
+        /// `--backend slurm` (with --packings K): the packings as a sweep of Slurm array
+        /// jobs (docs/cluster.md).
+        #[command(flatten)]
+        backend: crate::sweep::BackendArgs,
     },
     /// One cantilever run per value of a parameter (paper Figs. 2–6, Table 1); writes
     /// DIR/<param>_<value>/…, DIR/table.csv, DIR/decay.png, DIR/envelope.png. Resumable.
@@ -65,6 +69,10 @@ enum PowderAction {
         packings: usize,
         #[command(flatten)]
         ck: CheckpointArgs,
+        /// `--backend slurm`: every run (value and packing) a task of a sweep of Slurm array
+        /// jobs (docs/cluster.md).
+        #[command(flatten)]
+        backend: crate::sweep::BackendArgs,
     },
     /// Eigenfrequencies of the empty beam of a scenario against Timoshenko beam theory.
     Modes {
@@ -74,6 +82,30 @@ enum PowderAction {
         #[arg(long, default_value_t = 4)]
         count: usize,
     },
+}
+
+/// The study parameter of a command-line choice.
+fn param_of(p: ParamArg) -> StudyParameter {
+    match p {
+        ParamArg::PackingDensity => StudyParameter::PackingDensity,
+        ParamArg::StiffnessFactor => StudyParameter::StiffnessFactor,
+        ParamArg::Friction => StudyParameter::Friction,
+        ParamArg::Restitution => StudyParameter::Restitution,
+        ParamArg::SurfaceEnergy => StudyParameter::SurfaceEnergy,
+        ParamArg::D50 => StudyParameter::D50,
+        ParamArg::Orientation => StudyParameter::Orientation,
+    }
+}
+
+/// A sweep continues by itself (every task resumes its checkpoint) and is started again by
+/// deleting its directory: `--resume` and `--overwrite` do not apply.
+fn refuse_with_slurm(ck: &CheckpointArgs) -> Result<()> {
+    if ck.resume || ck.overwrite {
+        return Err(anyhow!(
+            "--backend slurm continues a sweep in DIR by itself (`pdamp sweep resubmit DIR`); --resume and --overwrite do not apply (delete DIR to start again)"
+        ));
+    }
+    Ok(())
 }
 
 /// Checkpointing of `powder run` and of every run of `powder study`.
@@ -94,7 +126,7 @@ struct CheckpointArgs {
 }
 
 /// What `pdamp powder run` and `study` write (checked for links and inputs).
-const OUTPUTS: [&str; 16] = [
+pub(crate) const OUTPUTS: [&str; 16] = [
     "particles.pvd",
     "vtk",
     "tip.csv",
@@ -162,6 +194,58 @@ pub fn run(args: PowderArgs) -> Result<()> {
             out,
             packings,
             ck,
+            backend,
+        } if backend.backend == Some(crate::sweep::Backend::Slurm) => {
+            refuse_with_slurm(&ck)?;
+            if packings < 2 {
+                return Err(anyhow!(
+                    "--backend slurm runs the packings of an ensemble as a sweep: give --packings K (K ≥ 2); a single run is one job (`sbatch --wrap \"pdamp powder run …\"`)"
+                ));
+            }
+            bar.finish();
+            crate::sweep::create_powder(
+                &scenario,
+                &out,
+                crate::sweep::PowderSweep::Ensemble { packings },
+            )?;
+            crate::sweep::submit(&out, &backend)?;
+        }
+        PowderAction::Run { backend, .. } | PowderAction::Study { backend, .. }
+            if backend.any_slurm_option()
+                && backend.backend != Some(crate::sweep::Backend::Slurm) =>
+        {
+            return Err(anyhow!(
+                "the Slurm options (--partition, --throttle, …) need --backend slurm"
+            ));
+        }
+        PowderAction::Study {
+            scenario,
+            parameter,
+            values,
+            out,
+            packings,
+            ck,
+            backend,
+        } if backend.backend == Some(crate::sweep::Backend::Slurm) => {
+            refuse_with_slurm(&ck)?;
+            bar.finish();
+            crate::sweep::create_powder(
+                &scenario,
+                &out,
+                crate::sweep::PowderSweep::Study {
+                    parameter: param_of(parameter).name().to_string(),
+                    values,
+                    packings,
+                },
+            )?;
+            crate::sweep::submit(&out, &backend)?;
+        }
+        PowderAction::Run {
+            scenario,
+            out,
+            packings,
+            ck,
+            ..
         } if packings != 1 => {
             let sc = load(&scenario)?;
             let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
@@ -209,19 +293,12 @@ pub fn run(args: PowderArgs) -> Result<()> {
             out,
             packings,
             ck,
+            ..
         } => {
             let sc = load(&scenario)?;
             let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
             let options = ck.options()?;
-            let p = match parameter {
-                ParamArg::PackingDensity => StudyParameter::PackingDensity,
-                ParamArg::StiffnessFactor => StudyParameter::StiffnessFactor,
-                ParamArg::Friction => StudyParameter::Friction,
-                ParamArg::Restitution => StudyParameter::Restitution,
-                ParamArg::SurfaceEnergy => StudyParameter::SurfaceEnergy,
-                ParamArg::D50 => StudyParameter::D50,
-                ParamArg::Orientation => StudyParameter::Orientation,
-            };
+            let p = param_of(parameter);
             // A study continues its finished runs (each checked against its scenario).
             let mut dir = open_continuing(&out, ck, &scenario)?;
             let rows =

@@ -164,7 +164,7 @@ pub(crate) enum SweepCommand {
 pub(crate) fn dispatch(command: SweepCommand) -> Result<()> {
     match command {
         SweepCommand::New { scenario, out } => {
-            let (m, _) = create(&scenario, &out)?;
+            let m = create(&scenario, &out)?;
             println!(
                 "{}",
                 serde_json::to_string_pretty(&serde_json::json!({
@@ -183,25 +183,131 @@ pub(crate) fn dispatch(command: SweepCommand) -> Result<()> {
     }
 }
 
-/// The sweep's scenario, validated, with the directory its relative paths resolve against.
-fn load_scenario(dir: &Path, m: &SweepManifest) -> Result<Scenario> {
+/// Kind names of powder sweeps.
+const POWDER_STUDY_KIND: &str = "powder-study";
+const POWDER_ENSEMBLE_KIND: &str = "powder-ensemble";
+
+/// What a powder sweep runs besides its scenario (kept in the manifest's `parameters`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "command", rename_all = "snake_case")]
+pub(crate) enum PowderSweep {
+    /// `pdamp powder study`: one run per value (and packing).
+    Study {
+        /// [`pdamp_powder::study::StudyParameter::name`].
+        parameter: String,
+        /// Its values.
+        values: Vec<f64>,
+        /// Packings per value.
+        packings: usize,
+    },
+    /// `pdamp powder run --packings K`.
+    Ensemble {
+        /// K.
+        packings: usize,
+    },
+}
+
+impl PowderSweep {
+    fn kind(&self) -> &'static str {
+        match self {
+            PowderSweep::Study { .. } => POWDER_STUDY_KIND,
+            PowderSweep::Ensemble { .. } => POWDER_ENSEMBLE_KIND,
+        }
+    }
+
+    /// The runs below `dir`, in the order of the local command.
+    fn runs(
+        &self,
+        base: &pdamp_powder::cantilever::CantileverScenario,
+        dir: &Path,
+    ) -> Result<Vec<pdamp_powder::study::StudyRun>> {
+        let runs = match self {
+            PowderSweep::Study {
+                parameter,
+                values,
+                packings,
+            } => {
+                let p = pdamp_powder::study::StudyParameter::from_name(parameter)
+                    .with_context(|| format!("unknown study parameter '{parameter}'"))?;
+                pdamp_powder::study::study_runs(base, p, values, *packings, dir)
+            }
+            PowderSweep::Ensemble { packings } => {
+                pdamp_powder::study::ensemble_runs(base, *packings, dir)
+            }
+        };
+        runs.map_err(anyhow::Error::msg)
+    }
+}
+
+/// A sweep opened for work: its scenario (checked against the manifest's digest) and tasks.
+enum Opened {
+    Fields {
+        sc: Box<Scenario>,
+        tasks: Vec<FieldTask>,
+        grid: FieldGrid,
+        packings: usize,
+    },
+    Powder {
+        base: Box<pdamp_powder::cantilever::CantileverScenario>,
+        what: PowderSweep,
+        runs: Vec<pdamp_powder::study::StudyRun>,
+    },
+}
+
+/// Opens the sweep of manifest `m` in `dir`: reads its copy of the scenario and refuses when the
+/// scenario or a file it reads changed since the sweep was made.
+fn open(dir: &Path, m: &SweepManifest) -> Result<Opened> {
     let copy = dir.join(pdamp_sweep::SCENARIO_COPY);
     let text =
         std::fs::read_to_string(&copy).with_context(|| format!("reading {}", copy.display()))?;
-    let sc = Scenario::from_toml_in(&text, &m.base_dir)
-        .and_then(|s| s.validate().map(|_| s))
-        .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
-    let digest = pdamp_io::run::scenario_content_digest(&sc, &m.base_dir);
-    if digest != m.scenario_digest {
-        bail!(
+    let changed = |digest: &str| {
+        anyhow::anyhow!(
             "{}: the scenario or a file it reads (relative to {}) changed since the sweep was made (digest {} now, {} then); finished tasks would not match new ones — make a new sweep in another directory",
             dir.display(),
             m.base_dir.display(),
             digest,
             m.scenario_digest
-        );
+        )
+    };
+    match m.kind.as_str() {
+        FIELDS_KIND => {
+            let sc = Scenario::from_toml_in(&text, &m.base_dir)
+                .and_then(|s| s.validate().map(|_| s))
+                .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
+            let digest = pdamp_io::run::scenario_content_digest(&sc, &m.base_dir);
+            if digest != m.scenario_digest {
+                return Err(changed(&digest));
+            }
+            let (tasks, grid, packings) = field_tasks(&sc)?;
+            Ok(Opened::Fields {
+                sc: Box::new(sc),
+                tasks,
+                grid,
+                packings,
+            })
+        }
+        POWDER_STUDY_KIND | POWDER_ENSEMBLE_KIND => {
+            let base = pdamp_powder::cantilever::CantileverScenario::from_toml(&text)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
+            let digest =
+                pdamp_powder::cantilever::scenario_digest(&base).map_err(anyhow::Error::msg)?;
+            if digest != m.scenario_digest {
+                return Err(changed(&digest));
+            }
+            let what: PowderSweep = serde_json::from_value(m.parameters.clone())
+                .with_context(|| format!("{}: parameters", SweepManifest::path(dir).display()))?;
+            let runs = what.runs(&base, dir)?;
+            Ok(Opened::Powder {
+                base: Box::new(base),
+                what,
+                runs,
+            })
+        }
+        other => bail!(
+            "{}: a sweep of kind '{other}', which this pdamp does not know",
+            dir.display()
+        ),
     }
-    Ok(sc)
 }
 
 /// Output directory of packing `k` of a field with `packings` packings.
@@ -292,12 +398,11 @@ fn describe(
     }
 }
 
-/// Makes (or opens, when it is of the same scenario) the sweep of `scenario` in `out`.
-pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scenario)> {
+/// Makes (or opens, when it is of the same scenario) the field sweep of `scenario` in `out`.
+pub(crate) fn create(scenario: &Path, out: &Path) -> Result<SweepManifest> {
     let sc = Scenario::load(scenario)?;
     let (tasks, grid, packings) = field_tasks(&sc)?;
-    let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let source = abs(scenario);
+    let source = absolute(scenario);
     let base_dir = source.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let manifest = SweepManifest {
         format: pdamp_sweep::SWEEP_FORMAT,
@@ -307,6 +412,7 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scen
         scenario_source: source,
         scenario_digest: pdamp_io::run::scenario_content_digest(&sc, &base_dir),
         base_dir,
+        parameters: serde_json::Value::Null,
         tasks: tasks
             .iter()
             .enumerate()
@@ -322,9 +428,74 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scen
             })
             .collect(),
     };
-    // Another scenario's sweep in `out` is refused before anything there is touched.
+    let inputs = crate::scenario_inputs(scenario, &sc);
+    install(scenario, out, manifest, &inputs, &crate::RUN_OUTPUTS)
+}
+
+/// Makes (or opens) the sweep of a powder study or ensemble of `scenario` in `out`: one task
+/// per run (value and packing), each checkpointed in its own folder.
+pub(crate) fn create_powder(
+    scenario: &Path,
+    out: &Path,
+    what: PowderSweep,
+) -> Result<SweepManifest> {
+    let text = std::fs::read_to_string(scenario)
+        .with_context(|| format!("reading {}", scenario.display()))?;
+    let base = pdamp_powder::cantilever::CantileverScenario::from_toml(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+    let runs = what.runs(&base, Path::new(""))?;
+    let source = absolute(scenario);
+    let manifest = SweepManifest {
+        format: pdamp_sweep::SWEEP_FORMAT,
+        pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
+        kind: what.kind().into(),
+        title: source
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+        base_dir: source.parent().map(|p| p.to_path_buf()).unwrap_or_default(),
+        scenario_source: source,
+        scenario_digest: pdamp_powder::cantilever::scenario_digest(&base)
+            .map_err(anyhow::Error::msg)?,
+        parameters: serde_json::to_value(&what)?,
+        tasks: runs
+            .iter()
+            .enumerate()
+            .map(|(index, r)| Task {
+                index,
+                label: r.label.clone(),
+                needs: vec![],
+                result: r.dir.join("summary.json"),
+                error: r.dir.join("error.txt"),
+            })
+            .collect(),
+    };
+    install(
+        scenario,
+        out,
+        manifest,
+        &[scenario.to_path_buf()],
+        &crate::powder::OUTPUTS,
+    )
+}
+
+fn absolute(p: &Path) -> PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// Writes the sweep `manifest` of `scenario` into `out` (or opens the same sweep there); another
+/// scenario's sweep is refused before anything in `out` is touched, and so is a directory that
+/// another command's results or the command's inputs make unusable.
+fn install(
+    scenario: &Path,
+    out: &Path,
+    manifest: SweepManifest,
+    inputs: &[PathBuf],
+    outputs: &[&str],
+) -> Result<SweepManifest> {
     if let Ok(existing) = SweepManifest::load(out)
         && (existing.scenario_digest != manifest.scenario_digest
+            || existing.kind != manifest.kind
+            || existing.parameters != manifest.parameters
             || existing.tasks != manifest.tasks)
     {
         return Err(pdamp_sweep::SweepError::OtherScenario {
@@ -336,35 +507,31 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<(SweepManifest, Scen
         }
         .into());
     }
-    // A sweep writes into a directory another command may have used: refused as `fields`
-    // refuses it (results of another kind of run), and an input file is never replaced.
-    let inputs = crate::scenario_inputs(scenario, &sc);
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let mut outputs = outputs.to_vec();
+    outputs.extend(["sweep.json", "sweep"]);
     let dir = pdamp_io::output_dir::OutputDir::open(
         out,
         pdamp_io::output_dir::OutputMode::Continue,
-        &crate::RUN_OUTPUTS,
+        &outputs,
         &inputs,
     )?;
     let text = std::fs::read_to_string(scenario)?;
     let m = SweepManifest::create_or_open(out, manifest, &text)?;
     crate::copy_input(out, scenario)?;
     dir.close()?;
-    Ok((m, sc))
+    Ok(m)
 }
 
-/// What the store holds for task `t` of the sweep in `dir`.
-fn stored(dir: &Path, grid: &FieldGrid, packings: usize, ft: FieldTask, t: &Task) -> Stored {
+/// What the store holds for a task of a field sweep.
+fn stored_field(dir: &Path, grid: &FieldGrid, packings: usize, ft: FieldTask, t: &Task) -> Stored {
     match ft {
         FieldTask::Bed { .. } => match std::fs::read(dir.join(&t.result)) {
             Ok(bytes) => match pdamp_io::checkpoint::verify_framing(&bytes) {
                 Ok(()) => Stored::Done,
                 Err(e) => Stored::Corrupt(format!("{}: {e}", t.result.display())),
             },
-            Err(_) => match std::fs::read_to_string(dir.join(&t.error)) {
-                Ok(e) => Stored::Failed(e.trim().to_string()),
-                Err(_) => Stored::Missing,
-            },
+            Err(_) => stored_error(dir, t),
         },
         FieldTask::Point {
             packing,
@@ -381,24 +548,46 @@ fn stored(dir: &Path, grid: &FieldGrid, packings: usize, ft: FieldTask, t: &Task
     }
 }
 
+/// A task without a result: failed when it left an error file, else missing.
+fn stored_error(dir: &Path, t: &Task) -> Stored {
+    match std::fs::read_to_string(dir.join(&t.error)) {
+        Ok(e) => Stored::Failed(e.trim().to_string()),
+        Err(_) => Stored::Missing,
+    }
+}
+
+impl Opened {
+    /// What the store holds for task `t`.
+    fn stored(&self, dir: &Path, t: &Task) -> Stored {
+        match self {
+            Opened::Fields {
+                tasks,
+                grid,
+                packings,
+                ..
+            } => stored_field(dir, grid, *packings, tasks[t.index], t),
+            Opened::Powder { runs, .. } => match runs[t.index].finished() {
+                Ok(true) => Stored::Done,
+                Ok(false) => stored_error(dir, t),
+                Err(e) => Stored::Corrupt(e),
+            },
+        }
+    }
+}
+
 /// State of every task of the sweep in `dir` (the queue asked only when something was submitted
 /// to Slurm).
-fn states(dir: &Path) -> Result<(SweepManifest, Vec<TaskState>)> {
+fn states(dir: &Path) -> Result<(SweepManifest, Opened, Vec<TaskState>)> {
     let m = SweepManifest::load(dir)?;
-    let sc = load_scenario(dir, &m)?;
-    let (tasks, grid, packings) = field_tasks(&sc)?;
+    let opened = open(dir, &m)?;
     let submissions = pdamp_sweep::load_submissions(dir)?;
     let queued = pdamp_sweep::status::queued_tasks(&submissions)?;
-    let st = pdamp_sweep::status::task_states(
-        &m,
-        |t| stored(dir, &grid, packings, tasks[t.index], t),
-        &queued,
-    );
-    Ok((m, st))
+    let st = pdamp_sweep::status::task_states(&m, |t| opened.stored(dir, t), &queued);
+    Ok((m, opened, st))
 }
 
 fn status(dir: &Path, json: bool) -> Result<()> {
-    let (m, st) = states(dir)?;
+    let (m, _, st) = states(dir)?;
     if json {
         let counts: serde_json::Map<String, serde_json::Value> = pdamp_sweep::status::counts(&st)
             .iter()
@@ -430,7 +619,7 @@ fn status(dir: &Path, json: bool) -> Result<()> {
 /// Submits the unfinished tasks of the sweep in `dir` to the chosen backend.
 pub(crate) fn submit(dir: &Path, args: &BackendArgs) -> Result<()> {
     let backend = args.backend.unwrap_or(Backend::Slurm);
-    let (m, st) = states(dir)?;
+    let (m, _, st) = states(dir)?;
     let wanted: Vec<usize> = m
         .tasks
         .iter()
@@ -546,8 +735,52 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
     for &i in indices {
         m.task(dir, i)?;
     }
-    let sc = load_scenario(dir, &m)?;
-    let (tasks, grid, packings) = field_tasks(&sc)?;
+    match open(dir, &m)? {
+        Opened::Fields {
+            sc,
+            tasks,
+            grid,
+            packings,
+        } => execute_field_tasks(dir, &m, &sc, &tasks, &grid, packings, indices),
+        Opened::Powder { runs, .. } => {
+            let mut run = TasksRun {
+                ran: 0,
+                failed: Vec::new(),
+            };
+            // One run after the other, each on all threads of the task; checkpointed in its
+            // folder, so a requeued or resubmitted task continues where it was stopped.
+            for &i in indices {
+                let task = &m.tasks[i];
+                match runs[i].run(60.0, &mut |_, _| {}) {
+                    Ok(ran) => {
+                        run.ran += usize::from(ran);
+                        let _ = std::fs::remove_file(dir.join(&task.error));
+                    }
+                    Err(e) if e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => bail!("{e}"),
+                    Err(e) => {
+                        if let Some(parent) = dir.join(&task.error).parent() {
+                            std::fs::create_dir_all(parent)?;
+                        }
+                        pdamp_io::atomic::write_atomic(dir.join(&task.error), e.as_bytes())?;
+                        run.failed.push(format!("task {i} ({}): {e}", task.label));
+                    }
+                }
+            }
+            Ok(run)
+        }
+    }
+}
+
+/// [`execute_tasks`] of a field sweep.
+fn execute_field_tasks(
+    dir: &Path,
+    m: &SweepManifest,
+    sc: &Scenario,
+    tasks: &[FieldTask],
+    grid: &FieldGrid,
+    packings: usize,
+    indices: &[usize],
+) -> Result<TasksRun> {
     let mut failed: Vec<String> = Vec::new();
     let mut ran = 0usize;
     // The beds asked for, then those the points need.
@@ -571,7 +804,7 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
             );
             let _ = std::fs::remove_file(&bed_file);
         }
-        let damper = field_damper(&sc, &m.base_dir, k, BedSource::Saved(dir), |_| {});
+        let damper = field_damper(sc, &m.base_dir, k, BedSource::Saved(dir), |_| {});
         let points: Vec<usize> = indices
             .iter()
             .filter_map(|&i| match tasks[i] {
@@ -601,7 +834,7 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
         let out = packing_dir(dir, packings, k);
         let results = pdamp_design::fields::run_field_points(
             &damper,
-            &grid,
+            grid,
             &out,
             &points,
             pdamp_design::ThreadSplit::default(),
@@ -644,7 +877,7 @@ fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
     println!(
         "{}",
         serde_json::to_string_pretty(&serde_json::json!({
-            "sweep": dir, "tasks": indices, "points_run": ran, "failed": failed,
+            "sweep": dir, "tasks": indices, "tasks_run": ran, "failed": failed,
         }))?
     );
     if !failed.is_empty() {
@@ -660,7 +893,7 @@ fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
 
 /// Builds fields.csv, the maps and the bed statistics from the store of the sweep in `dir`.
 pub(crate) fn collect(dir: &Path) -> Result<()> {
-    let (m, st) = states(dir)?;
+    let (m, opened, st) = states(dir)?;
     let open: Vec<String> = m
         .tasks
         .iter()
@@ -687,7 +920,10 @@ pub(crate) fn collect(dir: &Path) -> Result<()> {
             if open.len() > 5 { "; …" } else { "" }
         );
     }
-    let sc = load_scenario(dir, &m)?;
+    let sc = match opened {
+        Opened::Fields { sc, .. } => sc,
+        Opened::Powder { base, what, .. } => return collect_powder(dir, &base, &what),
+    };
     let mut out_dir = pdamp_io::output_dir::OutputDir::open(
         dir,
         pdamp_io::output_dir::OutputMode::Continue,
@@ -726,6 +962,57 @@ pub(crate) fn collect(dir: &Path) -> Result<()> {
             "fields_csv": dir.join("fields.csv"),
             "wall_time_s": start.elapsed().as_secs_f64(),
         }))?
+    );
+    Ok(())
+}
+
+/// Collects a powder study or ensemble: the tables, plots and ensemble statistics of the local
+/// command, read from the finished runs.
+fn collect_powder(
+    dir: &Path,
+    base: &pdamp_powder::cantilever::CantileverScenario,
+    what: &PowderSweep,
+) -> Result<()> {
+    let mut out_dir = pdamp_io::output_dir::OutputDir::open(
+        dir,
+        pdamp_io::output_dir::OutputMode::Continue,
+        &crate::powder::OUTPUTS,
+        &[],
+    )?;
+    // Every run is finished (checked above): nothing runs, everything is read back.
+    let options = pdamp_powder::cantilever::RunOptions {
+        checkpoint_interval_s: 0.0,
+        resume: false,
+    };
+    let result: Result<serde_json::Value, String> = match what {
+        PowderSweep::Study {
+            parameter,
+            values,
+            packings,
+        } => pdamp_powder::study::StudyParameter::from_name(parameter)
+            .ok_or_else(|| format!("unknown study parameter '{parameter}'"))
+            .and_then(|p| {
+                pdamp_powder::study::run_study_packings(
+                    base,
+                    p,
+                    values,
+                    *packings,
+                    dir,
+                    options,
+                    &mut |_, _| {},
+                )
+            })
+            .map(|rows| serde_json::to_value(rows).unwrap_or_default()),
+        PowderSweep::Ensemble { packings } => {
+            pdamp_powder::study::run_ensemble(base, *packings, dir, options, &mut |_, _| {})
+                .map(|e| serde_json::to_value(e).unwrap_or_default())
+        }
+    };
+    out_dir.set_outcome(&result);
+    out_dir.close()?;
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&result.map_err(anyhow::Error::msg)?)?
     );
     Ok(())
 }

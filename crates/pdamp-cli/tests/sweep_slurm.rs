@@ -561,3 +561,81 @@ fn arrays_are_chunked_and_an_unknown_partition_is_refused_by_slurm() {
 fn pdamp_sweep_submissions() -> &'static str {
     "sweep/submissions.json"
 }
+
+/// The powder study as a sweep (one task per value and packing, each checkpointed in its
+/// folder): through Slurm it collects to the table and ensemble statistics of the local
+/// `pdamp powder study` (timing columns aside).
+#[test]
+fn a_powder_study_through_slurm_equals_the_local_run() {
+    if !slurm() {
+        return;
+    }
+    let scenario = examples().join("powder_cantilever_small.toml");
+    let args = [
+        "--parameter",
+        "friction",
+        "--values",
+        "0.3",
+        "--packings",
+        "2",
+    ];
+    let local = temp("powder-local");
+    ok(&pdamp()
+        .args(["--quiet", "powder", "study"])
+        .arg(&scenario)
+        .args(args)
+        .arg("--out")
+        .arg(&local)
+        .output()
+        .unwrap());
+    let swept = temp("powder-slurm");
+    let v = ok(&pdamp()
+        .args(["powder", "study"])
+        .arg(&scenario)
+        .args(args)
+        .arg("--out")
+        .arg(&swept)
+        .args(["--backend", "slurm", "--cpus-per-task", "1"])
+        .output()
+        .unwrap());
+    assert_eq!(v["submitted_tasks"], 2, "{v}");
+    let s = wait_idle(&swept);
+    assert_eq!(count(&s, "done"), 2, "{s}");
+    ok(&pdamp()
+        .args(["sweep", "collect"])
+        .arg(&swept)
+        .output()
+        .unwrap());
+    let table = |d: &Path| -> Vec<String> {
+        std::fs::read_to_string(d.join("table.csv"))
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let cols: Vec<&str> = l.split(',').collect();
+                // the last three columns are wall times
+                cols[..cols.len() - 3].join(",")
+            })
+            .collect()
+    };
+    assert_eq!(table(&local), table(&swept));
+    assert_eq!(table(&local).len(), 3);
+    assert_eq!(
+        std::fs::read_to_string(local.join("ensemble.csv")).unwrap(),
+        std::fs::read_to_string(swept.join("ensemble.csv")).unwrap()
+    );
+    // --resume/--overwrite and a single run are refused with the reason.
+    let e = failed(
+        &pdamp()
+            .args(["powder", "run"])
+            .arg(&scenario)
+            .arg("--out")
+            .arg(temp("powder-single"))
+            .args(["--backend", "slurm"])
+            .output()
+            .unwrap(),
+    );
+    assert!(e.contains("give --packings K"), "{e}");
+    for d in [local, swept] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}

@@ -45,6 +45,22 @@ pub enum StudyParameter {
 }
 
 impl StudyParameter {
+    /// Every parameter, in the order of the paper's figures.
+    pub const ALL: [StudyParameter; 7] = [
+        Self::PackingDensity,
+        Self::StiffnessFactor,
+        Self::Friction,
+        Self::Restitution,
+        Self::SurfaceEnergy,
+        Self::D50,
+        Self::Orientation,
+    ];
+
+    /// The parameter with this [`StudyParameter::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// Name used in file names.
     pub fn name(&self) -> &'static str {
         match self {
@@ -401,6 +417,126 @@ fn ensemble_line(value: f64, e: &PowderEnsemble) -> [f64; 11] {
     ]
 }
 
+/// One run of a study or an ensemble — what a task of a sweep runs (issue 27): the value of the
+/// varied parameter, the packing, the scenario with both applied, its folder and a label.
+#[derive(Debug, Clone)]
+pub struct StudyRun {
+    /// Value of the varied parameter (an ensemble: the packing index).
+    pub value: f64,
+    /// Packing index.
+    pub packing: usize,
+    /// The scenario of this run.
+    pub scenario: CantileverScenario,
+    /// Its folder (summary.json, tip.csv, … when finished; checkpoint.bin while running).
+    pub dir: PathBuf,
+    /// For people (`packing_density = 0.6, packing 1`).
+    pub label: String,
+}
+
+/// The runs of [`run_study_packings`] in its order (values, then packings), with their folders
+/// below `out`; every value is applied (and checked) here.
+pub fn study_runs(
+    base: &CantileverScenario,
+    param: StudyParameter,
+    values: &[f64],
+    packings: usize,
+    out: &Path,
+) -> Result<Vec<StudyRun>, String> {
+    if values.is_empty() {
+        return Err("--values: give at least one value".into());
+    }
+    if packings == 0 {
+        return Err("--packings must be at least 1".into());
+    }
+    let mut runs = Vec::with_capacity(values.len() * packings);
+    for &v in values {
+        let sc = param.apply(base, v)?;
+        let dir = out.join(format!("{}_{}", param.name(), v));
+        let label = format!("{} = {v}", param.name());
+        if packings == 1 {
+            runs.push(StudyRun {
+                value: v,
+                packing: 0,
+                scenario: sc,
+                dir,
+                label,
+            });
+        } else {
+            for k in 0..packings {
+                runs.push(StudyRun {
+                    value: v,
+                    packing: k,
+                    scenario: with_packing(&sc, k)?,
+                    dir: packing_dir(&dir, k),
+                    label: format!("{label}, packing {k}"),
+                });
+            }
+        }
+    }
+    Ok(runs)
+}
+
+/// The runs of [`run_ensemble`]: packing k in `out/packing_KKK/`.
+pub fn ensemble_runs(
+    base: &CantileverScenario,
+    packings: usize,
+    out: &Path,
+) -> Result<Vec<StudyRun>, String> {
+    if packings < 2 {
+        return Err(format!(
+            "--packings: an ensemble needs at least 2 packings, got {packings}"
+        ));
+    }
+    (0..packings)
+        .map(|k| {
+            Ok(StudyRun {
+                value: k as f64,
+                packing: k,
+                scenario: with_packing(base, k)?,
+                dir: packing_dir(out, k),
+                label: format!("packing {k}"),
+            })
+        })
+        .collect()
+}
+
+impl StudyRun {
+    /// Whether its folder holds the finished results of its scenario (`Ok(false)`: nothing,
+    /// or an interrupted run of it); a folder of another scenario or an unreadable summary is
+    /// an error that names it.
+    pub fn finished(&self) -> Result<bool, String> {
+        let digest = cantilever::scenario_digest(&self.scenario)?;
+        check_run_dir(&self.dir, &digest).map_err(|e| e.to_string())
+    }
+
+    /// Runs it in its folder unless finished, continuing an interrupted run from its checkpoint
+    /// (written every `checkpoint_interval_s` and on SIGTERM, so a preempted or cancelled task
+    /// loses at most that much).
+    pub fn run(
+        &self,
+        checkpoint_interval_s: f64,
+        progress: &mut dyn FnMut(&str, f64),
+    ) -> Result<bool, String> {
+        if self.finished()? {
+            return Ok(false);
+        }
+        let resume = self
+            .dir
+            .join(pdamp_io::checkpoint::CHECKPOINT_FILE)
+            .is_file();
+        cantilever::run_in_dir(
+            &self.scenario,
+            &self.dir,
+            cantilever::RunOptions {
+                checkpoint_interval_s,
+                resume,
+            },
+            progress,
+        )?;
+        Ok(true)
+    }
+}
+
 /// One planned run: scenario, folder, whether it has finished, its label.
 struct PlannedRun {
     value: f64,
@@ -535,31 +671,10 @@ pub fn run_study_packings(
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<Vec<StudyRow>, String> {
     // every value is validated and every existing run directory checked before any run
-    if values.is_empty() {
-        return Err("--values: give at least one value".into());
-    }
-    if packings == 0 {
-        return Err("--packings must be at least 1".into());
-    }
-    let mut plan = Vec::with_capacity(values.len() * packings);
-    for &v in values {
-        let sc = param.apply(base, v)?;
-        let dir = out.join(format!("{}_{}", param.name(), v));
-        let label = format!("{} = {v}", param.name());
-        if packings == 1 {
-            plan.push(plan_run(v, 0, sc, dir, label)?);
-        } else {
-            for k in 0..packings {
-                plan.push(plan_run(
-                    v,
-                    k,
-                    with_packing(&sc, k)?,
-                    packing_dir(&dir, k),
-                    format!("{label}, packing {k}"),
-                )?);
-            }
-        }
-    }
+    let plan = study_runs(base, param, values, packings, out)?
+        .into_iter()
+        .map(|r| plan_run(r.value, r.packing, r.scenario, r.dir, r.label))
+        .collect::<Result<Vec<_>, _>>()?;
     let rows = run_planned(plan, out, options, progress)?;
     let mut header = vec![param.name()];
     if packings > 1 {
@@ -609,24 +724,12 @@ pub fn run_ensemble(
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<PowderEnsemble, String> {
-    if packings < 2 {
-        return Err(format!(
-            "--packings: an ensemble needs at least 2 packings, got {packings}"
-        ));
-    }
-    let mut plan = Vec::with_capacity(packings);
-    let mut seeds = Vec::with_capacity(packings);
-    for k in 0..packings {
-        let sc = with_packing(base, k)?;
-        seeds.push(seed_of(&sc));
-        plan.push(plan_run(
-            k as f64,
-            k,
-            sc,
-            packing_dir(out, k),
-            format!("packing {k}"),
-        )?);
-    }
+    let runs = ensemble_runs(base, packings, out)?;
+    let seeds: Vec<u64> = runs.iter().map(|r| seed_of(&r.scenario)).collect();
+    let plan = runs
+        .into_iter()
+        .map(|r| plan_run(r.value, r.packing, r.scenario, r.dir, r.label))
+        .collect::<Result<Vec<_>, _>>()?;
     let rows = run_planned(plan, out, options, progress)?;
     let mut header = vec!["packing"];
     header.extend(TABLE_COLUMNS);

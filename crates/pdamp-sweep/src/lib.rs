@@ -135,6 +135,10 @@ pub struct SweepManifest {
     /// Digest of the scenario and of the content of every file it reads: a task refuses to run
     /// when they changed since the sweep was made.
     pub scenario_digest: String,
+    /// What the kind needs besides the scenario to rebuild its tasks (a study's parameter,
+    /// values and packings); `null` for a field.
+    #[serde(default)]
+    pub parameters: serde_json::Value,
     /// The tasks.
     pub tasks: Vec<Task>,
 }
@@ -189,6 +193,7 @@ impl SweepManifest {
             Ok(existing) => {
                 if existing.scenario_digest != manifest.scenario_digest
                     || existing.kind != manifest.kind
+                    || existing.parameters != manifest.parameters
                     || existing.tasks != manifest.tasks
                 {
                     return Err(SweepError::OtherScenario {

@@ -190,6 +190,7 @@ mod tests {
             scenario_source: PathBuf::from("/a.toml"),
             base_dir: PathBuf::from("/"),
             scenario_digest: "d".into(),
+            parameters: serde_json::Value::Null,
             tasks: (0..n)
                 .map(|i| Task {
                     index: i,
