@@ -577,17 +577,28 @@ impl Opened {
 
 /// State of every task of the sweep in `dir` (the queue asked only when something was submitted
 /// to Slurm).
-fn states(dir: &Path) -> Result<(SweepManifest, Opened, Vec<TaskState>)> {
+/// Without `strict`, a queue that cannot be asked (no Slurm client on this machine) is a
+/// warning and queued tasks show as missing; with it (before submitting) it is an error.
+fn states(dir: &Path, strict: bool) -> Result<(SweepManifest, Opened, Vec<TaskState>)> {
     let m = SweepManifest::load(dir)?;
     let opened = open(dir, &m)?;
     let submissions = pdamp_sweep::load_submissions(dir)?;
-    let queued = pdamp_sweep::status::queued_tasks(&submissions)?;
+    let queued = match pdamp_sweep::status::queued_tasks(&submissions) {
+        Ok(q) => q,
+        Err(e) if !strict => {
+            eprintln!(
+                "warning: cannot ask Slurm's queue ({e}); tasks queued or running there show as missing"
+            );
+            Default::default()
+        }
+        Err(e) => return Err(e.into()),
+    };
     let st = pdamp_sweep::status::task_states(&m, |t| opened.stored(dir, t), &queued);
     Ok((m, opened, st))
 }
 
 fn status(dir: &Path, json: bool) -> Result<()> {
-    let (m, _, st) = states(dir)?;
+    let (m, _, st) = states(dir, false)?;
     if json {
         let counts: serde_json::Map<String, serde_json::Value> = pdamp_sweep::status::counts(&st)
             .iter()
@@ -619,7 +630,7 @@ fn status(dir: &Path, json: bool) -> Result<()> {
 /// Submits the unfinished tasks of the sweep in `dir` to the chosen backend.
 pub(crate) fn submit(dir: &Path, args: &BackendArgs) -> Result<()> {
     let backend = args.backend.unwrap_or(Backend::Slurm);
-    let (m, _, st) = states(dir)?;
+    let (m, _, st) = states(dir, true)?;
     let wanted: Vec<usize> = m
         .tasks
         .iter()
@@ -832,12 +843,24 @@ fn execute_field_tasks(
             continue;
         }
         let out = packing_dir(dir, packings, k);
+        let start = std::time::Instant::now();
         let results = pdamp_design::fields::run_field_points(
             &damper,
             grid,
             &out,
             &points,
             pdamp_design::ThreadSplit::default(),
+            |g, r| {
+                let (_, _, f, x) = grid.points()[g];
+                eprintln!(
+                    "[{:.0} s] packing {k}: point f = {f} Hz, X = {x:.4e} m {}",
+                    start.elapsed().as_secs_f64(),
+                    match r {
+                        Ok(_) => "finished".to_string(),
+                        Err(e) => format!("failed: {e}"),
+                    }
+                )
+            },
         )
         .map_err(anyhow::Error::msg)?;
         for (g, r) in results {
@@ -893,7 +916,7 @@ fn run_tasks(dir: &Path, indices: &[usize]) -> Result<()> {
 
 /// Builds fields.csv, the maps and the bed statistics from the store of the sweep in `dir`.
 pub(crate) fn collect(dir: &Path) -> Result<()> {
-    let (m, opened, st) = states(dir)?;
+    let (m, opened, st) = states(dir, false)?;
     let open: Vec<String> = m
         .tasks
         .iter()

@@ -523,14 +523,16 @@ pub type PointRun = Result<bool, String>;
 /// Runs the grid points `indices` (positions in [`FieldGrid::points`], frequency-major) of the
 /// field stored in `out_dir` that are not finished yet — a task of a sweep — with the threads
 /// shared as `split` says, storing each point as it ends (its result, or its error next to its
-/// slot). Returns, per index, `Ok(true)` when it ran, `Ok(false)` when it was already finished,
-/// or the error of a failed point; an `output:` error or an interruption ends the call.
+/// slot) and telling `on_point(index, outcome)`. Returns, per index, `Ok(true)` when it ran,
+/// `Ok(false)` when it was already finished, or the error of a failed point; an `output:`
+/// error or an interruption ends the call.
 pub fn run_field_points(
     damper: &Damper,
     grid: &FieldGrid,
     out_dir: &Path,
     indices: &[usize],
     split: ThreadSplit,
+    on_point: impl Fn(usize, &Result<PointResult, String>) + Sync,
 ) -> Result<Vec<(usize, PointRun)>, String> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
     std::fs::create_dir_all(out_dir.join("points")).map_err(|e| format!("output: {e}"))?;
@@ -554,7 +556,9 @@ pub fn run_field_points(
     let particles = damper.settled.particles.len();
     let ran = run_split(&pending, split, particles, |k| {
         let (i, j, f, x) = points[k];
-        store_point(out_dir, i, j, damper.run_point(f, x, &mut ()))
+        let r = store_point(out_dir, i, j, damper.run_point(f, x, &mut ()));
+        on_point(k, &r);
+        r
     });
     for (k, r) in ran {
         match r {
