@@ -850,6 +850,13 @@ fn execute_field_tasks(
             &out,
             &points,
             pdamp_design::ThreadSplit::default(),
+            Some(&pdamp_design::fields::PointCheckpoints {
+                scenario_digest: pdamp_io::run::scenario_content_digest(
+                    &pdamp_io::prepare::scenario_for_packing(sc, k),
+                    &m.base_dir,
+                ),
+                interval_s: 60.0,
+            }),
             |g, r| {
                 let (_, _, f, x) = grid.points()[g];
                 eprintln!(

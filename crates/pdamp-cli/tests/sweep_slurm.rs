@@ -219,9 +219,24 @@ fn a_field_through_slurm_equals_the_local_run_also_after_scancel_and_resubmit() 
     }
     let running = status(&cancelled);
     assert!(count(&running, "running") >= 1, "{running}");
+    // Into its first point (≈ 2 s each): SIGTERM saves the point in progress.
+    std::thread::sleep(Duration::from_millis(1000));
     let o = Command::new("scancel").arg(&element).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s = wait_idle(&cancelled);
+    let checkpoints = |d: &Path| -> Vec<PathBuf> {
+        std::fs::read_dir(d.join("points"))
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "ckpt"))
+            .collect()
+    };
+    // The point in progress was checkpointed (when the signal came after it started; it is
+    // continued from there by the resubmission and gives the same numbers).
+    eprintln!(
+        "points saved in progress by scancel: {:?}",
+        checkpoints(&cancelled)
+    );
     let missing = count(&s, "missing");
     assert!(
         (1..=3).contains(&missing),
@@ -261,6 +276,10 @@ fn a_field_through_slurm_equals_the_local_run_also_after_scancel_and_resubmit() 
     assert_eq!(v["submitted_tasks"].as_u64().unwrap(), missing, "{v}");
     let s = wait_idle(&cancelled);
     assert_eq!(count(&s, "done"), 10, "{s}");
+    assert!(
+        checkpoints(&cancelled).is_empty(),
+        "a finished point leaves no checkpoint"
+    );
     for (p, t) in finished {
         assert_eq!(
             std::fs::metadata(&p).unwrap().modified().unwrap(),

@@ -516,6 +516,24 @@ pub fn run_fields_on(
     })
 }
 
+/// Checkpoints inside the points of [`run_field_points`]: every `interval_s` of wall-clock
+/// time and on SIGTERM (a cancelled or preempted Slurm task) the point in progress is saved
+/// next to its slot (`points/fIII_aJJJ.ckpt`); the next run of the point continues from it and
+/// gives the result of an uninterrupted run.
+#[derive(Debug, Clone)]
+pub struct PointCheckpoints {
+    /// Digest of the packing's scenario and the files it reads
+    /// ([`pdamp_io::run::scenario_content_digest`]): a checkpoint of another scenario is refused.
+    pub scenario_digest: String,
+    /// Wall-clock seconds between checkpoints (≤ 0: only on a stop request).
+    pub interval_s: f64,
+}
+
+/// Checkpoint file of a point in progress (see [`PointCheckpoints`]).
+pub fn point_checkpoint_path(dir: &Path, i: usize, j: usize) -> PathBuf {
+    dir.join("points").join(format!("f{i:03}_a{j:03}.ckpt"))
+}
+
 /// Outcome of one point of [`run_field_points`]: `Ok(true)` computed now, `Ok(false)` found
 /// finished in the store, `Err` the error of a failed point (stored next to its slot).
 pub type PointRun = Result<bool, String>;
@@ -532,6 +550,7 @@ pub fn run_field_points(
     out_dir: &Path,
     indices: &[usize],
     split: ThreadSplit,
+    checkpoints: Option<&PointCheckpoints>,
     on_point: impl Fn(usize, &Result<PointResult, String>) + Sync,
 ) -> Result<Vec<(usize, PointRun)>, String> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
@@ -556,7 +575,45 @@ pub fn run_field_points(
     let particles = damper.settled.particles.len();
     let ran = run_split(&pending, split, particles, |k| {
         let (i, j, f, x) = points[k];
-        let r = store_point(out_dir, i, j, damper.run_point(f, x, &mut ()));
+        if pdamp_io::checkpoint::stop_requested() {
+            // Stopped (SIGTERM of a cancelled task): the points not started stay missing.
+            return Err(pdamp_io::checkpoint::INTERRUPTED.to_string());
+        }
+        let r = match checkpoints {
+            None => damper.run_point(f, x, &mut ()),
+            Some(c) => {
+                let path = point_checkpoint_path(out_dir, i, j);
+                let run = |resume: bool| {
+                    damper.run_point_checkpointed(
+                        f,
+                        x,
+                        &mut (),
+                        Some(&crate::damper::PointCheckpointing {
+                            resume,
+                            path: path.clone(),
+                            scenario_digest: c.scenario_digest.clone(),
+                            interval_s: c.interval_s,
+                        }),
+                    )
+                };
+                let resume = path.is_file();
+                let mut r = run(resume);
+                // A checkpoint that cannot be continued (damaged, foreign) costs the point its
+                // progress, not its result: it starts again.
+                if resume
+                    && let Err(e) = &r
+                    && e.starts_with("checkpoint")
+                {
+                    let _ = std::fs::remove_file(&path);
+                    r = run(false);
+                }
+                if r.is_ok() {
+                    let _ = std::fs::remove_file(&path);
+                }
+                r
+            }
+        };
+        let r = store_point(out_dir, i, j, r);
         on_point(k, &r);
         r
     });
