@@ -1,7 +1,11 @@
-//! `pdamp sweep …` and `pdamp fields --backend slurm`: an effective field (with its packings)
-//! as a sweep of independent tasks — one per packing's bed, one per grid point and packing —
-//! run here or as Slurm array jobs, and collected into exactly the outputs of a local
-//! `pdamp fields` run (see [`pdamp_sweep`] and docs/cluster.md).
+//! `pdamp sweep …`, `pdamp fields --backend slurm` and `pdamp powder study|run --backend
+//! slurm`: a grid of independent simulations as a sweep of tasks run here or as Slurm array
+//! jobs, collected into exactly the outputs of the local command (see [`pdamp_sweep`] and
+//! docs/cluster.md). Kinds:
+//! * `fields` — an effective field with its packings: one task per packing's bed (prepared
+//!   and saved once), one per grid point and packing (checkpointed inside the point);
+//! * `powder-study`, `powder-ensemble` — one task per coupled DEM–FEM run (value and packing),
+//!   checkpointed in its folder.
 
 use anyhow::{Context, Result, bail};
 use pdamp_design::FieldGrid;
@@ -350,23 +354,19 @@ fn field_tasks(sc: &Scenario) -> Result<(Vec<FieldTask>, FieldGrid, usize)> {
     Ok((tasks, grid, packings))
 }
 
+/// Label, the tasks it needs, and its result and error files (relative to the sweep directory)
+/// of a task of a field sweep.
 fn describe(
     grid: &FieldGrid,
     packings: usize,
     t: FieldTask,
 ) -> (String, Vec<usize>, PathBuf, PathBuf) {
-    let rel = |p: PathBuf, dir: &Path| p.strip_prefix(dir).map(|r| r.to_path_buf()).unwrap_or(p);
     let root = Path::new("");
     match t {
         FieldTask::Bed { packing } => {
             let result = prepared_bed_path(root, packing);
             let error = result.with_extension("error.txt");
-            (
-                format!("bed of packing {packing}"),
-                vec![],
-                rel(result, root),
-                error,
-            )
+            (format!("bed of packing {packing}"), vec![], result, error)
         }
         FieldTask::Point {
             packing,
