@@ -387,6 +387,50 @@ fn local_backend_damaged_store_other_scenario_and_no_slurm_are_clear() {
             .collect()
     };
     assert_eq!(strip(&csv), strip(&again), "wall_time_s is the last column");
+    // A point that failed (its error stored next to its slot, as a task writes it): status
+    // shows the message, collect gives its NaN row and names it, resubmit runs it again.
+    let point = dir.join("points/f000_a000.json");
+    let result = std::fs::read(&point).unwrap();
+    std::fs::remove_file(&point).unwrap();
+    std::fs::write(
+        dir.join("points/f000_a000.error.txt"),
+        "unstable: particle 7 left the container",
+    )
+    .unwrap();
+    let s = status(&dir);
+    assert_eq!(count(&s, "failed"), 1, "{s}");
+    assert!(
+        s.to_string().contains("particle 7 left the container"),
+        "{s}"
+    );
+    let o = pdamp()
+        .args(["sweep", "collect"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let v = ok(&o);
+    assert_eq!(v["failed_points"].as_array().unwrap().len(), 1, "{v}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("particle 7 left the container"));
+    let nan_row = std::fs::read_to_string(dir.join("fields.csv")).unwrap();
+    let row = nan_row.lines().nth(1).unwrap();
+    assert!(row.starts_with("160,") && row.contains("NaN"), "{row}");
+    let v = ok(&pdamp()
+        .args(["--quiet", "sweep", "resubmit"])
+        .arg(&dir)
+        .args(["--backend", "local"])
+        .output()
+        .unwrap());
+    assert!(v["failed_points"].as_array().unwrap().is_empty(), "{v}");
+    assert!(!dir.join("points/f000_a000.error.txt").exists());
+    let without_time = |b: &[u8]| {
+        let mut v: Value = serde_json::from_slice(b).unwrap();
+        v["wall_time_s"] = Value::Null;
+        v
+    };
+    assert_eq!(
+        without_time(&std::fs::read(&point).unwrap()),
+        without_time(&result)
+    );
     // A damaged bed file: status says so; a task prepares the bed again.
     let bed = dir.join("beds/packing_000.pdprep");
     let mut bytes = std::fs::read(&bed).unwrap();
