@@ -234,14 +234,30 @@ mod tests {
         assert!((z - 0.055).abs() < 0.0006, "{z}");
         let u = optimal_base_amplitude_m(1.058, 0.147, 0.012);
         assert!((u - 1.34e-3).abs() < 0.01e-3, "{u}");
-        let zd = 0.196 / (4.0 * 1.108);
-        assert!((bed_mass_for_damping(1.108, zd, 0.5) - 0.196).abs() < 1e-12);
+        // Eq. 5.15 against the dissertation's stated pairs (not against its own inverse):
+        // 196 g give ζ_d = 0.046 on M = 1.058 kg and 0.025 on 2.0 kg (D L2365, L2373; the
+        // text rounds ζ_d, hence ≈ 1–2 %), and ζ_d = 0.044 on 1.108 kg (D Sect. 6.2).
+        for (m, zd, tol) in [
+            (1.058, 0.046, 0.01),
+            (2.0, 0.025, 0.025),
+            (1.108, 0.044, 0.01),
+        ] {
+            let bed = bed_mass_for_damping(m, zd, 0.5);
+            assert!((bed / 0.196 - 1.0).abs() < tol, "M = {m}: m_bed = {bed}");
+        }
         // Eq. 3.51 with φ² = 1/M equals Eq. 3.52 when m̄ = m_bed.
         let a = damping_ratio_modal(1.0 / 1.058f64.sqrt(), 0.149, 0.149, 0.91);
         assert!((a - damping_ratio_single_mode(1.058, 0.149, 0.91)).abs() < 1e-15);
-        // Eq. 5.21 and 5.22 are inverse to each other.
-        let x = optimal_resonance_amplitude_m(0.3, 1.058, 143.0, 0.147);
-        let m = optimal_bed_mass_kg(0.3, 1.058, 143.0, x).unwrap();
-        assert!((m - 0.147).abs() < 1e-12);
+        // Eq. 5.21 and 5.22 with the dissertation's forced-vibration design (D L2504–L2522):
+        // K = 143 N/m, M = 1.058 kg, 147 g, the drive U_opt = 1.34 mm (R' = U K) reaches the
+        // optimal stroke X_opt = 12 mm, and a 12 mm target asks for the 147 g bed (the
+        // quoted U_opt is rounded to 0.01 mm: ≈ 1 %).
+        let r = 1.34e-3 * 143.0;
+        let x = optimal_resonance_amplitude_m(r, 1.058, 143.0, 0.147);
+        assert!((x / 12e-3 - 1.0).abs() < 0.01, "X = {x}");
+        let m = optimal_bed_mass_kg(r, 1.058, 143.0, 12e-3).unwrap();
+        assert!((m / 0.147 - 1.0).abs() < 0.01, "m_bed = {m}");
+        // Beyond the reach of the drive (20 K X ≤ 7π R') no bed is large enough.
+        assert!(optimal_bed_mass_kg(r, 1.058, 143.0, 0.5e-3).is_none());
     }
 }
