@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # All tests of the project (what CI runs, see README.md): Rust, the GPU kernels on a CPU Vulkan
-# driver, ParaView output read back by VTK, sweeps submitted through a real local Slurm. The
-# GPU kernels' tests need a Vulkan driver with 64-bit float shaders: on a machine without a
-# GPU that is Mesa's lavapipe (CPU Vulkan, Debian package mesa-vulkan-drivers), installed here
-# when missing. Where lavapipe (or a
-# GPU) is present the GPU tests are required to run (PDAMP_REQUIRE_GPU_TESTS=1), not skipped.
+# driver, ParaView output read back by VTK, sweeps submitted through a real local Slurm, and the
+# Python package with pytest. The GPU kernels' tests need a Vulkan driver with 64-bit float
+# shaders: on a machine without a GPU that is Mesa's lavapipe (CPU Vulkan, Debian package
+# mesa-vulkan-drivers), installed here when missing. Where lavapipe (or a GPU) is present the
+# GPU tests are required to run (PDAMP_REQUIRE_GPU_TESTS=1), not skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 have_vulkan() {
@@ -66,6 +66,22 @@ fi
 # the profiles in Cargo.toml). The test harnesses keep debug assertions ([profile.bench]).
 status=0
 cargo test --release --workspace --no-fail-fast "$@" || status=$?
+# The Python package (python/, the PyO3 extension crates/pdamp-py): built into a virtual
+# environment with maturin (reusing this build's artifacts) and tested with pytest against the
+# `pdamp` binary of the same build.
+pyvenv=target/py-venv
+if ! "$pyvenv/bin/python" -c "import maturin, pytest, numpy, pandas" >/dev/null 2>&1; then
+  echo "making $pyvenv (pip install -r python/requirements-test.txt)"
+  rm -rf "$pyvenv"
+  python3 -m venv "$pyvenv" && "$pyvenv/bin/pip" install -q -r python/requirements-test.txt || status=1
+fi
+if [ -x "$pyvenv/bin/maturin" ]; then
+  (cd python && VIRTUAL_ENV="$PWD/../$pyvenv" PATH="$PWD/../$pyvenv/bin:$PATH" maturin develop --release --quiet) \
+    && PDAMP_BIN="$PWD/target/release/pdamp" "$pyvenv/bin/pytest" -q python/tests || status=$?
+else
+  echo "ERROR: no Python environment with maturin: the Python package was not tested" >&2
+  status=1
+fi
 # Lints are part of the tests: clippy with every warning an error (issue 30).
 cargo clippy --release --workspace --all-targets -- -D warnings || status=$?
 # … and the API documentation builds without a warning (broken links, unclosed tags).

@@ -1,0 +1,115 @@
+"""Tests of the Python package against the command line (issue 28).
+
+`PDAMP_BIN` names the `pdamp` binary of the same build (scripts/test.sh sets it); the results
+of the library called from Python must equal the command line's, every number but the timing.
+"""
+
+import json
+import math
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pdamp
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "examples"
+SMALL = EXAMPLES / "damper_cylinder_small.toml"
+BIN = os.environ.get("PDAMP_BIN", str(ROOT / "target" / "release" / "pdamp"))
+
+
+def cli(*args):
+    r = subprocess.run([BIN, "--quiet", *map(str, args)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+def same(a, b, path=""):
+    """Equal to the bit, timing fields aside."""
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            if "wall_time" not in k:
+                same(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            same(x, y, f"{path}[{i}]")
+    elif isinstance(a, float) and math.isnan(a):
+        assert isinstance(b, float) and math.isnan(b), path
+    else:
+        assert a == b, f"{path}: {a!r} != {b!r}"
+
+
+def test_version_is_the_crates():
+    cargo = (ROOT / "Cargo.toml").read_text()
+    version = cargo.split("[workspace.package]")[1].split('version = "')[1].split('"')[0]
+    assert pdamp.__version__ == version
+
+
+def test_a_scenario_round_trips_through_a_dict_and_toml():
+    sc = pdamp.load(SMALL)
+    assert sc.title.startswith("small cylinder damper")
+    d = sc.to_dict()
+    assert d["particles"][0]["count"] == 300
+    again = pdamp.Scenario.from_dict(d, base_dir=sc.base_dir)
+    assert again.to_toml() == sc.to_toml()
+    assert pdamp.Scenario.from_toml(sc.to_toml(), base_dir=sc.base_dir).to_dict() == d
+    # a change made in the dict is the scenario's
+    d["damper"]["cycles"] = 5
+    assert pdamp.Scenario.from_dict(d, base_dir=sc.base_dir).to_dict()["damper"]["cycles"] == 5
+
+
+def test_a_bad_key_or_value_raises_scenario_error_naming_it():
+    d = pdamp.load(SMALL).to_dict()
+    d["simulation"]["time_stepp_s"] = 1e-6
+    with pytest.raises(pdamp.ScenarioError, match="time_stepp_s"):
+        pdamp.Scenario.from_dict(d)
+    d = pdamp.load(SMALL).to_dict()
+    d["simulation"]["time_step_s"] = -1.0
+    with pytest.raises(pdamp.ScenarioError, match=r"simulation\.time_step_s"):
+        pdamp.Scenario.from_dict(d)
+    with pytest.raises(pdamp.ScenarioError, match="line"):
+        pdamp.Scenario.from_toml('title = "x"\n[simulation]\nduration_s = -1.0\ntime_step_s = 1e-6\n')
+    assert issubclass(pdamp.ScenarioError, ValueError)
+    with pytest.raises(TypeError, match="simulation.seed"):
+        pdamp.Scenario.from_dict({"simulation": {"seed": object()}})
+
+
+def test_a_damper_point_equals_the_command_lines_summary(tmp_path):
+    cli("run", SMALL, "--out", tmp_path / "cli")
+    want = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    got = pdamp.damper_point(pdamp.load(SMALL), tmp_path / "py", threads=2)
+    same(got, want)
+    assert 0.0 < got["effective_loss_factor"] < 4.0 / math.pi
+    # another excitation given from Python is the command line's option
+    cli("run", SMALL, "--out", tmp_path / "cli2", "--frequency-hz", "120", "--intensity", "5")
+    want = json.loads((tmp_path / "cli2" / "summary.json").read_text())
+    got = pdamp.damper_point(pdamp.load(SMALL), tmp_path / "py2", frequency_hz=120.0, intensity=5.0)
+    same(got, want)
+
+
+def test_fields_are_a_dataframe_equal_to_the_command_lines_fields_csv(tmp_path):
+    pd = pytest.importorskip("pandas")
+    text = SMALL.read_text()
+    text = text.replace(
+        'frequencies_hz = { from = 40.0, to = 160.0, count = 3, spacing = "log" }', "frequencies_hz = [160.0]"
+    ).replace('intensities = { from = 2.0, to = 20.0, count = 3, spacing = "log" }', "intensities = [5.0, 20.0]")
+    assert "frequencies_hz = [160.0]" in text
+    scenario = tmp_path / "tiny.toml"
+    scenario.write_text(text)
+    cli("fields", scenario, "--out", tmp_path / "cli")
+    want = pd.read_csv(tmp_path / "cli" / "fields.csv", dtype=float)
+    df = pdamp.fields(pdamp.load(scenario), tmp_path / "py")
+    assert isinstance(df, pd.DataFrame)
+    assert list(df.columns) == list(want.columns)
+    assert len(df) == 2
+    cols = [c for c in df.columns if c != "wall_time_s"]
+    # read back by pandas from text (17 significant digits) and returned by the library: equal
+    pd.testing.assert_frame_equal(df[cols], want[cols], check_exact=True)
+    arrays = pdamp.fields(pdamp.load(scenario), tmp_path / "py", as_frame=False)
+    assert isinstance(arrays["effective_loss_factor"], np.ndarray)
+    assert arrays["effective_loss_factor"].dtype == np.float64
