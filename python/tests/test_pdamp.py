@@ -113,3 +113,41 @@ def test_fields_are_a_dataframe_equal_to_the_command_lines_fields_csv(tmp_path):
     arrays = pdamp.fields(pdamp.load(scenario), tmp_path / "py", as_frame=False)
     assert isinstance(arrays["effective_loss_factor"], np.ndarray)
     assert arrays["effective_loss_factor"].dtype == np.float64
+
+
+def test_the_gil_is_released_and_ctrl_c_stops_a_run(tmp_path):
+    import signal
+    import threading
+    import time
+
+    sc = pdamp.load(SMALL)
+    # Another Python thread runs while a damper point computes (the GIL is released).
+    ticks = []
+    done = threading.Event()
+
+    def run():
+        pdamp.damper_point(sc, tmp_path / "bg", threads=1)
+        done.set()
+
+    t = threading.Thread(target=run)
+    t.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+        time.sleep(0.01)
+    t.join()
+    assert len(ticks) > 50, len(ticks)
+    full = ticks[-1] - ticks[0]
+
+    # Ctrl-C (SIGINT to this process) stops the run: KeyboardInterrupt, sooner than a whole run.
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        pdamp.damper_point(sc, tmp_path / "stopped", threads=1)
+    stopped = time.perf_counter() - start
+    timer.join()
+    assert stopped < full, (stopped, full)
+    # The next run is not stopped by the old request and gives the same numbers.
+    again = pdamp.damper_point(sc, tmp_path / "again", threads=1)
+    first = json.loads((tmp_path / "bg" / "summary.json").read_text())
+    same(again, first)

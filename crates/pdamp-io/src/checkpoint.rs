@@ -57,6 +57,12 @@ impl Drop for StoppableSection {
     }
 }
 
+/// Withdraws a stop request once the stopped run has returned, so that the next run in the same
+/// process (a Python session after Ctrl-C) is not stopped at once.
+pub fn clear_stop() {
+    STOP.store(false, Ordering::SeqCst);
+}
+
 /// True once [`request_stop`] was called.
 pub fn stop_requested() -> bool {
     STOP.load(Ordering::Relaxed)

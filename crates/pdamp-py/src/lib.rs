@@ -1,7 +1,8 @@
 //! The extension module `pdamp._pdamp` of the Python package `pdamp` (issue 28): scenarios
 //! read, built from Python dicts, validated with the messages of the command line
 //! ([`ScenarioError`] with the key and its line), and the damper level — one excitation point,
-//! effective fields — run on the library (not on the CLI binary) with the GIL released.
+//! effective fields — run on the library (not on the CLI binary) with the GIL released and
+//! Ctrl-C turned into a clean stop (`KeyboardInterrupt`).
 //! The Python side (`python/pdamp/__init__.py`) turns the JSON results into dicts, numpy arrays
 //! and pandas DataFrames.
 
@@ -195,7 +196,10 @@ impl PyScenario {
 }
 
 /// Runs `f` on a pool of `threads` threads (all cores when `None`) with the GIL released; an
-/// error of the library becomes a `RuntimeError`, Ctrl-C a `KeyboardInterrupt`.
+/// error of the library becomes a `RuntimeError`. Python's signals are checked every 50 ms while
+/// it runs: Ctrl-C (KeyboardInterrupt, in a notebook the stop button) asks the run to stop at its
+/// next check ([`pdamp_io::checkpoint::request_stop`]), waits for it, and raises the
+/// KeyboardInterrupt.
 fn detached<T: Send>(
     py: Python<'_>,
     threads: Option<usize>,
@@ -205,14 +209,28 @@ fn detached<T: Send>(
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    let r = py.detach(|| pool.install(f));
-    r.map_err(|e| {
-        if e.starts_with(pdamp_io::checkpoint::INTERRUPTED) {
-            pyo3::exceptions::PyKeyboardInterrupt::new_err(e)
-        } else {
-            PyRuntimeError::new_err(e)
+    let mut signal: Option<PyErr> = None;
+    let r = std::thread::scope(|s| {
+        let run = s.spawn(|| pool.install(f));
+        while !run.is_finished() {
+            py.detach(|| std::thread::sleep(std::time::Duration::from_millis(50)));
+            if signal.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                pdamp_io::checkpoint::request_stop();
+                signal = Some(e);
+            }
         }
-    })
+        run.join()
+    });
+    if let Some(e) = signal {
+        pdamp_io::checkpoint::clear_stop();
+        return Err(e);
+    }
+    match r {
+        Ok(r) => r.map_err(PyRuntimeError::new_err),
+        Err(_) => Err(PyRuntimeError::new_err("the simulation panicked")),
+    }
 }
 
 /// One excitation point of a damper scenario (`pdamp run DAMPER.toml --out OUT`): prepares the
