@@ -12,9 +12,9 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use pdamp_impact::study::{CorModel, cor_curve_with};
+use pdamp_impact::study::{CorError, CorModel, check_cor_request, checked_cor_curve};
 use pdamp_impact::{FeOptions, MaterialSet, MeshDensity, Partner};
 use pdamp_plot::{Axis, LinePlot, Marker, Series, line_plot};
 
@@ -56,11 +56,6 @@ pub struct CorArgs {
     overwrite: bool,
 }
 
-/// Most impact velocities of one `pdamp cor`.
-const MAX_VELOCITIES: usize = 1000;
-/// Most repeated impacts per velocity.
-const MAX_REPEAT: usize = 100;
-
 #[derive(Clone, Copy, ValueEnum)]
 enum ModelArg {
     Fe,
@@ -74,6 +69,14 @@ enum MeshArg {
     Coarse,
     Medium,
     Fine,
+}
+
+/// A library error as the command line says it: the input by its flag.
+fn flag_error(e: CorError) -> anyhow::Error {
+    match e.key {
+        "result" => anyhow::anyhow!("{}", e.message),
+        key => anyhow::anyhow!("--{} {}", key.replace('_', "-"), e.message),
+    }
 }
 
 /// Runs `pdamp cor`.
@@ -93,38 +96,6 @@ pub fn run(a: CorArgs) -> Result<()> {
     } else {
         Partner::Wall(set.get(&a.wall)?)
     };
-    if !(a.sphere_radius_m > 0.0 && a.sphere_radius_m <= 1.0) {
-        bail!(
-            "--sphere-radius-m must lie in (0, 1] m, got {}; check the unit",
-            a.sphere_radius_m
-        );
-    }
-    let mut vs = a.velocities_m_s.clone();
-    if let Some(v) = vs.iter().find(|v| !(**v > 0.0 && **v <= 1000.0)) {
-        bail!(
-            "--velocities-m-s must all lie in (0, 1000] m/s (the models are quasi-static: far below the speed of sound), got {v}"
-        );
-    }
-    if vs.len() > MAX_VELOCITIES {
-        bail!(
-            "--velocities-m-s: {} velocities, at most {MAX_VELOCITIES}",
-            vs.len()
-        );
-    }
-    if !(1..=MAX_REPEAT).contains(&a.repeat) {
-        bail!("--repeat must lie in 1..={MAX_REPEAT}, got {}", a.repeat);
-    }
-    if !(a.thornton_pressure_factor.is_finite()
-        && a.thornton_pressure_factor >= 1.0
-        && a.thornton_pressure_factor <= 10.0)
-    {
-        bail!(
-            "--thornton-pressure-factor must lie in [1, 10] (p_y/σ_y; 1.6 = first yield), got {}",
-            a.thornton_pressure_factor
-        );
-    }
-    vs.sort_by(f64::total_cmp);
-    vs.dedup();
     let density = match a.mesh {
         MeshArg::Coarse => MeshDensity::Coarse,
         MeshArg::Medium => MeshDensity::Medium,
@@ -138,6 +109,9 @@ pub fn run(a: CorArgs) -> Result<()> {
         },
         ModelArg::Viscoelastic => CorModel::Viscoelastic,
     };
+    // Checked before the output directory is opened: a bad input leaves nothing behind.
+    let vs = check_cor_request(a.sphere_radius_m, &a.velocities_m_s, model, a.repeat)
+        .map_err(flag_error)?;
     let inputs: Vec<&std::path::Path> = a.materials.as_deref().into_iter().collect();
     let mut dir = crate::open_out(
         &a.out,
@@ -157,43 +131,18 @@ pub fn run(a: CorArgs) -> Result<()> {
     )?;
     let start = std::time::Instant::now();
     let bar = crate::progress::Progress::new();
-    let pts = cor_curve_with(
+    let pts = checked_cor_curve(
         &sphere,
         &partner,
         a.sphere_radius_m,
-        &vs,
+        &a.velocities_m_s,
         model,
         a.repeat,
         &|done, total| bar.count("impacts", done, total),
     );
     bar.finish();
-    if let Some((p, why)) = pts.iter().find_map(|p| {
-        p.fe.as_ref()
-            .and_then(|r| r.failure.as_ref())
-            .map(|w| (p, w))
-    }) {
-        bail!(
-            "FE impact at v = {} m/s (impact {}) failed: {why}",
-            p.velocity_m_s,
-            p.impact
-        );
-    }
-    // A model outside its range gives ε outside [0, 1] or no number: said, not written.
-    if let Some(p) = pts.iter().find(|p| {
-        !(p.restitution.is_finite()
-            && (0.0..=1.0 + 1e-9).contains(&p.restitution)
-            && p.contact_time_s.is_finite()
-            && p.max_force_n.is_finite())
-    }) {
-        bail!(
-            "the impact model gave ε = {}, contact time {} s, peak force {} N at v = {} m/s (impact {}): outside its range of validity for this sphere and these materials; check --sphere-radius-m, the velocities and the material data",
-            p.restitution,
-            p.contact_time_s,
-            p.max_force_n,
-            p.velocity_m_s,
-            p.impact
-        );
-    }
+    // The library names the input; the command line prints it as its flag.
+    let pts = pts.map_err(flag_error)?;
     let elapsed = start.elapsed().as_secs_f64();
 
     let first: Vec<_> = pts.iter().filter(|p| p.impact == 1).collect();

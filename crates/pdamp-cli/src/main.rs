@@ -7,11 +7,10 @@
 // as DIR/<param>_<value>), written for the terminal, not for rustdoc.
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use pdamp_dem::Material;
-use pdamp_dem::contact::NormalLaw;
-use pdamp_dem::impact::{ImpactSetup, Partner, head_on_impact};
+use pdamp_dem::impact::{ImpactLaw, ImpactRequest, Partner, checked_head_on_impact};
 use std::path::PathBuf;
 
 mod cor;
@@ -497,90 +496,29 @@ fn dispatch(command: Command) -> Result<()> {
             stiffness_n_m,
             velocity_m_s,
         } => {
-            let material =
-                Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio);
-            material.validate().map_err(anyhow::Error::msg)?;
-            if !(radius_m > 0.0 && radius_m <= 1.0) {
-                bail!("--radius-m must lie in (0, 1] m, got {radius_m}; check the unit");
-            }
-            if !(velocity_m_s > 0.0 && velocity_m_s <= 1000.0) {
-                bail!("--velocity-m-s must lie in (0, 1000] m/s, got {velocity_m_s}");
-            }
-            if !(restitution > 0.0 && restitution <= 1.0) {
-                bail!("--restitution must lie in (0, 1], got {restitution}");
-            }
-            if let Some(k) = stiffness_n_m
-                && !(k.is_finite() && k > 0.0)
-            {
-                bail!("--stiffness-n-m must be a finite stiffness > 0 N/m, got {k}");
-            }
-            let partner = match partner {
-                PartnerArg::Wall => Partner::Wall,
-                PartnerArg::Sphere => Partner::Sphere,
-            };
-            let normal = match law {
-                LawArg::Hertz => NormalLaw::Hertz,
-                LawArg::Gonthier => NormalLaw::Gonthier {
-                    restitution,
-                    min_impact_velocity_m_s: 1e-3,
+            let req = ImpactRequest {
+                partner: match partner {
+                    PartnerArg::Wall => Partner::Wall,
+                    PartnerArg::Sphere => Partner::Sphere,
                 },
-                LawArg::LankaraniNikravesh => NormalLaw::LankaraniNikravesh {
-                    restitution,
-                    min_impact_velocity_m_s: 1e-3,
-                },
-                LawArg::HertzMindlin => NormalLaw::HertzMindlin {
-                    restitution,
-                    clip_attractive: false,
-                },
-                LawArg::Linear => {
-                    let k = stiffness_n_m.unwrap_or_else(|| {
-                        pdamp_dem::impact::hertz_equivalent_linear_stiffness(
-                            partner,
-                            radius_m,
-                            &material,
-                            velocity_m_s,
-                        )
-                    });
-                    NormalLaw::Linear {
-                        stiffness_n_m: k,
-                        restitution,
-                        clip_attractive: false,
-                    }
-                }
-            };
-            let model = pdamp_dem::ContactModel {
-                normal: normal.clone(),
-                friction: Default::default(),
-                rolling: None,
-                adhesion: None,
-            };
-            model.validate().map_err(anyhow::Error::msg)?;
-            let r = head_on_impact(&ImpactSetup {
-                partner,
                 radius_m,
-                material,
-                normal,
+                material: Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio),
+                law: match law {
+                    LawArg::Hertz => ImpactLaw::Hertz,
+                    LawArg::Gonthier => ImpactLaw::Gonthier,
+                    LawArg::LankaraniNikravesh => ImpactLaw::LankaraniNikravesh,
+                    LawArg::Linear => ImpactLaw::Linear,
+                    LawArg::HertzMindlin => ImpactLaw::HertzMindlin,
+                },
+                restitution,
+                stiffness_n_m,
                 velocity_m_s,
-                steps_per_contact: 2000.0,
-            });
-            let v = serde_json::to_value(r)?;
-            if let Some(bad) = v.as_object().and_then(|o| {
-                o.iter()
-                    .find(|(_, x)| x.is_null() || x.as_f64().is_some_and(|x| !x.is_finite()))
-            }) {
-                bail!(
-                    "the impact gave {} = {}: no contact was resolved for these inputs; check the radius, the material data and the velocity",
-                    bad.0,
-                    bad.1
-                );
-            }
-            if let Some(e) = v.get("restitution").and_then(|e| e.as_f64())
-                && !(0.0..=1.0 + 1e-6).contains(&e)
-            {
-                bail!(
-                    "the impact gave ε = {e}, outside [0, 1]: the contact was not resolved (time step or stiffness out of range for these inputs)"
-                );
-            }
+            };
+            // The library names the input; the command line prints it as its flag.
+            let r = checked_head_on_impact(&req).map_err(|e| match e.key {
+                "result" | "material" => anyhow!("{}", e.message),
+                key => anyhow!("--{} {}", key.replace('_', "-"), e.message),
+            })?;
             println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())
         }

@@ -95,6 +95,34 @@ impl PrescribedMotion for HarmonicTranslation {
     }
 }
 
+/// A body moved from outside one step at a time (a user's own structure model, Python's
+/// `World.drive_body`): the translation of the reference point relative to its reference
+/// position, known at `t1_s` with its velocity and acceleration and extrapolated
+/// quadratically around it, $u(t) = u_1 + v_1 s + \tfrac12 a_1 s^2$, $s = t - t_1$ (the
+/// explicit coupling of D Sect. 3.3 evaluates the container at the end of the step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TranslationTrack {
+    /// Time the state below belongs to, s.
+    pub t1_s: f64,
+    /// Displacement $u_1$ from the reference position, m.
+    pub displacement_m: Vec3,
+    /// Velocity $v_1$, m/s.
+    pub velocity_m_s: Vec3,
+    /// Acceleration $a_1$, m/s².
+    pub acceleration_m_s2: Vec3,
+}
+
+impl PrescribedMotion for TranslationTrack {
+    fn offset(&self, t_s: f64) -> BodyState {
+        let s = t_s - self.t1_s;
+        let mut b = BodyState::at_rest(
+            self.displacement_m + self.velocity_m_s * s + self.acceleration_m_s2 * (0.5 * s * s),
+        );
+        b.velocity_m_s = self.velocity_m_s + self.acceleration_m_s2 * s;
+        b
+    }
+}
+
 /// How a rigid body moves.
 #[derive(Debug, Clone)]
 pub enum Motion {

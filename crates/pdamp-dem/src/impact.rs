@@ -156,3 +156,188 @@ pub fn hertz_equivalent_linear_stiffness(
     let d = hertz::hertz_max_overlap(k_n, m_eff, velocity_m_s);
     k_n * d.sqrt()
 }
+
+/// Normal law of a checked single impact ([`ImpactRequest`]), by the names `pdamp impact
+/// --law` and Python's `pdamp.impact(law=…)` take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImpactLaw {
+    /// Elastic Hertz [D Eq. 2.69, 2.70].
+    Hertz,
+    /// Gonthier et al. with a restitution [D Eq. 2.78, 2.79].
+    Gonthier,
+    /// Lankarani–Nikravesh with a restitution [D Eq. 2.77].
+    LankaraniNikravesh,
+    /// Linear spring–dashpot with a restitution [P Eq. (2)–(4)].
+    Linear,
+    /// Hertz–Mindlin with the LIGGGHTS damping of a restitution.
+    HertzMindlin,
+}
+
+impl ImpactLaw {
+    /// Every law with its name.
+    pub const ALL: [(&'static str, ImpactLaw); 5] = [
+        ("hertz", ImpactLaw::Hertz),
+        ("gonthier", ImpactLaw::Gonthier),
+        ("lankarani-nikravesh", ImpactLaw::LankaraniNikravesh),
+        ("linear", ImpactLaw::Linear),
+        ("hertz-mindlin", ImpactLaw::HertzMindlin),
+    ];
+
+    /// The law of a name (`hertz`, `gonthier`, `lankarani-nikravesh`, `linear`,
+    /// `hertz-mindlin`; `_` for `-` accepted).
+    pub fn from_name(name: &str) -> Option<Self> {
+        let n = name.to_ascii_lowercase().replace('_', "-");
+        Self::ALL.iter().find(|(k, _)| *k == n).map(|(_, l)| *l)
+    }
+}
+
+/// A single head-on impact as a user asks for it: every input checked before the run, and a
+/// result that resolves no contact refused ([`checked_head_on_impact`]).
+#[derive(Debug, Clone)]
+pub struct ImpactRequest {
+    /// Partner of the sphere.
+    pub partner: Partner,
+    /// Sphere radius, m.
+    pub radius_m: f64,
+    /// Material of sphere and partner.
+    pub material: Material,
+    /// Normal law.
+    pub law: ImpactLaw,
+    /// Coefficient of restitution of the dissipative laws.
+    pub restitution: f64,
+    /// Stiffness of the linear law, N/m (default: the Hertz secant stiffness at the peak
+    /// overlap, [`hertz_equivalent_linear_stiffness`]).
+    pub stiffness_n_m: Option<f64>,
+    /// Relative normal impact velocity, m/s.
+    pub velocity_m_s: f64,
+}
+
+/// A bad input of an [`ImpactRequest`] or an impact that resolved no contact; `key` names the
+/// input (`radius_m`, `velocity_m_s`, …; `result` for the outcome) so that the command line
+/// can print its flag and Python its keyword.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpactError {
+    /// The input at fault (or `result`).
+    pub key: &'static str,
+    /// What is wrong, without the key.
+    pub message: String,
+}
+
+impl std::fmt::Display for ImpactError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.key == "result" || self.key == "material" {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "{} {}", self.key, self.message)
+        }
+    }
+}
+
+impl std::error::Error for ImpactError {}
+
+/// Checks `req`, runs the impact (2 000 steps per Hertz contact time) and checks that a contact
+/// was resolved (every number finite, ε in [0, 1]).
+pub fn checked_head_on_impact(req: &ImpactRequest) -> Result<ImpactResult, ImpactError> {
+    let bad = |key, message: String| Err(ImpactError { key, message });
+    if let Err(m) = req.material.validate() {
+        return bad("material", m);
+    }
+    if !(req.radius_m > 0.0 && req.radius_m <= 1.0) {
+        return bad(
+            "radius_m",
+            format!("must lie in (0, 1] m, got {}; check the unit", req.radius_m),
+        );
+    }
+    if !(req.velocity_m_s > 0.0 && req.velocity_m_s <= 1000.0) {
+        return bad(
+            "velocity_m_s",
+            format!("must lie in (0, 1000] m/s, got {}", req.velocity_m_s),
+        );
+    }
+    if !(req.restitution > 0.0 && req.restitution <= 1.0) {
+        return bad(
+            "restitution",
+            format!("must lie in (0, 1], got {}", req.restitution),
+        );
+    }
+    if let Some(k) = req.stiffness_n_m
+        && !(k.is_finite() && k > 0.0)
+    {
+        return bad(
+            "stiffness_n_m",
+            format!("must be a finite stiffness > 0 N/m, got {k}"),
+        );
+    }
+    let restitution = req.restitution;
+    let normal = match req.law {
+        ImpactLaw::Hertz => NormalLaw::Hertz,
+        ImpactLaw::Gonthier => NormalLaw::Gonthier {
+            restitution,
+            min_impact_velocity_m_s: 1e-3,
+        },
+        ImpactLaw::LankaraniNikravesh => NormalLaw::LankaraniNikravesh {
+            restitution,
+            min_impact_velocity_m_s: 1e-3,
+        },
+        ImpactLaw::HertzMindlin => NormalLaw::HertzMindlin {
+            restitution,
+            clip_attractive: false,
+        },
+        ImpactLaw::Linear => NormalLaw::Linear {
+            stiffness_n_m: req.stiffness_n_m.unwrap_or_else(|| {
+                hertz_equivalent_linear_stiffness(
+                    req.partner,
+                    req.radius_m,
+                    &req.material,
+                    req.velocity_m_s,
+                )
+            }),
+            restitution,
+            clip_attractive: false,
+        },
+    };
+    let model = ContactModel {
+        normal: normal.clone(),
+        friction: Default::default(),
+        rolling: None,
+        adhesion: None,
+    };
+    if let Err(m) = model.validate() {
+        return bad("law", m);
+    }
+    let r = head_on_impact(&ImpactSetup {
+        partner: req.partner,
+        radius_m: req.radius_m,
+        material: req.material.clone(),
+        normal,
+        velocity_m_s: req.velocity_m_s,
+        steps_per_contact: 2000.0,
+    });
+    let fields = [
+        ("restitution", r.restitution),
+        ("contact_time_s", r.contact_time_s),
+        ("max_force_n", r.max_force_n),
+        ("max_overlap_m", r.max_overlap_m),
+        ("hertz_contact_time_s", r.hertz_contact_time_s),
+        ("hertz_max_overlap_m", r.hertz_max_overlap_m),
+        ("hertz_max_force_n", r.hertz_max_force_n),
+    ];
+    if let Some((name, x)) = fields.iter().find(|(_, x)| !x.is_finite()) {
+        return bad(
+            "result",
+            format!(
+                "the impact gave {name} = {x}: no contact was resolved for these inputs; check the radius, the material data and the velocity"
+            ),
+        );
+    }
+    if !(0.0..=1.0 + 1e-6).contains(&r.restitution) {
+        return bad(
+            "result",
+            format!(
+                "the impact gave ε = {}, outside [0, 1]: the contact was not resolved (time step or stiffness out of range for these inputs)",
+                r.restitution
+            ),
+        );
+    }
+    Ok(r)
+}

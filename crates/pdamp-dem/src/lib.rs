@@ -28,7 +28,9 @@ pub mod walls;
 pub mod world;
 
 pub use bed::Bed;
-pub use body::{BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, Wall};
+pub use body::{
+    BodyState, HarmonicTranslation, Motion, PrescribedMotion, RigidBody, TranslationTrack, Wall,
+};
 pub use contact::{ContactModel, FrictionLaw, NormalLaw};
 pub use energy::EnergyLedger;
 pub use forces::{PairState, PpContact, WallSlot};

@@ -238,3 +238,127 @@ pub fn cor_curve_with(
     let _ = effective_pair;
     per_v.into_iter().flatten().collect()
 }
+
+/// Most impact velocities of one checked ε(v) curve ([`checked_cor_curve`]).
+pub const MAX_VELOCITIES: usize = 1000;
+/// Most repeated impacts per velocity of one checked ε(v) curve.
+pub const MAX_REPEAT: usize = 100;
+
+/// A bad input of [`checked_cor_curve`] or an impact outside its model's range; `key` names
+/// the input (`sphere_radius_m`, `velocities_m_s`, `repeat`, `thornton_pressure_factor`;
+/// `result` for the outcome) so that the command line prints its flag and Python its keyword.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CorError {
+    /// The input at fault (or `result`).
+    pub key: &'static str,
+    /// What is wrong, without the key.
+    pub message: String,
+}
+
+impl std::fmt::Display for CorError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.key == "result" {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "{} {}", self.key, self.message)
+        }
+    }
+}
+
+impl std::error::Error for CorError {}
+
+/// [`cor_curve_with`] as a user asks for it (`pdamp cor`, Python `pdamp.cor`): the inputs
+/// checked first (radius in (0, 1] m, velocities in (0, 1000] m/s, at most [`MAX_VELOCITIES`],
+/// `repeat` in 1..=[`MAX_REPEAT`], Thornton's p_y/σ_y in [1, 10]), the velocities sorted and
+/// deduplicated, and afterwards a failed FE impact or an ε outside [0, 1] (a model outside its
+/// range) refused with the velocity and impact named.
+pub fn checked_cor_curve(
+    sphere: &Material,
+    partner: &Partner,
+    radius_m: f64,
+    velocities_m_s: &[f64],
+    model: CorModel,
+    repeat: usize,
+    on_impact: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<CorPoint>, CorError> {
+    let bad = |key, message: String| Err(CorError { key, message });
+    let vs = check_cor_request(radius_m, velocities_m_s, model, repeat)?;
+    let pts = cor_curve_with(sphere, partner, radius_m, &vs, model, repeat, on_impact);
+    if let Some((p, why)) = pts.iter().find_map(|p| {
+        p.fe.as_ref()
+            .and_then(|r| r.failure.as_ref())
+            .map(|w| (p, w))
+    }) {
+        return bad(
+            "result",
+            format!(
+                "FE impact at v = {} m/s (impact {}) failed: {why}",
+                p.velocity_m_s, p.impact
+            ),
+        );
+    }
+    if let Some(p) = pts.iter().find(|p| {
+        !(p.restitution.is_finite()
+            && (0.0..=1.0 + 1e-9).contains(&p.restitution)
+            && p.contact_time_s.is_finite()
+            && p.max_force_n.is_finite())
+    }) {
+        return bad(
+            "result",
+            format!(
+                "the impact model gave ε = {}, contact time {} s, peak force {} N at v = {} m/s (impact {}): outside its range of validity for this sphere and these materials; check the sphere radius, the velocities and the material data",
+                p.restitution, p.contact_time_s, p.max_force_n, p.velocity_m_s, p.impact
+            ),
+        );
+    }
+    Ok(pts)
+}
+
+/// The input checks of [`checked_cor_curve`], for callers that check before they open their
+/// outputs; returns the velocities sorted and deduplicated.
+pub fn check_cor_request(
+    radius_m: f64,
+    velocities_m_s: &[f64],
+    model: CorModel,
+    repeat: usize,
+) -> Result<Vec<f64>, CorError> {
+    let bad = |key, message: String| Err(CorError { key, message });
+    if !(radius_m > 0.0 && radius_m <= 1.0) {
+        return bad(
+            "sphere_radius_m",
+            format!("must lie in (0, 1] m, got {radius_m}; check the unit"),
+        );
+    }
+    if let Some(v) = velocities_m_s.iter().find(|v| !(**v > 0.0 && **v <= 1000.0)) {
+        return bad(
+            "velocities_m_s",
+            format!(
+                "must all lie in (0, 1000] m/s (the models are quasi-static: far below the speed of sound), got {v}"
+            ),
+        );
+    }
+    if velocities_m_s.is_empty() || velocities_m_s.len() > MAX_VELOCITIES {
+        return bad(
+            "velocities_m_s",
+            format!(
+                "{} velocities, give 1 to {MAX_VELOCITIES}",
+                velocities_m_s.len()
+            ),
+        );
+    }
+    if !(1..=MAX_REPEAT).contains(&repeat) {
+        return bad("repeat", format!("must lie in 1..={MAX_REPEAT}, got {repeat}"));
+    }
+    if let CorModel::Thornton { pressure_factor } = model
+        && !(pressure_factor.is_finite() && (1.0..=10.0).contains(&pressure_factor))
+    {
+        return bad(
+            "thornton_pressure_factor",
+            format!("must lie in [1, 10] (p_y/σ_y; 1.6 = first yield), got {pressure_factor}"),
+        );
+    }
+    let mut vs = velocities_m_s.to_vec();
+    vs.sort_by(f64::total_cmp);
+    vs.dedup();
+    Ok(vs)
+}

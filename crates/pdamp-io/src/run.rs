@@ -454,7 +454,8 @@ fn cylinder_surface(base: Vec3, axis: Vec3, r: f64, l: f64) -> (Vec<Vec3>, Vec<[
     (verts, tris)
 }
 
-fn ledger_row(w: &World) -> Vec<f64> {
+/// One row of `energy.csv` ([`ENERGY_COLUMNS`]): the time and the world's energy ledger, J.
+pub fn ledger_row(w: &World) -> Vec<f64> {
     let l = &w.ledger;
     vec![
         w.time_s,

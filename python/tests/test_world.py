@@ -1,0 +1,126 @@
+"""The step-wise World (issue 28): stepped from Python it gives `pdamp run`'s numbers to the
+bit, its particle views are the world's memory (no copy), a driven body moved from Python
+equals the scenario's own harmonic motion to the bit, and the bed's load on its container is
+its weight."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import pdamp
+
+from test_pdamp import BIN, cli
+
+
+def box(tmp_path, particles=300, duration_s=0.02):
+    text = subprocess.run(
+        [BIN, "--quiet", "example", "--particles", str(particles), "--duration-s", str(duration_s)],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    path = tmp_path / "box.toml"
+    path.write_text(text)
+    return path
+
+
+def test_world_stepped_from_python_equals_pdamp_run(tmp_path):
+    path = box(tmp_path)
+    cli("run", path, "--out", tmp_path / "cli")
+    summary = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    w = pdamp.World(pdamp.load(path), threads=2)
+    assert len(w) == summary["particles"] == 300
+    assert w.time_s == 0.0 and w.settling_time_s == summary["settling_time_s"]
+    w.step(7)            # short calls (no watcher thread) …
+    w.step(500)          # … a long one …
+    w.run_until()        # … and the rest up to the scenario's duration, as `pdamp run`
+    e = w.energy()
+    assert e["time_s"] == summary["simulated_time_s"]
+    for k, v in summary["energy"].items():
+        assert e[k] == v, k                       # to the bit
+    assert e["closure_error_j"] == summary["energy_closure_error_j"]
+    assert abs(e["closure_error_j"]) <= 1e-3 * e["wall_work_j"]
+
+
+def test_particle_views_are_the_worlds_memory(tmp_path):
+    w = pdamp.World(pdamp.load(box(tmp_path, 100, 0.005)), threads=1)
+    x = w.positions_m
+    assert x.shape == (100, 3) and x.dtype == np.float64
+    address = x.__array_interface__["data"][0]
+    assert w.positions_m.__array_interface__["data"][0] == address   # no copy per access
+    assert np.shares_memory(x, w.positions_m)
+    before = x.copy()
+    w.step(20)
+    assert x.__array_interface__["data"][0] == address
+    assert not np.array_equal(x, before)          # the view follows the world
+    assert not x.flags.writeable and not w.velocities_m_s.flags.writeable
+    with pytest.raises(ValueError):
+        x[0, 0] = 1.0
+    r, m = w.radii_m, w.masses_kg
+    assert r.shape == m.shape == (100,)
+    # m = 4/3 π r³ ρ for every particle (ρ of the example's material)
+    rho = pdamp.load(box(tmp_path, 100, 0.005)).to_dict()["materials"][0]["density_kg_m3"]
+    np.testing.assert_allclose(m, 4.0 / 3.0 * math.pi * r**3 * rho, rtol=1e-14)
+    base = sys.getrefcount(w)
+    v = w.forces_n
+    assert sys.getrefcount(w) == base + 1         # the view holds the world alive
+    del w
+    assert np.isfinite(v).all() and np.isfinite(x).all()
+
+
+def driven_copy(path, tmp_path):
+    d = pdamp.load(path).to_dict()
+    body = d["bodies"][0]
+    law = dict(body["motion"])
+    body["motion"] = {"type": "driven"}
+    return pdamp.Scenario.from_dict(d, base_dir=tmp_path), body["name"], law
+
+
+def test_driven_body_equals_the_harmonic_motion_to_the_bit(tmp_path):
+    path = box(tmp_path, 150, 0.01)
+    harmonic = pdamp.World(pdamp.load(path), threads=2)
+    sc, name, law = driven_copy(path, tmp_path)
+    driven = pdamp.World(sc, threads=2)
+    e = np.array(law["direction"], dtype=float)
+    e /= np.linalg.norm(e)
+    w = 2.0 * math.pi * law["frequency_hz"]
+    x = law["amplitude_m"]
+    phase = law.get("phase_rad", 0.0)
+
+    def state(t):
+        a = w * t + phase
+        return e * (x * math.sin(a)), e * (x * w * math.cos(a)), e * (-x * w * w * math.sin(a))
+
+    u, v, acc = state(0.0)
+    driven.drive_body(name, u, v, acc, at_s=0.0)          # the starting state
+    for _ in range(2000):
+        u, v, acc = state(driven.time_s + driven.dt_s)     # the state at the end of the step
+        driven.drive_body(name, u, v, acc)
+        driven.step()
+        harmonic.step()
+    assert driven.time_s == harmonic.time_s
+    assert driven.energy() == harmonic.energy()
+    assert driven.body_load(name) == harmonic.body_load(name)
+    np.testing.assert_array_equal(driven.positions_m, harmonic.positions_m)
+    with pytest.raises(ValueError, match="not driven"):
+        harmonic.drive_body(name, u, v, acc)
+    with pytest.raises(KeyError, match="no body"):
+        driven.body_load("lid")
+    with pytest.raises(ValueError, match="before the first step"):
+        driven.drive_body(name, u, v, acc, at_s=driven.time_s)
+
+
+def test_bed_at_rest_weighs_on_its_container(tmp_path):
+    path = box(tmp_path, 200, 0.005)
+    sc, name, _ = driven_copy(path, tmp_path)
+    world = pdamp.World(sc, threads=2)
+    for _ in range(3000):                       # held at its reference pose, the bed settles
+        world.drive_body(name, [0.0] * 3, [0.0] * 3)
+        world.step()
+    force, _ = world.body_load(name)
+    g = np.array(sc.to_dict()["simulation"]["gravity_m_s2"])
+    weight = world.masses_kg.sum() * g
+    # Σ F_wall = m g at rest (the residual kinetic energy of the bed is tiny)
+    np.testing.assert_allclose(force, weight, rtol=2e-3, atol=2e-3 * np.linalg.norm(weight))
