@@ -297,10 +297,13 @@ pub fn checked_cor_curve(
             ),
         );
     }
+    // Thornton's closed form gives no contact time (NaN, written as such); every other model
+    // does.
+    let no_contact_time = matches!(model, CorModel::Thornton { .. });
     if let Some(p) = pts.iter().find(|p| {
         !(p.restitution.is_finite()
             && (0.0..=1.0 + 1e-9).contains(&p.restitution)
-            && p.contact_time_s.is_finite()
+            && (p.contact_time_s.is_finite() || no_contact_time && p.contact_time_s.is_nan())
             && p.max_force_n.is_finite())
     }) {
         return bad(

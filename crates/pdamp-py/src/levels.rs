@@ -109,7 +109,11 @@ pub(crate) fn couple(
     };
     let pool = crate::detach::pool(threads)?;
     let v = detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        pdamp_structure::report::run_couple(&path, &out, options, &mut |f| p.set("running", f))
+        let v = pdamp_structure::report::run_couple(&path, &out, options, &mut |f| {
+            p.set("running", f)
+        })?;
+        p.set("running", 1.0);
+        Ok(v)
     })?;
     serde_json::to_string(&v).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
@@ -177,6 +181,9 @@ pub(crate) fn powder_run(
 
 /// A `ValueError` naming the keyword argument at fault.
 fn input_error(key: &str, message: &str) -> PyErr {
+    if key == "result" {
+        return pyo3::exceptions::PyValueError::new_err(message.to_string());
+    }
     pyo3::exceptions::PyValueError::new_err(format!("{key} {message}"))
 }
 
