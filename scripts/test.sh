@@ -70,7 +70,7 @@ cargo test --release --workspace --no-fail-fast "$@" || status=$?
 # environment with maturin (reusing this build's artifacts) and tested with pytest against the
 # `pdamp` binary of the same build.
 pyvenv=target/py-venv
-if ! "$pyvenv/bin/python" -c "import maturin, pytest, numpy, pandas" >/dev/null 2>&1; then
+if ! "$pyvenv/bin/python" -c "import maturin, pytest, numpy, pandas, tqdm, matplotlib" >/dev/null 2>&1; then
   echo "making $pyvenv (pip install -r python/requirements-test.txt)"
   rm -rf "$pyvenv"
   python3 -m venv "$pyvenv" && "$pyvenv/bin/pip" install -q -r python/requirements-test.txt || status=1

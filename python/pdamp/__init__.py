@@ -45,6 +45,7 @@ __all__ = [
     "powder_run",
     "cor",
     "impact",
+    "horizontal_formulas",
 ]
 
 PathLike = Union[str, "_os.PathLike[str]"]
@@ -355,3 +356,29 @@ def impact(
             None if stiffness_n_m is None else float(stiffness_n_m),
         )
     )
+
+
+def horizontal_formulas(
+    amplitudes_m: Sequence[float],
+    *,
+    frequency_hz: float,
+    rolling_clearance_m: float,
+    bouncing_clearance_m: float,
+    bouncing_mass_ratio: float = 1.0,
+    as_frame: bool = True,
+):
+    """The analytical motion-mode model of a horizontally excited damper (D Eq. 6.12):
+    effective loss factor η̄ and mass ratio m̄_bed/m_bed over the amplitudes (m) at
+    ``frequency_hz`` — rolling (scattered ``X/h_rol``, collect-and-collide D Eq. 5.10, maximum
+    20/(7π) ≈ 0.91 at ``X_opt = 0.4 h_rol``) below A = g, bouncing (scattered ``2X/h_bou``,
+    collect-and-collide D Eq. 6.8, maximum 4/π ≈ 1.27 at ``X_opt = h_bou/π``) above. Clearances
+    in m (D Eq. 5.1, 6.1; D Tab. 6.2). Returns the columns ``amplitude_m``,
+    ``effective_loss_factor``, ``effective_mass_ratio``."""
+    cols = _pdamp.horizontal_formulas(
+        [float(x) for x in amplitudes_m],
+        float(frequency_hz),
+        float(rolling_clearance_m),
+        float(bouncing_clearance_m),
+        float(bouncing_mass_ratio),
+    )
+    return _frame(cols, as_frame)

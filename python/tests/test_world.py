@@ -124,3 +124,41 @@ def test_bed_at_rest_weighs_on_its_container(tmp_path):
     weight = world.masses_kg.sum() * g
     # Σ F_wall = m g at rest (the residual kinetic energy of the bed is tiny)
     np.testing.assert_allclose(force, weight, rtol=2e-3, atol=2e-3 * np.linalg.norm(weight))
+
+
+def test_ctrl_c_stops_a_world_cleanly_and_it_continues_to_the_same_numbers(tmp_path):
+    import os
+    import signal
+    import threading
+
+    path = box(tmp_path, 300, 0.05)
+    whole = pdamp.World(pdamp.load(path), threads=1)
+    seen = []
+    whole.run_until(progress=lambda phase, f: seen.append((phase, f)))
+    assert [p for p, _ in seen] == ["running"] * len(seen) and len(seen) >= 2
+    fractions = [f for _, f in seen]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+
+    w = pdamp.World(pdamp.load(path), threads=1)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        w.run_until()
+    timer.join()
+    assert 0.0 < w.time_s < w.duration_s          # stopped in the middle, at a whole step
+    w.check_health()
+    w.run_until()                                   # the stop request is gone: runs to the end
+    assert w.energy() == whole.energy()             # and the interruption changed nothing
+    np.testing.assert_array_equal(w.positions_m, whole.positions_m)
+
+
+def test_tqdm_bar(tmp_path, capsys):
+    pytest.importorskip("tqdm")
+    w = pdamp.World(pdamp.load(box(tmp_path, 100, 0.01)), threads=1)
+    from tqdm import tqdm
+
+    bar = pdamp._Bar(tqdm)
+    w.run_until(progress=bar)
+    bar.close()
+    err = capsys.readouterr().err
+    assert "running" in err and "100%" in err

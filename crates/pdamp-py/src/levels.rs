@@ -346,3 +346,63 @@ pub(crate) fn impact(
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     serde_json::to_string(&r).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
+
+/// The combined analytical model of a horizontally excited damper [D Eq. 6.12]: η̄ and
+/// m̄_bed/m_bed at each amplitude for frequency `frequency_hz` — rolling (scattered Eq. 5.3,
+/// collect-and-collide Eq. 5.10, mass Eq. 5.14) for A < g, bouncing (scattered Eq. 6.3,
+/// collect-and-collide Eq. 6.8 with 6.6) for A ≥ g. Returns the columns `amplitude_m`,
+/// `effective_loss_factor`, `effective_mass_ratio` as numpy arrays.
+#[pyfunction]
+#[pyo3(signature = (amplitudes_m, frequency_hz, rolling_clearance_m, bouncing_clearance_m, bouncing_mass_ratio = 1.0))]
+pub(crate) fn horizontal_formulas<'py>(
+    py: Python<'py>,
+    amplitudes_m: Vec<f64>,
+    frequency_hz: f64,
+    rolling_clearance_m: f64,
+    bouncing_clearance_m: f64,
+    bouncing_mass_ratio: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use pdamp_structure::formulas::{HorizontalDamper, RollingDamper};
+    let positive = [
+        ("frequency_hz", frequency_hz),
+        ("bouncing_mass_ratio", bouncing_mass_ratio),
+    ];
+    if let Some((k, v)) = positive.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+        return Err(input_error(k, &format!("must be finite and > 0, got {v}")));
+    }
+    for (k, v) in [
+        ("rolling_clearance_m", rolling_clearance_m),
+        ("bouncing_clearance_m", bouncing_clearance_m),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(input_error(k, &format!("must be finite and >= 0 m, got {v}")));
+        }
+    }
+    if let Some(x) = amplitudes_m.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+        return Err(input_error(
+            "amplitudes_m",
+            &format!("must all be finite and > 0 m, got {x}"),
+        ));
+    }
+    let d = HorizontalDamper {
+        rolling: RollingDamper {
+            bed_mass_kg: 1.0,
+            clearance_m: rolling_clearance_m,
+            smoothing_log_width: None,
+        },
+        bouncing_clearance_m,
+        bouncing_mass_ratio,
+    };
+    let omega = 2.0 * std::f64::consts::PI * frequency_hz;
+    let rows: Vec<Vec<f64>> = amplitudes_m
+        .iter()
+        .map(|&x| {
+            let (eta, m) = d.loss_factor_and_mass_ratio(x, omega);
+            vec![x, eta, m]
+        })
+        .collect();
+    let header: Vec<String> = ["amplitude_m", "effective_loss_factor", "effective_mass_ratio"]
+        .map(String::from)
+        .to_vec();
+    columns(py, &header, &rows)
+}

@@ -35,5 +35,6 @@ fn _pdamp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(levels::powder_run, m)?)?;
     m.add_function(wrap_pyfunction!(levels::cor, m)?)?;
     m.add_function(wrap_pyfunction!(levels::impact, m)?)?;
+    m.add_function(wrap_pyfunction!(levels::horizontal_formulas, m)?)?;
     Ok(())
 }
