@@ -502,7 +502,12 @@ fn dispatch(command: Command) -> Result<()> {
                     PartnerArg::Sphere => Partner::Sphere,
                 },
                 radius_m,
-                material: Material::new("material", density_kg_m3, youngs_modulus_pa, poisson_ratio),
+                material: Material::new(
+                    "material",
+                    density_kg_m3,
+                    youngs_modulus_pa,
+                    poisson_ratio,
+                ),
                 law: match law {
                     LawArg::Hertz => ImpactLaw::Hertz,
                     LawArg::Gonthier => ImpactLaw::Gonthier,

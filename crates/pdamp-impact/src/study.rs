@@ -332,7 +332,10 @@ pub fn check_cor_request(
             format!("must lie in (0, 1] m, got {radius_m}; check the unit"),
         );
     }
-    if let Some(v) = velocities_m_s.iter().find(|v| !(**v > 0.0 && **v <= 1000.0)) {
+    if let Some(v) = velocities_m_s
+        .iter()
+        .find(|v| !(**v > 0.0 && **v <= 1000.0))
+    {
         return bad(
             "velocities_m_s",
             format!(
@@ -350,7 +353,10 @@ pub fn check_cor_request(
         );
     }
     if !(1..=MAX_REPEAT).contains(&repeat) {
-        return bad("repeat", format!("must lie in 1..={MAX_REPEAT}, got {repeat}"));
+        return bad(
+            "repeat",
+            format!("must lie in 1..={MAX_REPEAT}, got {repeat}"),
+        );
     }
     if let CorModel::Thornton { pressure_factor } = model
         && !(pressure_factor.is_finite() && (1.0..=10.0).contains(&pressure_factor))

@@ -375,7 +375,10 @@ pub(crate) fn horizontal_formulas<'py>(
         ("bouncing_clearance_m", bouncing_clearance_m),
     ] {
         if !(v.is_finite() && v >= 0.0) {
-            return Err(input_error(k, &format!("must be finite and >= 0 m, got {v}")));
+            return Err(input_error(
+                k,
+                &format!("must be finite and >= 0 m, got {v}"),
+            ));
         }
     }
     if let Some(x) = amplitudes_m.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
@@ -401,8 +404,12 @@ pub(crate) fn horizontal_formulas<'py>(
             vec![x, eta, m]
         })
         .collect();
-    let header: Vec<String> = ["amplitude_m", "effective_loss_factor", "effective_mass_ratio"]
-        .map(String::from)
-        .to_vec();
+    let header: Vec<String> = [
+        "amplitude_m",
+        "effective_loss_factor",
+        "effective_mass_ratio",
+    ]
+    .map(String::from)
+    .to_vec();
     columns(py, &header, &rows)
 }

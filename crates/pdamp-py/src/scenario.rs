@@ -188,4 +188,3 @@ impl PyScenario {
         format!("pdamp.Scenario({:?})", self.inner.title)
     }
 }
-
