@@ -224,3 +224,28 @@ impl RigidBody {
         s
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The track gives its state at t1 exactly and extrapolates quadratically around it.
+    #[test]
+    fn translation_track_is_exact_at_t1_and_quadratic_around_it() {
+        let t = TranslationTrack {
+            t1_s: 0.25,
+            displacement_m: Vec3::new(1e-3, -2e-3, 0.5e-3),
+            velocity_m_s: Vec3::new(0.1, 0.0, -0.2),
+            acceleration_m_s2: Vec3::new(3.0, 1.0, 0.0),
+        };
+        let at = t.offset(0.25);
+        assert_eq!(at.position_m, t.displacement_m);
+        assert_eq!(at.velocity_m_s, t.velocity_m_s);
+        let s = 0.01;
+        let later = t.offset(0.25 + s);
+        let want = t.displacement_m + t.velocity_m_s * s + t.acceleration_m_s2 * (0.5 * s * s);
+        assert!((later.position_m - want).norm() < 1e-15);
+        assert!((later.velocity_m_s - (t.velocity_m_s + t.acceleration_m_s2 * s)).norm() < 1e-15);
+        assert_eq!(later.angular_velocity_rad_s, Vec3::zeros());
+    }
+}

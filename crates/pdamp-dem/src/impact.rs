@@ -341,3 +341,62 @@ pub fn checked_head_on_impact(req: &ImpactRequest) -> Result<ImpactResult, Impac
     }
     Ok(r)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn steel(law: ImpactLaw, velocity_m_s: f64) -> ImpactRequest {
+        ImpactRequest {
+            partner: Partner::Wall,
+            radius_m: 1e-3,
+            material: Material::new("steel", 7850.0, 2.1e11, 0.3),
+            law,
+            restitution: 0.8,
+            stiffness_n_m: None,
+            velocity_m_s,
+        }
+    }
+
+    /// Gonthier's law reproduces its ε [D Eq. 2.79] to 1e-6; elastic Hertz its contact time
+    /// [D Eq. 4.8] to 3 % and its peak overlap [D Eq. 2.80] to 1e-3.
+    #[test]
+    fn checked_impact_reproduces_the_closed_forms() {
+        let g = checked_head_on_impact(&steel(ImpactLaw::Gonthier, 0.5)).unwrap();
+        assert!((g.restitution - 0.8).abs() < 1e-6, "{g:?}");
+        let h = checked_head_on_impact(&steel(ImpactLaw::Hertz, 0.5)).unwrap();
+        assert!((h.restitution - 1.0).abs() < 1e-6, "{h:?}");
+        assert!((h.contact_time_s / h.hertz_contact_time_s - 1.0).abs() < 0.03);
+        assert!((h.max_overlap_m / h.hertz_max_overlap_m - 1.0).abs() < 1e-3);
+    }
+
+    /// Every bad input is refused before the run, with the input named.
+    #[test]
+    fn checked_impact_names_the_bad_input() {
+        let key = |r: ImpactRequest| checked_head_on_impact(&r).unwrap_err().key;
+        assert_eq!(key(steel(ImpactLaw::Hertz, -1.0)), "velocity_m_s");
+        assert_eq!(key(steel(ImpactLaw::Hertz, 2000.0)), "velocity_m_s");
+        let mut r = steel(ImpactLaw::Hertz, 0.5);
+        r.radius_m = 2.0;
+        assert_eq!(key(r), "radius_m");
+        let mut r = steel(ImpactLaw::Gonthier, 0.5);
+        r.restitution = 0.0;
+        assert_eq!(key(r), "restitution");
+        let mut r = steel(ImpactLaw::Linear, 0.5);
+        r.stiffness_n_m = Some(f64::NAN);
+        assert_eq!(key(r), "stiffness_n_m");
+        let mut r = steel(ImpactLaw::Hertz, 0.5);
+        r.material.youngs_modulus_pa = -1.0;
+        assert_eq!(key(r), "material");
+        let e = checked_head_on_impact(&steel(ImpactLaw::Hertz, -1.0)).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "velocity_m_s must lie in (0, 1000] m/s, got -1"
+        );
+        assert_eq!(
+            ImpactLaw::from_name("Lankarani_Nikravesh"),
+            Some(ImpactLaw::LankaraniNikravesh)
+        );
+        assert_eq!(ImpactLaw::from_name("hooke"), None);
+    }
+}

@@ -371,3 +371,48 @@ pub fn check_cor_request(
     vs.dedup();
     Ok(vs)
 }
+
+#[cfg(test)]
+mod checked_tests {
+    use super::*;
+    use crate::material::MaterialSet;
+
+    fn s235() -> Material {
+        MaterialSet::builtins().get("s235").unwrap()
+    }
+
+    /// Inputs are checked and named; velocities come back sorted and deduplicated; Thornton's
+    /// curve is accepted with its NaN contact time; elastic Hertz gives ε = 1.
+    #[test]
+    fn checked_cor_curve_checks_and_names() {
+        let wall = Partner::Wall(s235());
+        let key = |r, v: &[f64], m, n| check_cor_request(r, v, m, n).unwrap_err().key;
+        assert_eq!(key(2.0, &[0.5], CorModel::Hertz, 1), "sphere_radius_m");
+        assert_eq!(
+            key(0.003, &[0.5, -1.0], CorModel::Hertz, 1),
+            "velocities_m_s"
+        );
+        assert_eq!(key(0.003, &[], CorModel::Hertz, 1), "velocities_m_s");
+        assert_eq!(key(0.003, &[0.5], CorModel::Hertz, 0), "repeat");
+        let th = |pressure_factor| CorModel::Thornton { pressure_factor };
+        assert_eq!(key(0.003, &[0.5], th(0.5), 1), "thornton_pressure_factor");
+        let vs = check_cor_request(0.003, &[1.0, 0.1, 1.0], CorModel::Hertz, 1).unwrap();
+        assert_eq!(vs, vec![0.1, 1.0]);
+        let pts = checked_cor_curve(&s235(), &wall, 0.003, &[0.5], th(1.6), 1, &|_, _| {}).unwrap();
+        assert!(pts[0].contact_time_s.is_nan() && (0.0..1.0).contains(&pts[0].restitution));
+        let h = checked_cor_curve(
+            &s235(),
+            &wall,
+            0.003,
+            &[0.1, 1.0],
+            CorModel::Hertz,
+            1,
+            &|_, _| {},
+        )
+        .unwrap();
+        assert!(
+            h.iter()
+                .all(|p| p.restitution == 1.0 && p.contact_time_s > 0.0)
+        );
+    }
+}
