@@ -3,7 +3,7 @@
 //! particle state as zero-copy numpy views, the contact loads on the bodies, and driven bodies
 //! moved from outside (a user's own structure model coupled to the bed, D Sect. 3.3).
 
-use crate::detach::{Progress, detached, detached_short};
+use crate::detach::WorldPool;
 use crate::scenario::PyScenario;
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::{PyArray1, PyArray2};
@@ -17,8 +17,8 @@ use std::sync::Arc;
 // The views below read a `Vec<Vec3>` as an (n, 3) array of f64.
 const _: () = assert!(std::mem::size_of::<Vec3>() == 3 * std::mem::size_of::<f64>());
 
-/// Steps of one `step(n)` call done without a watcher thread (see
-/// [`crate::detach::detached_short`]); longer calls can be stopped with Ctrl-C while they run.
+/// Steps of one `step(n)` call done without a watcher thread where the world has no pool of
+/// its calling thread ([`WorldPool`]); longer calls can be stopped with Ctrl-C while they run.
 const SHORT_CALL_STEPS: u64 = 64;
 
 /// A DEM world of a scenario, ready at the start of the main run of `pdamp run` (built,
@@ -27,11 +27,9 @@ const SHORT_CALL_STEPS: u64 = 64;
 #[pyclass(name = "World", module = "pdamp._pdamp")]
 pub(crate) struct PyWorld {
     world: World,
-    pool: rayon::ThreadPool,
+    pool: WorldPool,
     settling_time_s: f64,
     duration_s: f64,
-    /// Step counter at the start of the main run.
-    steps_at_start: u64,
     /// Bodies the scenario declares driven (only these may be moved by `drive_body`).
     driven: Vec<bool>,
 }
@@ -95,14 +93,19 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 impl PyWorld {
     /// Builds the world of `scenario` and settles it as `pdamp run` does (unless
     /// `settle=False`); `threads` workers (default: all cores; the numbers do not depend on it).
+    /// `drive` gives driven bodies their state at t = 0, `{name: (displacement_m, velocity_m_s,
+    /// acceleration_m_s2)}` (default: at rest at the reference pose): the bed settles with the
+    /// body held at its reference pose and the main run starts with it in that state, as a
+    /// prescribed motion does.
     #[new]
-    #[pyo3(signature = (scenario, threads = None, settle = true, progress = None))]
+    #[pyo3(signature = (scenario, threads = None, settle = true, progress = None, drive = None))]
     fn new(
         py: Python<'_>,
         scenario: &PyScenario,
         threads: Option<usize>,
         settle: bool,
         progress: Option<Bound<'_, PyAny>>,
+        drive: Option<std::collections::BTreeMap<String, [[f64; 3]; 3]>>,
     ) -> PyResult<Self> {
         let sc = &scenario.inner;
         if sc.damper.is_some() {
@@ -110,22 +113,55 @@ impl PyWorld {
                 "a damper scenario is run by pdamp.damper_point or pdamp.fields; World takes a plain scenario (pdamp run without [damper])",
             ));
         }
-        let pool = crate::detach::pool(threads)?;
+        let pool = WorldPool::new(threads);
         let base = &scenario.base_dir;
-        let (world, settling_time_s) = detached(py, &pool, progress.as_ref(), |p: &Progress| {
+        let drive = drive.unwrap_or_default();
+        let declared_driven = |b: &pdamp_dem::RigidBody| {
+            sc.bodies.iter().any(|s| {
+                s.name == b.name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
+            })
+        };
+        for name in drive.keys() {
+            if !sc.bodies.iter().any(|s| {
+                &s.name == name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
+            }) {
+                return Err(PyValueError::new_err(format!(
+                    "drive: {name:?} is not a driven body of the scenario (motion = {{ type = \"driven\" }})"
+                )));
+            }
+        }
+        let work = |poll: &mut dyn FnMut(&str, f64) -> bool| {
             let mut world = sc.build_world(base)?;
+            for (name, [u, v, a]) in &drive {
+                let b = world
+                    .bodies
+                    .iter()
+                    .position(|b| &b.name == name && matches!(b.motion, Motion::Driven))
+                    .ok_or_else(|| {
+                        format!("drive: {name:?} is not a driven body of the scenario (motion = {{ type = \"driven\" }})")
+                    })?;
+                if [u, v, a].iter().any(|x| x.iter().any(|c| !c.is_finite())) {
+                    return Err(format!("drive: {name:?}: every number must be finite"));
+                }
+                // Held during settling like any moving body; from t = 0 on in this state.
+                world.bodies[b].motion = Motion::Prescribed(Arc::new(TranslationTrack {
+                    t1_s: 0.0,
+                    displacement_m: vec3(*u),
+                    velocity_m_s: vec3(*v),
+                    acceleration_m_s2: vec3(*a),
+                }));
+            }
             let main_gravity = Vec3::from(sc.simulation.gravity_m_s2);
             let mut t = 0.0;
             if let (true, Some(spec)) = (settle, &sc.settle) {
                 let mut bad = None;
                 let max = spec.max_duration_s;
                 let r = pdamp_io::run::settle_with_or_break(&mut world, spec, main_gravity, |w| {
-                    p.set("settling", w.time_s / max);
                     if let Err(e) = health(w) {
                         bad = Some(e);
                         return ControlFlow::Break(());
                     }
-                    if pdamp_io::checkpoint::stop_requested() {
+                    if poll("settling", w.time_s / max) {
                         return ControlFlow::Break(());
                     }
                     ControlFlow::Continue(())
@@ -138,14 +174,10 @@ impl PyWorld {
             // The main run of `pdamp run` starts from here.
             world.initialize();
             Ok((world, t))
-        })?;
-        let driven = world
-            .bodies
-            .iter()
-            .map(|b| matches!(b.motion, Motion::Driven))
-            .collect();
+        };
+        let (world, settling_time_s) = pool.run(py, progress.as_ref(), "settling", false, work)?;
+        let driven = world.bodies.iter().map(declared_driven).collect();
         Ok(Self {
-            steps_at_start: world.counters.steps,
             driven,
             world,
             pool,
@@ -158,8 +190,8 @@ impl PyWorld {
     #[pyo3(signature = (n = 1))]
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let world = &mut self.world;
-        let work = move || {
-            for _ in 0..n {
+        let work = move |poll: &mut dyn FnMut(&str, f64) -> bool| {
+            for k in 0..n {
                 world.step();
                 if world
                     .counters
@@ -168,20 +200,14 @@ impl PyWorld {
                 {
                     health(world)?;
                 }
-                if pdamp_io::checkpoint::stop_requested() {
+                if poll("stepping", k as f64 / n as f64) {
                     break;
                 }
             }
             Ok(())
         };
-        if n <= SHORT_CALL_STEPS {
-            detached_short(py, &self.pool, work)
-        } else {
-            detached(py, &self.pool, None, |_: &Progress| {
-                let mut work = work;
-                work()
-            })
-        }
+        self.pool
+            .run(py, None, "stepping", n <= SHORT_CALL_STEPS, work)
     }
 
     /// Steps until the clock reaches `t_s` (default: the scenario's duration; the last step
@@ -201,7 +227,7 @@ impl PyWorld {
         }
         let world = &mut self.world;
         let t0 = world.time_s;
-        detached(py, &self.pool, progress.as_ref(), |p: &Progress| {
+        let work = |poll: &mut dyn FnMut(&str, f64) -> bool| {
             let mut bad = None;
             world.run_until_or_break_deferred(t_end, |w| {
                 if w.counters
@@ -213,16 +239,15 @@ impl PyWorld {
                         bad = Some(e);
                         return ControlFlow::Break(());
                     }
-                    p.set("running", (w.time_s - t0) / (t_end - t0).max(1e-300));
                 }
-                if pdamp_io::checkpoint::stop_requested() {
+                if poll("running", (w.time_s - t0) / (t_end - t0).max(1e-300)) {
                     return ControlFlow::Break(());
                 }
                 ControlFlow::Continue(())
             });
-            p.set("running", 1.0);
             bad.map_or(Ok(()), Err)
-        })
+        };
+        self.pool.run(py, progress.as_ref(), "running", false, work)
     }
 
     /// Simulated time, s (zero at the start of the main run).
@@ -322,9 +347,8 @@ impl PyWorld {
     /// displacement from the reference position (m), velocity (m/s) and acceleration (m/s²) at
     /// time `at_s` (default: the end of the next step, as the structure coupling of D Sect. 3.3
     /// hands the container its state at t_{n+1}); between updates the body follows them
-    /// quadratically. `at_s = time_s` before the first step sets the starting state (contact
-    /// forces and ledger evaluated afresh). Read the bed's reaction with `body_load` after the
-    /// step.
+    /// quadratically. The starting state at t = 0 is given to the constructor (`drive=`). Read
+    /// the bed's reaction with `body_load` after the step.
     #[pyo3(signature = (name, displacement_m, velocity_m_s, acceleration_m_s2 = [0.0; 3], at_s = None))]
     fn drive_body(
         &mut self,
@@ -352,18 +376,7 @@ impl PyWorld {
             velocity_m_s: vec3(velocity_m_s),
             acceleration_m_s2: vec3(acceleration_m_s2),
         };
-        let now = self.world.time_s;
-        let at_start = self.world.counters.steps == self.steps_at_start;
-        if at_s == Some(now) && !at_start {
-            return Err(PyValueError::new_err(format!(
-                "drive_body({name:?}, at_s = now): a body is placed at the current time only before the first step; later give its state at the end of the next step (at_s = time_s + dt_s, the default)"
-            )));
-        }
         self.world.bodies[b].motion = Motion::Prescribed(Arc::new(track));
-        if at_s == Some(now) {
-            // The starting state: body placed, contact forces and ledger evaluated afresh.
-            self.world.initialize();
-        }
         Ok(())
     }
 
