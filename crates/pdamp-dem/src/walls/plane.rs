@@ -10,13 +10,19 @@ use super::WallContact;
 use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
-/// Returns `v / |v|`, or an error message when `v` is zero or not finite.
+/// Returns `v / |v|`, or an error message when `v` is zero or not finite. A vector that is a
+/// unit vector to round-off (|v| within 4 ε of 1) is returned unchanged, so that normalising is
+/// idempotent: a scenario written with its normalised vectors reads back to the same bits (and
+/// the same digest).
 pub(super) fn unit(v: Vec3, what: &str) -> Result<Vec3, String> {
     let n = v.norm();
     if !(n.is_finite() && n > 0.0) {
         return Err(format!(
             "{what} must be a finite non-zero vector, got {v:?}"
         ));
+    }
+    if (n - 1.0).abs() <= 4.0 * f64::EPSILON {
+        return Ok(v);
     }
     Ok(v / n)
 }
