@@ -41,7 +41,9 @@ class World:
         threads: Optional[int] = None,
         settle: bool = True,
         progress: Progress = None,
-    ) -> None: ...
+        drive: Optional[Dict[str, Tuple[Sequence[float], Sequence[float], Sequence[float]]]] = None,
+    ) -> None:
+        """`drive`: driven bodies' (displacement_m, velocity_m_s, acceleration_m_s2) at t = 0."""
     def step(self, n: int = 1) -> None:
         """Advances by `n` time steps."""
     def run_until(self, t_s: Optional[float] = None, progress: Progress = None) -> None:
