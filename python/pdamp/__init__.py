@@ -38,6 +38,7 @@ __all__ = [
     "RunResult",
     "__version__",
     "load",
+    "run",
     "damper_point",
     "fields",
     "couple",
@@ -176,6 +177,22 @@ def _with_excitation(scenario: Scenario, frequency_hz, amplitude_m, acceleration
             damper.pop(k, None)
         damper.update({k: float(v) for k, v in given.items()})
     return Scenario.from_dict(d, base_dir=scenario.base_dir)
+
+
+def run(
+    scenario: Scenario,
+    out: PathLike,
+    *,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+) -> RunResult:
+    """A scenario run to files, as ``pdamp run SCENARIO.toml --out OUT``: settling, the main
+    run, ``energy.csv`` (the ledger over time), VTK snapshots and ``summary.json``. Returns a
+    :class:`RunResult` (``summary``; table ``energy``). A damper scenario runs its excitation
+    point (see :func:`damper_point`). For a loop of your own use :class:`World`."""
+    with _Progress(progress) as cb:
+        text = _pdamp.run(scenario, _os.fspath(out), threads, cb)
+    return RunResult(_json.loads(text), out)
 
 
 def damper_point(

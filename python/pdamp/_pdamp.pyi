@@ -96,6 +96,9 @@ class World:
         """The energy ledger, J, with `time_s`, `dissipated_j` and `closure_error_j`."""
     def check_health(self) -> None: ...
 
+def run(
+    scenario: Scenario, out: str, threads: Optional[int] = None, progress: Progress = None
+) -> str: ...
 def damper_point(
     scenario: Scenario, out: str, threads: Optional[int] = None, progress: Progress = None
 ) -> str: ...

@@ -13,7 +13,9 @@ import pytest
 
 import pdamp
 
-from test_pdamp import BIN, cli
+import pandas as pd
+
+from test_pdamp import BIN, cli, same
 
 
 def box(tmp_path, particles=300, duration_s=0.02):
@@ -42,6 +44,11 @@ def test_world_stepped_from_python_equals_pdamp_run(tmp_path):
         assert e[k] == v, k                       # to the bit
     assert e["closure_error_j"] == summary["energy_closure_error_j"]
     assert abs(e["closure_error_j"]) <= 1e-3 * e["wall_work_j"]
+    # pdamp.run writes what the command line writes, with the same numbers
+    r = pdamp.run(pdamp.load(path), tmp_path / "py")          # all cores, as the command line
+    same(r.summary, summary)
+    pd.testing.assert_frame_equal(r.energy, pd.read_csv(tmp_path / "cli" / "energy.csv"))
+    assert r.energy["time_s"].iloc[-1] == pytest.approx(0.02)
 
 
 def test_particle_views_are_the_worlds_memory(tmp_path):
