@@ -534,7 +534,7 @@ impl HmBatch {
             .zip(&mut self.st[..nblk])
             .zip(&mut self.out[..nblk])
         {
-            kernel(b, s, o, dt);
+            kernel.eval(b, s, o, dt);
         }
         for (e, &(i, j, slot)) in self.lane[..m].iter().enumerate() {
             let (s, o, k) = (&self.st[e / LANES], &self.out[e / LANES], e % LANES);
@@ -1593,7 +1593,7 @@ mod tests {
         batch.push(hm, (0, 1), radii, kin, d, st, 0);
         let (mut rf, mut rt) = (vec![Vec3::zeros(); 2], vec![Vec3::zeros(); 2]);
         let mut sums = (0.0, 0.0, 0.0);
-        let kernel: crate::hm_block::Kernel = crate::hm_block::eval_scalar;
+        let kernel = crate::hm_block::Kernel::SCALAR;
         let mut acc = BlockAcc {
             lo: 0,
             hi: 2,

@@ -194,8 +194,23 @@ fn eval_body(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
     }
 }
 
-/// A block kernel: inputs, state (updated), outputs, time step.
-pub(crate) type Kernel = fn(&HmInput, &mut HmState, &mut HmOutput, f64);
+/// A block kernel: inputs, state (updated), outputs, time step. A value exists only for a
+/// variant this processor runs ([`kernel`], [`variants`]), so calling it is safe.
+#[derive(Clone, Copy)]
+pub(crate) struct Kernel(unsafe fn(&HmInput, &mut HmState, &mut HmOutput, f64));
+
+impl Kernel {
+    /// The baseline variant (every processor).
+    pub(crate) const SCALAR: Kernel = Kernel(eval_scalar);
+
+    /// Evaluates a block.
+    #[inline]
+    pub(crate) fn eval(self, b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
+        // SAFETY: a `Kernel` is built only by `kernel`, `variants` and `SCALAR`, each after
+        // detecting the instruction set its function is compiled for.
+        unsafe { (self.0)(b, s, o, dt) }
+    }
+}
 
 /// The kernel compiled for the baseline instruction set.
 pub(crate) fn eval_scalar(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
@@ -216,15 +231,22 @@ mod x86 {
         eval_body(b, s, o, dt)
     }
 
-    /// AVX2 version; only handed out by [`super::kernel`] when the processor has AVX2.
-    pub(super) fn eval_avx2(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
-        // SAFETY: `kernel` returns this function only after detecting AVX2.
+    /// AVX2 version.
+    ///
+    /// # Safety
+    /// The processor must have AVX2 (wrapped in a [`super::Kernel`] only after detecting it).
+    pub(super) unsafe fn eval_avx2(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
+        // SAFETY: the caller guarantees AVX2.
         unsafe { avx2(b, s, o, dt) }
     }
 
-    /// AVX-512 version; only handed out by [`super::kernel`] when the processor has it.
-    pub(super) fn eval_avx512(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
-        // SAFETY: `kernel` returns this function only after detecting AVX-512 F/VL/DQ.
+    /// AVX-512 version.
+    ///
+    /// # Safety
+    /// The processor must have AVX-512 F/VL/DQ (wrapped in a [`super::Kernel`] only after
+    /// detecting them).
+    pub(super) unsafe fn eval_avx512(b: &HmInput, s: &mut HmState, o: &mut HmOutput, dt: f64) {
+        // SAFETY: the caller guarantees AVX-512 F/VL/DQ.
         unsafe { avx512(b, s, o, dt) }
     }
 }
@@ -240,31 +262,31 @@ pub(crate) fn kernel() -> Kernel {
                     && is_x86_feature_detected!("avx512vl")
                     && is_x86_feature_detected!("avx512dq")
                 {
-                    return x86::eval_avx512 as Kernel;
+                    return Kernel(x86::eval_avx512);
                 }
                 if is_x86_feature_detected!("avx2") {
-                    return x86::eval_avx2 as Kernel;
+                    return Kernel(x86::eval_avx2);
                 }
             }
         }
-        eval_scalar as Kernel
+        Kernel::SCALAR
     })
 }
 
 /// Every kernel variant this processor can run, with its name (for tests).
 #[cfg(test)]
 pub(crate) fn variants() -> Vec<(&'static str, Kernel)> {
-    let mut v: Vec<(&'static str, Kernel)> = vec![("scalar", eval_scalar)];
+    let mut v: Vec<(&'static str, Kernel)> = vec![("scalar", Kernel::SCALAR)];
     #[cfg(target_arch = "x86_64")]
     {
         if is_x86_feature_detected!("avx2") {
-            v.push(("avx2", x86::eval_avx2));
+            v.push(("avx2", Kernel(x86::eval_avx2)));
         }
         if is_x86_feature_detected!("avx512f")
             && is_x86_feature_detected!("avx512vl")
             && is_x86_feature_detected!("avx512dq")
         {
-            v.push(("avx512", x86::eval_avx512));
+            v.push(("avx512", Kernel(x86::eval_avx512)));
         }
     }
     v
@@ -325,7 +347,7 @@ mod tests {
             }
             for (name, kern) in &variants {
                 let (mut s1, mut o1) = (s, HmOutput::default());
-                kern(&b, &mut s1, &mut o1, dt);
+                kern.eval(&b, &mut s1, &mut o1, dt);
                 let bits = |x: &[f64; LANES]| x.map(f64::to_bits);
                 for (x, y) in [
                     (&o0.fx, &o1.fx),

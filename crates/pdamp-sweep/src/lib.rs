@@ -18,6 +18,8 @@
 //! list, runs a task and collects; this crate keeps the directory, plans and submits the
 //! Slurm arrays and tells the state of every task.
 
+#![forbid(unsafe_code)]
+
 pub mod slurm;
 pub mod status;
 
