@@ -1306,7 +1306,7 @@ impl World {
 /// with their radius and interaction range both grown by `3 × skin`. A particle moves less than one skin
 /// between neighbour-list rebuilds [D Eq. 2.11], so less than two skins since any refresh after
 /// the last rebuild; the refresh is repeated at every rebuild and whenever a body has translated
-/// by one skin since, or rotated at all. Skipping the others therefore changes no result.
+/// by one skin since, rotated at all, or its deformable walls moved by one skin. Skipping the others therefore changes no result.
 #[allow(clippy::too_many_arguments)]
 fn refresh_wall_candidates(
     p: &crate::particles::ParticleSet,
@@ -1315,7 +1315,7 @@ fn refresh_wall_candidates(
     bodies: &[crate::body::RigidBody],
     body_step: &[BodyState],
     candidate: &mut Vec<bool>,
-    reference: &mut Vec<(Vec3, crate::math::Rotation, usize)>,
+    reference: &mut Vec<(Vec3, crate::math::Rotation, usize, f64)>,
     ref_builds: &mut u64,
     enabled: bool,
     slots: &mut [Vec<WallSlot>],
@@ -1332,16 +1332,20 @@ fn refresh_wall_candidates(
             (b.state.position_m - r.0).norm() < skin
                 && b.state.orientation == r.1
                 && b.walls.len() == r.2
+                && deformation_m(b) - r.3 < skin
         });
     if fresh {
         return false;
     }
     reference.clear();
-    reference.extend(
-        bodies
-            .iter()
-            .map(|b| (b.state.position_m, b.state.orientation, b.walls.len())),
-    );
+    reference.extend(bodies.iter().map(|b| {
+        (
+            b.state.position_m,
+            b.state.orientation,
+            b.walls.len(),
+            deformation_m(b),
+        )
+    }));
     *ref_builds = nl.builds;
     refresh_candidate_flags(p, interactions, nl, bodies, body_step, candidate, enabled);
     list.clear();
@@ -1355,6 +1359,12 @@ fn refresh_wall_candidates(
         }
     }
     true
+}
+
+/// How far the deformable walls of body `b` have moved in all, m (a refresh of the wall
+/// candidates is due when it has grown by a skin, like a body's translation).
+fn deformation_m(b: &crate::body::RigidBody) -> f64 {
+    b.walls.iter().map(|w| w.geometry.deformation_m()).sum()
 }
 
 /// Wall contacts a particle has room for once it is a wall candidate (more grow the buffer).
@@ -1417,6 +1427,24 @@ fn refresh_candidate_flags(
         });
 }
 
+/// Velocity of a deformable mesh's surface at contact point `point_world` of `feature`, on top
+/// of its body's rigid motion (world frame), m/s; zero for every other wall, at the cost of a
+/// match.
+#[inline]
+fn deforming_surface_velocity(
+    geometry: &crate::walls::Geometry,
+    bs: &BodyState,
+    feature: u32,
+    point_world: &Vec3,
+) -> Vec3 {
+    match geometry {
+        crate::walls::Geometry::Mesh(m) if !m.vertex_velocities().is_empty() => {
+            bs.vector_to_world(&m.surface_velocity(feature, &bs.to_body(point_world)))
+        }
+        _ => Vec3::zeros(),
+    }
+}
+
 /// Contacts of particle `i` with all walls: finds them, matches them to the previous slots
 /// (same feature, or the same wall with a nearly parallel normal, so that history survives a
 /// sphere sliding from a face onto an edge), evaluates the laws and accumulates force, torque
@@ -1474,9 +1502,11 @@ fn wall_contacts_of(
                         }
                     }
                 }
+                let mut prev_feature = c.feature;
                 if let Some((k, _)) = best {
                     state = slots[k].state;
                     prev_point = slots[k].point;
+                    prev_feature = slots[k].feature;
                     slots[k].state.active = false; // consumed
                 }
                 fresh.push(WallSlot {
@@ -1494,7 +1524,8 @@ fn wall_contacts_of(
                     r_eff_m: effective_radius(r, c.curvature_radius_m),
                     ..props0
                 };
-                let v_wall = bs.point_velocity(&point);
+                let v_wall = bs.point_velocity(&point)
+                    + deforming_surface_velocity(&wall.geometry, bs, c.feature, &point);
                 let rb = r - 0.5 * c.overlap_m.max(0.0);
                 let v_p = v + w.cross(&(-rb * normal));
                 let v_rel = v_p - v_wall;
@@ -1522,7 +1553,9 @@ fn wall_contacts_of(
                 // The previous force acted at the previous contact point: on a rotating wall
                 // its half of the trapezoid uses the wall velocity there (exactly zero change
                 // for walls that only translate).
-                let dv_wall = bs.point_velocity(&prev_point) - v_wall;
+                let dv_wall = bs.point_velocity(&prev_point)
+                    + deforming_surface_velocity(&wall.geometry, bs, prev_feature, &prev_point)
+                    - v_wall;
                 let (fn_prev, ft_prev) = (s.state.normal_force_prev, s.state.tangential_force_prev);
                 inc.wall_work_j += 0.5 * (fn_prev + ft_prev).dot(&dv_wall) * dt;
                 let (mut dn, mut dtan) =
@@ -1542,7 +1575,9 @@ fn wall_contacts_of(
     // Contacts that ended during this step: close their work integral (force falls to zero).
     for s in slots.iter_mut().filter(|s| s.state.active) {
         let bs = &body_step[s.body as usize];
-        let v_wall = bs.point_velocity(&s.point);
+        let geometry = &bodies[s.body as usize].walls[s.wall as usize].geometry;
+        let v_wall = bs.point_velocity(&s.point)
+            + deforming_surface_velocity(geometry, bs, s.feature, &s.point);
         let rb = r;
         let v_rel = v + w.cross(&(-rb * s.normal)) - v_wall;
         let w_rel = w - bs.angular_velocity_rad_s;

@@ -11,6 +11,7 @@ pub mod bed;
 pub mod bed_statistics;
 pub mod body;
 pub mod contact;
+pub mod deformable;
 pub mod drop_down;
 pub mod energy;
 mod forces;

@@ -90,7 +90,7 @@ pub struct World {
     /// `refresh_wall_candidates`); the others skip the wall search.
     pub(crate) wall_candidate: Vec<bool>,
     /// Body poses and neighbour-list build count when the candidates were computed.
-    pub(crate) wall_ref: Vec<(Vec3, crate::math::Rotation, usize)>,
+    pub(crate) wall_ref: Vec<(Vec3, crate::math::Rotation, usize, f64)>,
     pub(crate) wall_ref_builds: u64,
     /// Refreshes of the wall candidates since the world was built (diagnostic, not saved).
     pub(crate) wall_refreshes: u64,

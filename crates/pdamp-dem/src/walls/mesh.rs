@@ -138,6 +138,31 @@ pub enum MeshError {
     /// A scale factor is not positive and finite.
     #[error("scale factor must be positive and finite, got {0}")]
     BadScale(f64),
+    /// New vertex positions or velocities of a deformable mesh in another number.
+    #[error("the mesh has {expected} vertices, {got} positions or velocities were given")]
+    VertexCount {
+        /// Vertices of the mesh.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+    /// No wall `wall` on body `body`.
+    #[error("there is no wall {wall} on body {body}")]
+    NoSuchWall {
+        /// Body index.
+        body: usize,
+        /// Wall index within the body.
+        wall: usize,
+    },
+    /// Vertices can be moved only on a triangle-mesh wall.
+    #[error("wall {wall:?} is not a triangle mesh: only mesh walls can deform")]
+    NotAMesh {
+        /// Name of the wall.
+        wall: String,
+    },
+    /// The time step of a vertex move is not positive and finite.
+    #[error("the time step of a vertex move must be positive and finite, got {0} s")]
+    BadTimeStep(f64),
 }
 
 /// Per-triangle derived data.
@@ -199,9 +224,16 @@ pub struct TriMesh {
     faces: Vec<[u32; 3]>,
     /// Derived data (shared between clones; rebuilt when the geometry changes).
     d: Arc<Derived>,
+    /// A deformable mesh's vertex velocities over the current step (body frame), m/s; empty for
+    /// a rigid mesh ([`TriMesh::move_vertices`]).
+    velocity: Vec<Vec3>,
+    /// Sum of the largest vertex displacement of every [`TriMesh::move_vertices`], m: the wall
+    /// candidates are refreshed when it has grown by a skin.
+    deformation_m: f64,
 }
 
 /// Topology, per-triangle data and the grid of a [`TriMesh`].
+#[derive(Clone)]
 struct Derived {
     tris: Vec<Tri>,
     edges: Vec<Edge>,
@@ -470,6 +502,8 @@ impl TriMesh {
             dir(edge_tris[s0]) != dir(edge_tris[s0 + 1])
         });
         Ok(TriMesh {
+            velocity: Vec::new(),
+            deformation_m: 0.0,
             vertices,
             faces,
             d: Arc::new(Derived {
@@ -947,6 +981,9 @@ impl Grid {
         }
     }
 }
+
+mod deform;
+pub use deform::VertexWeights;
 
 #[cfg(test)]
 mod tests;

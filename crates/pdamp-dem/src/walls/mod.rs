@@ -11,7 +11,7 @@ mod mesh;
 mod plane;
 
 pub use cylinder::{CylinderInside, CylinderOutside};
-pub use mesh::{MeshError, TriMesh};
+pub use mesh::{MeshError, TriMesh, VertexWeights};
 pub use plane::{BoxInside, Plane};
 
 /// One contact of a sphere with a wall, expressed in the wall's body frame.
@@ -90,6 +90,26 @@ impl Geometry {
             return Some(f64::INFINITY);
         }
         None
+    }
+
+    /// Velocity of the wall surface itself at contact point `x` (body frame) of `feature`, on
+    /// top of the body's rigid motion: non-zero only for a deformable mesh
+    /// ([`TriMesh::move_vertices`]), m/s.
+    #[inline]
+    pub fn surface_velocity(&self, feature: u32, x: &Vec3) -> Vec3 {
+        match self {
+            Geometry::Mesh(m) => m.surface_velocity(feature, x),
+            _ => Vec3::zeros(),
+        }
+    }
+
+    /// How far the surface has deformed in all (sum of the largest vertex displacement of
+    /// every move), m; 0 for rigid geometry.
+    pub fn deformation_m(&self) -> f64 {
+        match self {
+            Geometry::Mesh(m) => m.deformation_m(),
+            _ => 0.0,
+        }
     }
 
     /// Axis-aligned bounding box in the body frame, if finite.
