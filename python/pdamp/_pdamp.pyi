@@ -92,6 +92,12 @@ class World:
         at_s: Optional[float] = None,
     ) -> None:
         """Moves a driven body: its state at `at_s` (default: the end of the next step)."""
+    def wall_vertices(self, body: str, wall: str) -> npt.NDArray[np.float64]:
+        """(n, 3) vertices of a mesh wall (body frame, m), a copy."""
+    def move_wall_vertices(self, body: str, wall: str, positions: npt.NDArray[np.float64]) -> None:
+        """Deforms a mesh wall: its vertices at the end of the next step (body frame, m)."""
+    def wall_nodal_forces(self, body: str, wall: str) -> npt.NDArray[np.float64]:
+        """(n, 3) loads of the particles on the wall's vertices in the last step, N."""
     def energy(self) -> Dict[str, float]:
         """The energy ledger, J, with `time_s`, `dissipated_j` and `closure_error_j`."""
     def check_health(self) -> None: ...

@@ -170,3 +170,46 @@ def test_tqdm_bar(tmp_path, capsys):
     bar.close()
     err = capsys.readouterr().err
     assert "running" in err and "100%" in err
+
+
+def test_a_deformable_wall_moved_from_python_returns_nodal_forces(tmp_path):
+    """A plate on the box floor (a `box_outside` mesh of its own body) is lifted from Python by
+    moving its vertices: the nodal forces handed back sum to the bed's load on the plate's body
+    (round-off), every step, and carry the bed's weight at rest."""
+    d = pdamp.load(box(tmp_path, 200, 0.01)).to_dict()
+    d["bodies"][0]["motion"] = {"type": "fixed"}
+    d["bodies"].append({
+        "name": "piston", "position_m": [0.0, 0.0, 0.0], "motion": {"type": "fixed"},
+        "walls": [{"name": "plate", "material": d["materials"][0]["name"],
+                   "geometry": {"type": "box_outside", "center_m": [0.0, 0.0, 0.001],
+                                "half_extents_m": [0.019, 0.019, 0.001]}}],
+    })
+    region = d["particles"][0]["placement"]["region"]
+    region["min_m"][2] = 0.0025                    # the bed starts above the plate
+    d["settle"]["max_duration_s"] = 0.08
+    w = pdamp.World(pdamp.Scenario.from_dict(d, base_dir=tmp_path), threads=2)
+    v0 = w.wall_vertices("piston", "plate")
+    assert v0.shape == (8, 3)
+    weight = w.masses_kg.sum() * 9.81
+    # at rest after settling: the plate carries (nearly all of) the bed's weight
+    f = w.wall_nodal_forces("piston", "plate")
+    np.testing.assert_allclose(f.sum(axis=0), w.body_load("piston")[0], rtol=1e-12, atol=1e-15)
+    assert f.sum(axis=0)[2] < 0 and abs(f.sum(axis=0)[2] + weight) < 0.05 * weight
+    lift, steps = 1e-3, 2000
+    pushed = 0.0
+    for k in range(1, steps + 1):                   # lift the plate by 1 mm (it throws the bed)
+        v = v0.copy()
+        v[:, 2] += lift * k / steps
+        w.move_wall_vertices("piston", "plate", v)
+        w.step()
+        f = w.wall_nodal_forces("piston", "plate")
+        np.testing.assert_allclose(f.sum(axis=0), w.body_load("piston")[0], rtol=1e-12, atol=1e-15)
+        pushed = max(pushed, -f[:, 2].sum())
+    np.testing.assert_array_equal(w.wall_vertices("piston", "plate")[:, 2], v0[:, 2] + lift)
+    assert pushed > weight                          # accelerating the bed upwards takes more
+    with pytest.raises(ValueError, match="not a triangle mesh"):
+        w.wall_vertices("box", "container")
+    with pytest.raises(ValueError, match="vertices"):
+        w.move_wall_vertices("piston", "plate", v0[:4])
+    with pytest.raises(KeyError, match="no wall"):
+        w.wall_nodal_forces("piston", "lid")

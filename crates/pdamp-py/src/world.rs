@@ -35,6 +35,18 @@ pub(crate) struct PyWorld {
 }
 
 impl PyWorld {
+    fn wall(&self, body: &str, wall: &str) -> PyResult<(usize, usize)> {
+        let b = self.body(body)?;
+        let walls = &self.world.bodies[b].walls;
+        let w = walls.iter().position(|w| w.name == wall).ok_or_else(|| {
+            let names: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
+            PyKeyError::new_err(format!(
+                "body {body:?} has no wall {wall:?}; its walls are {names:?}"
+            ))
+        })?;
+        Ok((b, w))
+    }
+
     fn body(&self, name: &str) -> PyResult<usize> {
         self.world
             .bodies
@@ -378,6 +390,73 @@ impl PyWorld {
         };
         self.world.bodies[b].motion = Motion::Prescribed(Arc::new(track));
         Ok(())
+    }
+
+    /// Vertices of mesh wall `wall` of body `body` (body frame, m), an (n, 3) copy; the
+    /// starting point of [`move_wall_vertices`](Self::move_wall_vertices).
+    fn wall_vertices<'py>(
+        &self,
+        py: Python<'py>,
+        body: &str,
+        wall: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (b, w) = self.wall(body, wall)?;
+        match &self.world.bodies[b].walls[w].geometry {
+            pdamp_dem::Geometry::Mesh(m) => {
+                let rows: Vec<Vec<f64>> =
+                    m.vertices().iter().map(|v| vec![v.x, v.y, v.z]).collect();
+                PyArray2::from_vec2(py, &rows).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+            }
+            _ => Err(PyValueError::new_err(format!(
+                "wall {wall:?} of body {body:?} is not a triangle mesh (stl or box_outside)"
+            ))),
+        }
+    }
+
+    /// Deforms mesh wall `wall` of body `body`: its vertices at the end of the next step
+    /// (an (n, 3) array, body frame, m, the order of `wall_vertices`); the step's contacts see
+    /// the mean vertex velocity. Read the loads on the vertices with `wall_nodal_forces` after
+    /// the step — a finite-element model of your own coupled to the bed (P Sect. 2.3).
+    fn move_wall_vertices(
+        &mut self,
+        body: &str,
+        wall: &str,
+        positions: numpy::PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<()> {
+        let (b, w) = self.wall(body, wall)?;
+        let a = positions.as_array();
+        if a.ncols() != 3 {
+            return Err(PyValueError::new_err(format!(
+                "positions must be an (n, 3) array, got {:?}",
+                a.shape()
+            )));
+        }
+        let p: Vec<Vec3> = a
+            .rows()
+            .into_iter()
+            .map(|r| Vec3::new(r[0], r[1], r[2]))
+            .collect();
+        self.world
+            .move_wall_vertices(b, w, &p)
+            .map_err(|e| PyValueError::new_err(format!("wall {wall:?}: {e}")))
+    }
+
+    /// The loads the particles put on the vertices of mesh wall `wall` of body `body` in the last
+    /// step (an (n, 3) array, N, world frame): each contact force split onto its face, edge or
+    /// vertex with the barycentric weights of the contact point.
+    fn wall_nodal_forces<'py>(
+        &self,
+        py: Python<'py>,
+        body: &str,
+        wall: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (b, w) = self.wall(body, wall)?;
+        let mut out = Vec::new();
+        self.world
+            .wall_nodal_forces(b, w, &mut out)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let rows: Vec<Vec<f64>> = out.iter().map(|v| vec![v.x, v.y, v.z]).collect();
+        PyArray2::from_vec2(py, &rows).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 
     /// The energy ledger now, J: the terms of `summary.json`'s `energy` (kinetic, potential,
