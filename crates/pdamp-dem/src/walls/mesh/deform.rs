@@ -37,18 +37,24 @@ impl TriMesh {
         if !(dt_s.is_finite() && dt_s > 0.0) {
             return Err(MeshError::BadTimeStep(dt_s));
         }
-        let mut d: Derived = (*self.d).clone();
+        // Checked on the new positions before anything changes (the mesh stays as it was).
         for (t, f) in self.faces.iter().enumerate() {
             let p = f.map(|i| positions[i as usize]);
-            let c = (p[1] - p[0]).cross(&(p[2] - p[0]));
+            let area2 = (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
             let lmax2 = (p[1] - p[0])
                 .norm_squared()
                 .max((p[2] - p[1]).norm_squared())
                 .max((p[0] - p[2]).norm_squared());
-            let area2 = c.norm();
             if area2.partial_cmp(&(1e-14 * lmax2)) != Some(std::cmp::Ordering::Greater) {
                 return Err(MeshError::Degenerate { triangle: t });
             }
+        }
+        // In place when no clone shares the derived data (the usual case: a world's wall).
+        let d: &mut Derived = Arc::make_mut(&mut self.d);
+        for (t, f) in self.faces.iter().enumerate() {
+            let p = f.map(|i| positions[i as usize]);
+            let c = (p[1] - p[0]).cross(&(p[2] - p[0]));
+            let area2 = c.norm();
             let n = c / area2;
             let tri = &mut d.tris[t];
             tri.n = n;
@@ -71,7 +77,6 @@ impl TriMesh {
         self.deformation_m += largest;
         self.vertices.clear();
         self.vertices.extend_from_slice(positions);
-        self.d = Arc::new(d);
         Ok(())
     }
 
