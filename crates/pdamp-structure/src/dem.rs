@@ -631,8 +631,13 @@ pub fn run_dem_free_with_energy(
     let n = structure.modes.len();
     let mut q0 = DVector::zeros(n);
     let mut v0 = DVector::zeros(n);
-    q0[k] = spec.initial_displacement_m / init[k];
-    v0[k] = spec.initial_velocity_m_s / init[k];
+    let scale = if spec.scale_initial_by_bed_mass {
+        crate::free::bed_mass_scale(init[k], damper.bed_mass_kg)
+    } else {
+        1.0
+    };
+    q0[k] = scale * spec.initial_displacement_m / init[k];
+    v0[k] = scale * spec.initial_velocity_m_s / init[k];
     let r = coupled_run(
         structure,
         damper,

@@ -88,12 +88,22 @@ pub struct FreeVibrationSpec {
     pub initial_displacement_m: f64,
     /// Initial velocity there, m/s.
     pub initial_velocity_m_s: f64,
+    /// Scale the initial displacement and velocity by $1 + m_{bed}/M$ [D Eq. 5.19] (see
+    /// [`bed_mass_scale`]).
+    pub scale_initial_by_bed_mass: bool,
     /// Output point.
     pub output_point: String,
     /// Update rule for attached dampers.
     pub update: UpdateRule,
     /// Store every n-th step.
     pub sample_every: usize,
+}
+
+/// The factor $1 + m_{bed}/M$ of the initial amplitude [D Eq. 5.19]: the excitation that starts
+/// the decay gives the same peak acceleration with and without particles. $M = 1/\varphi^2$ is
+/// the modal mass of the mode at the initial point ($\varphi$ its mass-normalised shape there).
+pub fn bed_mass_scale(shape_at_initial_point: f64, bed_mass_kg: f64) -> f64 {
+    1.0 + bed_mass_kg * shape_at_initial_point * shape_at_initial_point
 }
 
 /// Effective eigenfrequency of mode k with attached effective masses [D Eq. 3.33], rad/s.
@@ -199,8 +209,13 @@ pub fn run_free_vibration(
         ));
     }
     let mut it = ModalIntegrator::new(structure, spec.time_step_s);
-    it.q[k] = spec.initial_displacement_m / init[k];
-    it.v[k] = spec.initial_velocity_m_s / init[k];
+    let scale = if spec.scale_initial_by_bed_mass {
+        bed_mass_scale(init[k], dampers.iter().map(|d| d.model.bed_mass_kg()).sum())
+    } else {
+        1.0
+    };
+    it.q[k] = scale * spec.initial_displacement_m / init[k];
+    it.v[k] = scale * spec.initial_velocity_m_s / init[k];
     let mut atts: Vec<Attachment> = shapes
         .iter()
         .map(|s| Attachment {

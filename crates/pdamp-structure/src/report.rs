@@ -198,6 +198,7 @@ pub fn run_couple(
             initial_point,
             initial_displacement_m,
             initial_velocity_m_s,
+            scale_initial_by_bed_mass,
             output_point,
             update,
             sample_every,
@@ -212,6 +213,7 @@ pub fn run_couple(
                 output_point: output_point.clone(),
                 update: *update,
                 sample_every: *sample_every,
+                scale_initial_by_bed_mass: *scale_initial_by_bed_mass,
             };
             let hist = match &dem {
                 Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, o, progress, Some(&ck))?,
@@ -603,7 +605,12 @@ fn free_outputs(
     // Plots: decay with envelope (positive peaks) and the bare structure's envelope.
     let z = structure.modes[spec.mode].damping_ratio;
     let w = TAU * f_k;
-    let x0 = spec.initial_displacement_m.abs();
+    // With D Eq. 5.19 the run starts from the scaled displacement: the output point's first
+    // sample (the initial point's, where they are the same point).
+    let x0 = match (spec.scale_initial_by_bed_mass, hist.displacement_m.first()) {
+        (true, Some(x)) if spec.output_point == spec.initial_point => x.abs(),
+        _ => spec.initial_displacement_m.abs(),
+    };
     let env: Vec<f64> = hist
         .time_s
         .iter()

@@ -1104,6 +1104,13 @@ pub enum AnalysisSpec {
         /// Initial velocity, m/s.
         #[serde(default)]
         initial_velocity_m_s: f64,
+        /// Scale the initial displacement (and velocity) by $1 + m_{bed}/M$ [D Eq. 5.19]: the
+        /// excitation that starts the decay gives the structure the same peak acceleration with
+        /// and without particles, so the amplitude grows with the added bed mass ($M$: the modal
+        /// mass of `mode` at `initial_point`, $m_{bed}$: the dampers' particle mass). For the
+        /// Flexor of D Sect. 5.2.1 (78 mm without particles).
+        #[serde(default)]
+        scale_initial_by_bed_mass: bool,
         /// Output point.
         output_point: String,
         /// Update rule for approaches 2/3.

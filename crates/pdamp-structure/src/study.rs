@@ -301,6 +301,7 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
             initial_point,
             initial_displacement_m,
             initial_velocity_m_s,
+            scale_initial_by_bed_mass,
             output_point,
             update,
             sample_every,
@@ -314,6 +315,7 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
             output_point: output_point.clone(),
             update: *update,
             sample_every: *sample_every,
+            scale_initial_by_bed_mass: *scale_initial_by_bed_mass,
         },
         _ => return Err("the study's scenario needs [analysis] kind = \"free\"".into()),
     };

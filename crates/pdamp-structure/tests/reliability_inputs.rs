@@ -614,6 +614,7 @@ fn free_spec(dt: f64) -> FreeVibrationSpec {
         output_point: "damper".into(),
         update: UpdateRule::ZeroCrossing,
         sample_every: 1,
+        scale_initial_by_bed_mass: false,
     }
 }
 

@@ -50,6 +50,7 @@ fn clamped_particle_is_an_added_mass() {
         output_point: "damper".into(),
         update: UpdateRule::Never,
         sample_every: 1,
+        scale_initial_by_bed_mass: false,
     };
     let h = run_dem_free(
         &s,

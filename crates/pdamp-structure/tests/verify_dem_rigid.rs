@@ -71,6 +71,7 @@ fn spec(point: &str, x0: f64, duration_s: f64) -> FreeVibrationSpec {
         output_point: point.into(),
         update: UpdateRule::Never,
         sample_every: 1,
+        scale_initial_by_bed_mass: false,
     }
 }
 

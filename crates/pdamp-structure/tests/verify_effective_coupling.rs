@@ -38,6 +38,7 @@ fn viscous_field_reproduces_exact_linear_decay() {
         output_point: "damper".into(),
         update: UpdateRule::ZeroCrossing,
         sample_every: 10,
+        scale_initial_by_bed_mass: false,
     };
     let h = free::run_free_vibration(&s, &dampers, &spec).unwrap();
     assert!(h.updates.len() > 20);

@@ -31,6 +31,7 @@ fn log_decrement_returns_set_damping_ratio() {
         output_point: "output".into(),
         update: UpdateRule::Never,
         sample_every: 1,
+        scale_initial_by_bed_mass: false,
     };
     let h = free::run_free_vibration(&s, &[], &spec).unwrap();
     let peaks = free::decay_peaks(&h, 0.5 / F0).unwrap();
