@@ -2,11 +2,11 @@
 //! (not the CLI binary) from Python, with the GIL released, Ctrl-C turned into a clean stop
 //! (`KeyboardInterrupt`) and progress handed to a Python callback.
 //!
-//! * [`scenario`]: scenarios from files and dicts, validated with the command line's messages;
-//! * [`world`]: a DEM world stepped from Python with zero-copy numpy views and driven bodies;
-//! * [`levels`]: damper points, effective fields, coupled structures, structural modes, powder
+//! * `scenario`: scenarios from files and dicts, validated with the command line's messages;
+//! * `world`: a DEM world stepped from Python with zero-copy numpy views and driven bodies;
+//! * `levels`: damper points, effective fields, coupled structures, structural modes, powder
 //!   cavities, restitution curves and single impacts;
-//! * [`detach`]: how library work runs under Python.
+//! * `detach`: how library work runs under Python.
 //!
 //! The Python side (`python/pdamp/__init__.py`) turns the JSON results into dicts, numpy arrays
 //! and pandas DataFrames.
