@@ -1427,22 +1427,26 @@ fn refresh_candidate_flags(
         });
 }
 
+/// The wall as a deformable mesh (a mesh whose vertices have velocities), if it is one.
+#[inline(always)]
+fn deforming_mesh(geometry: &crate::walls::Geometry) -> Option<&crate::walls::TriMesh> {
+    match geometry {
+        crate::walls::Geometry::Mesh(m) if !m.vertex_velocities().is_empty() => Some(m),
+        _ => None,
+    }
+}
+
 /// Velocity of a deformable mesh's surface at contact point `point_world` of `feature`, on top
-/// of its body's rigid motion (world frame), m/s; zero for every other wall, at the cost of a
-/// match.
-#[inline]
+/// of its body's rigid motion (world frame), m/s. Kept out of line: rigid walls never call it.
+#[inline(never)]
+#[cold]
 fn deforming_surface_velocity(
-    geometry: &crate::walls::Geometry,
+    mesh: &crate::walls::TriMesh,
     bs: &BodyState,
     feature: u32,
     point_world: &Vec3,
 ) -> Vec3 {
-    match geometry {
-        crate::walls::Geometry::Mesh(m) if !m.vertex_velocities().is_empty() => {
-            bs.vector_to_world(&m.surface_velocity(feature, &bs.to_body(point_world)))
-        }
-        _ => Vec3::zeros(),
-    }
+    bs.vector_to_world(&mesh.surface_velocity(feature, &bs.to_body(point_world)))
 }
 
 /// Contacts of particle `i` with all walls: finds them, matches them to the previous slots
@@ -1483,6 +1487,7 @@ fn wall_contacts_of(
             let gap = model.max_interaction_gap_m(&props0);
             contacts.clear();
             wall.geometry.sphere_contacts(&xb, r, gap, contacts);
+            let deforming = deforming_mesh(&wall.geometry);
             for c in contacts.iter() {
                 let normal = bs.vector_to_world(&c.normal);
                 let point = bs.point_to_world(&c.point);
@@ -1502,11 +1507,9 @@ fn wall_contacts_of(
                         }
                     }
                 }
-                let mut prev_feature = c.feature;
                 if let Some((k, _)) = best {
                     state = slots[k].state;
                     prev_point = slots[k].point;
-                    prev_feature = slots[k].feature;
                     slots[k].state.active = false; // consumed
                 }
                 fresh.push(WallSlot {
@@ -1524,8 +1527,10 @@ fn wall_contacts_of(
                     r_eff_m: effective_radius(r, c.curvature_radius_m),
                     ..props0
                 };
-                let v_wall = bs.point_velocity(&point)
-                    + deforming_surface_velocity(&wall.geometry, bs, c.feature, &point);
+                let mut v_wall = bs.point_velocity(&point);
+                if let Some(m) = deforming {
+                    v_wall += deforming_surface_velocity(m, bs, c.feature, &point);
+                }
                 let rb = r - 0.5 * c.overlap_m.max(0.0);
                 let v_p = v + w.cross(&(-rb * normal));
                 let v_rel = v_p - v_wall;
@@ -1553,9 +1558,12 @@ fn wall_contacts_of(
                 // The previous force acted at the previous contact point: on a rotating wall
                 // its half of the trapezoid uses the wall velocity there (exactly zero change
                 // for walls that only translate).
-                let dv_wall = bs.point_velocity(&prev_point)
-                    + deforming_surface_velocity(&wall.geometry, bs, prev_feature, &prev_point)
-                    - v_wall;
+                let mut dv_wall = bs.point_velocity(&prev_point) - v_wall;
+                if let Some(m) = deforming {
+                    // the surface velocity at the previous point, interpolated in the
+                    // current contact's feature
+                    dv_wall += deforming_surface_velocity(m, bs, c.feature, &prev_point);
+                }
                 let (fn_prev, ft_prev) = (s.state.normal_force_prev, s.state.tangential_force_prev);
                 inc.wall_work_j += 0.5 * (fn_prev + ft_prev).dot(&dv_wall) * dt;
                 let (mut dn, mut dtan) =
@@ -1575,9 +1583,10 @@ fn wall_contacts_of(
     // Contacts that ended during this step: close their work integral (force falls to zero).
     for s in slots.iter_mut().filter(|s| s.state.active) {
         let bs = &body_step[s.body as usize];
-        let geometry = &bodies[s.body as usize].walls[s.wall as usize].geometry;
-        let v_wall = bs.point_velocity(&s.point)
-            + deforming_surface_velocity(geometry, bs, s.feature, &s.point);
+        let mut v_wall = bs.point_velocity(&s.point);
+        if let Some(m) = deforming_mesh(&bodies[s.body as usize].walls[s.wall as usize].geometry) {
+            v_wall += deforming_surface_velocity(m, bs, s.feature, &s.point);
+        }
         let rb = r;
         let v_rel = v + w.cross(&(-rb * s.normal)) - v_wall;
         let w_rel = w - bs.angular_velocity_rad_s;
