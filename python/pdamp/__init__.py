@@ -219,7 +219,7 @@ def damper_point(
     """
     sc = _with_excitation(scenario, frequency_hz, amplitude_m, acceleration_m_s2, intensity)
     with _Progress(progress) as cb:
-        return _json.loads(_pdamp.damper_point(sc, _os.fspath(out), threads, cb))
+        return _json.loads(_pdamp.run(sc, _os.fspath(out), threads, cb))
 
 
 def fields(

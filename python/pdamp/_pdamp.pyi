@@ -105,9 +105,6 @@ class World:
 def run(
     scenario: Scenario, out: str, threads: Optional[int] = None, progress: Progress = None
 ) -> str: ...
-def damper_point(
-    scenario: Scenario, out: str, threads: Optional[int] = None, progress: Progress = None
-) -> str: ...
 def fields(
     scenario: Scenario, out: str, threads: Optional[int] = None, progress: Progress = None
 ) -> Columns: ...

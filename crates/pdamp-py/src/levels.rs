@@ -32,7 +32,8 @@ fn columns<'py>(
 
 /// A plain scenario run to files (`pdamp run SCENARIO.toml --out OUT`: settling, the main run,
 /// `energy.csv`, VTK snapshots, `summary.json`); returns the text of `summary.json`. A damper
-/// scenario runs its excitation point, as the command line does.
+/// scenario runs its excitation point (prepares the bed, excites the container, evaluates the
+/// complex power), as the command line does — Python's `damper_point`.
 #[pyfunction]
 #[pyo3(signature = (scenario, out, threads = None, progress = None))]
 pub(crate) fn run(
@@ -55,27 +56,6 @@ pub(crate) fn run(
         } else {
             pdamp_io::run::run_scenario(sc, base, &out, options, |phase, f| p.set(phase, f))?;
         }
-        std::fs::read_to_string(out.join("summary.json")).map_err(|e| e.to_string())
-    })
-}
-
-/// One excitation point of a damper scenario (`pdamp run DAMPER.toml --out OUT`): prepares the
-/// bed, excites the container and writes every output of the command line into `out`; returns
-/// the text of `summary.json`.
-#[pyfunction]
-#[pyo3(signature = (scenario, out, threads = None, progress = None))]
-pub(crate) fn damper_point(
-    py: Python<'_>,
-    scenario: &PyScenario,
-    out: PathBuf,
-    threads: Option<usize>,
-    progress: Option<Bound<'_, PyAny>>,
-) -> PyResult<String> {
-    std::fs::create_dir_all(&out).map_err(io_err)?;
-    let (sc, base) = (&scenario.inner, &scenario.base_dir);
-    let pool = crate::detach::pool(threads)?;
-    detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        pdamp_design::report::run_damper_scenario(sc, base, &out, |phase, f| p.set(phase, f))?;
         std::fs::read_to_string(out.join("summary.json")).map_err(|e| e.to_string())
     })
 }

@@ -29,7 +29,6 @@ fn _pdamp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scenario::PyScenario>()?;
     m.add_class::<world::PyWorld>()?;
     m.add_function(wrap_pyfunction!(levels::run, m)?)?;
-    m.add_function(wrap_pyfunction!(levels::damper_point, m)?)?;
     m.add_function(wrap_pyfunction!(levels::fields, m)?)?;
     m.add_function(wrap_pyfunction!(levels::couple, m)?)?;
     m.add_function(wrap_pyfunction!(levels::structure_modes, m)?)?;

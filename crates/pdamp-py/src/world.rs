@@ -6,7 +6,7 @@
 use crate::detach::WorldPool;
 use crate::scenario::PyScenario;
 use numpy::ndarray::{ArrayView1, ArrayView2};
-use numpy::{PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pdamp_dem::{Motion, TranslationTrack, Vec3, World};
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -97,6 +97,14 @@ fn f64_view<'py>(
     Ok(a)
 }
 
+/// An (n, 3) numpy copy of vectors.
+fn vec3_array<'py>(py: Python<'py>, v: &[Vec3]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = v.iter().flat_map(|x| [x.x, x.y, x.z]).collect();
+    numpy::ndarray::Array2::from_shape_vec((v.len(), 3), flat)
+        .expect("n × 3 values")
+        .into_pyarray(py)
+}
+
 fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
@@ -128,30 +136,25 @@ impl PyWorld {
         let pool = WorldPool::new(threads);
         let base = &scenario.base_dir;
         let drive = drive.unwrap_or_default();
-        let declared_driven = |b: &pdamp_dem::RigidBody| {
+        let declared_driven = |name: &str| {
             sc.bodies.iter().any(|s| {
-                s.name == b.name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
+                s.name == name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
             })
         };
-        for name in drive.keys() {
-            if !sc.bodies.iter().any(|s| {
-                &s.name == name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
-            }) {
-                return Err(PyValueError::new_err(format!(
-                    "drive: {name:?} is not a driven body of the scenario (motion = {{ type = \"driven\" }})"
-                )));
-            }
+        if let Some(name) = drive.keys().find(|n| !declared_driven(n)) {
+            return Err(PyValueError::new_err(format!(
+                "drive: {name:?} is not a driven body of the scenario (motion = {{ type = \"driven\" }})"
+            )));
         }
         let work = |poll: &mut dyn FnMut(&str, f64) -> bool| {
             let mut world = sc.build_world(base)?;
             for (name, [u, v, a]) in &drive {
+                // declared driven (checked above), so the world has it
                 let b = world
                     .bodies
                     .iter()
-                    .position(|b| &b.name == name && matches!(b.motion, Motion::Driven))
-                    .ok_or_else(|| {
-                        format!("drive: {name:?} is not a driven body of the scenario (motion = {{ type = \"driven\" }})")
-                    })?;
+                    .position(|b| &b.name == name)
+                    .ok_or("drive: no body")?;
                 if [u, v, a].iter().any(|x| x.iter().any(|c| !c.is_finite())) {
                     return Err(format!("drive: {name:?}: every number must be finite"));
                 }
@@ -188,7 +191,11 @@ impl PyWorld {
             Ok((world, t))
         };
         let (world, settling_time_s) = pool.run(py, progress.as_ref(), "settling", false, work)?;
-        let driven = world.bodies.iter().map(declared_driven).collect();
+        let driven = world
+            .bodies
+            .iter()
+            .map(|b| declared_driven(&b.name))
+            .collect();
         Ok(Self {
             driven,
             world,
@@ -402,11 +409,7 @@ impl PyWorld {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (b, w) = self.wall(body, wall)?;
         match &self.world.bodies[b].walls[w].geometry {
-            pdamp_dem::Geometry::Mesh(m) => {
-                let rows: Vec<Vec<f64>> =
-                    m.vertices().iter().map(|v| vec![v.x, v.y, v.z]).collect();
-                PyArray2::from_vec2(py, &rows).map_err(|e| PyRuntimeError::new_err(e.to_string()))
-            }
+            pdamp_dem::Geometry::Mesh(m) => Ok(vec3_array(py, m.vertices())),
             _ => Err(PyValueError::new_err(format!(
                 "wall {wall:?} of body {body:?} is not a triangle mesh (stl or box_outside)"
             ))),
@@ -455,8 +458,7 @@ impl PyWorld {
         self.world
             .wall_nodal_forces(b, w, &mut out)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let rows: Vec<Vec<f64>> = out.iter().map(|v| vec![v.x, v.y, v.z]).collect();
-        PyArray2::from_vec2(py, &rows).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+        Ok(vec3_array(py, &out))
     }
 
     /// The energy ledger now, J: the terms of `summary.json`'s `energy` (kinetic, potential,
