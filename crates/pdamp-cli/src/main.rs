@@ -14,6 +14,7 @@ use pdamp_dem::impact::{ImpactLaw, ImpactRequest, Partner, checked_head_on_impac
 use std::path::PathBuf;
 
 mod cor;
+mod design;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod powder;
@@ -166,6 +167,10 @@ enum Command {
     /// Particle dampers coupled to a structure (full DEM, effective fields or formulas): free
     /// decay (decay.csv, damping.csv), sweeps or steady-state FRFs (frf.csv), summary.json, plots.
     Couple(structure::CoupleArgs),
+    /// Design optimiser: from a structure and a target to a verified damper (envelope screening,
+    /// time-simulation verification); writes DIR/designs.csv, report.md, summary.json, plots and
+    /// ready-to-run scenarios/design_N.toml (docs/design.md).
+    Design(design::DesignArgs),
     /// Powder-filled cavities, two-way coupled DEM–FEM (docs/powder.md): run, study, modes.
     Powder(powder::PowderArgs),
     /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
@@ -530,6 +535,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Cor(args) => cor::run(args),
         Command::Structure(args) => structure::run_structure(args),
         Command::Couple(args) => structure::run_couple(args),
+        Command::Design(args) => design::run(args),
         Command::Powder(args) => powder::run(args),
         Command::Bench {
             particles,
@@ -1045,7 +1051,53 @@ fn other_scenario_kind(path: &std::path::Path) -> Option<&'static str> {
     )
 }
 
+/// `pdamp check` of a design study (`scenario`, `[objective]`, `[damper]`): every key checked
+/// by the optimiser's loader, then the size of the space and the work it implies.
+fn check_design_study(path: &std::path::Path) -> Option<Result<()>> {
+    let table = std::fs::read_to_string(path)
+        .ok()?
+        .parse::<toml::Table>()
+        .ok()?;
+    if !(table.contains_key("objective") && table.contains_key("damper")) {
+        return None;
+    }
+    Some((|| {
+        let study = pdamp_optimizer::DesignStudy::load(path).map_err(|e| anyhow!(e))?;
+        let space = pdamp_optimizer::Space::new(&study);
+        let size = space.size();
+        let s = &study.file.search;
+        let enumerate = match s.screening {
+            pdamp_optimizer::study::Screening::Enumerate => true,
+            pdamp_optimizer::study::Screening::Swarm => false,
+            pdamp_optimizer::study::Screening::Auto => size <= s.max_enumerated as f64,
+        };
+        let screened = if enumerate {
+            format!("all {size:.0} designs screened with the envelope model")
+        } else {
+            format!(
+                "{size:.3e} designs: a particle swarm over {} categorical choice(s), ≤ {} envelope \
+                 evaluations each",
+                space.choices().len(),
+                s.swarm_particles as u64 * (s.swarm_iterations + 1)
+            )
+        };
+        let verify = s.verifications.map_or_else(
+            || "10 % of the screened designs (2 … 60)".to_string(),
+            |v| v.to_string(),
+        );
+        println!(
+            "{}: a design study, OK — {screened}; time simulations: {verify}; run it with \
+             `pdamp design FILE --out DIR` (docs/design.md)",
+            path.display()
+        );
+        Ok(())
+    })())
+}
+
 fn cmd_check(scenario: &std::path::Path) -> Result<()> {
+    if let Some(r) = check_design_study(scenario) {
+        return r;
+    }
     if let Some(kind) = other_scenario_kind(scenario) {
         bail!(
             "{} is not a DEM scenario (it has no [simulation] table) but {kind}; `pdamp check` \

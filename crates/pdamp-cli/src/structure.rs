@@ -104,7 +104,7 @@ pub struct CoupleArgs {
 
 /// Runs `work` with `out` opened for it (see [`crate::open_out`]): the manifest records how it
 /// ended; a failure that wrote nothing leaves no directory.
-fn in_out_dir<T>(
+pub(crate) fn in_out_dir<T>(
     out: &std::path::Path,
     resume: bool,
     overwrite: bool,

@@ -191,30 +191,8 @@ pub fn run_couple(
     };
     let started = std::time::Instant::now();
     let mut summary = match &scn.analysis {
-        AnalysisSpec::Free {
-            duration_s,
-            time_step_s,
-            mode,
-            initial_point,
-            initial_displacement_m,
-            initial_velocity_m_s,
-            scale_initial_by_bed_mass,
-            output_point,
-            update,
-            sample_every,
-        } => {
-            let spec = FreeVibrationSpec {
-                duration_s: *duration_s,
-                time_step_s: *time_step_s,
-                mode: mode.saturating_sub(1),
-                initial_point: initial_point.clone(),
-                initial_displacement_m: *initial_displacement_m,
-                initial_velocity_m_s: *initial_velocity_m_s,
-                output_point: output_point.clone(),
-                update: *update,
-                sample_every: *sample_every,
-                scale_initial_by_bed_mass: *scale_initial_by_bed_mass,
-            };
+        AnalysisSpec::Free { .. } => {
+            let spec = scn.analysis.free_vibration_spec().expect("a free analysis");
             let hist = match &dem {
                 Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, o, progress, Some(&ck))?,
                 None => free::run_free_vibration(&structure, &dampers, &spec)?,

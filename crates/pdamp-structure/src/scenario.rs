@@ -1186,6 +1186,39 @@ pub enum AnalysisSpec {
     },
 }
 
+impl AnalysisSpec {
+    /// The free-vibration settings of a `kind = "free"` analysis (`None` for the others);
+    /// `mode` becomes 0-based.
+    pub fn free_vibration_spec(&self) -> Option<crate::free::FreeVibrationSpec> {
+        match self {
+            AnalysisSpec::Free {
+                duration_s,
+                time_step_s,
+                mode,
+                initial_point,
+                initial_displacement_m,
+                initial_velocity_m_s,
+                scale_initial_by_bed_mass,
+                output_point,
+                update,
+                sample_every,
+            } => Some(crate::free::FreeVibrationSpec {
+                duration_s: *duration_s,
+                time_step_s: *time_step_s,
+                mode: mode.saturating_sub(1),
+                initial_point: initial_point.clone(),
+                initial_displacement_m: *initial_displacement_m,
+                initial_velocity_m_s: *initial_velocity_m_s,
+                output_point: output_point.clone(),
+                update: *update,
+                sample_every: *sample_every,
+                scale_initial_by_bed_mass: *scale_initial_by_bed_mass,
+            }),
+            _ => None,
+        }
+    }
+}
+
 fn one_usize() -> usize {
     1
 }

@@ -27,7 +27,7 @@ use crate::effective::EffectiveDamper;
 use crate::formulas::{LayeredDamper, RollingDamper, VerticalDamper, clearance_m};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
 use crate::modal::ModalStructure;
-use crate::scenario::{AnalysisSpec, CoupleScenario};
+use crate::scenario::CoupleScenario;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -293,32 +293,10 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
         .build(scn_path.parent().unwrap_or(Path::new(".")))
         .map_err(|m| crate::scenario::locate(&scn.structure_source(&scn_path), m))?
         .modal;
-    let fs = match &scn.analysis {
-        AnalysisSpec::Free {
-            duration_s,
-            time_step_s,
-            mode,
-            initial_point,
-            initial_displacement_m,
-            initial_velocity_m_s,
-            scale_initial_by_bed_mass,
-            output_point,
-            update,
-            sample_every,
-        } => FreeVibrationSpec {
-            duration_s: *duration_s,
-            time_step_s: *time_step_s,
-            mode: mode.saturating_sub(1),
-            initial_point: initial_point.clone(),
-            initial_displacement_m: *initial_displacement_m,
-            initial_velocity_m_s: *initial_velocity_m_s,
-            output_point: output_point.clone(),
-            update: *update,
-            sample_every: *sample_every,
-            scale_initial_by_bed_mass: *scale_initial_by_bed_mass,
-        },
-        _ => return Err("the study's scenario needs [analysis] kind = \"free\"".into()),
-    };
+    let fs = scn
+        .analysis
+        .free_vibration_spec()
+        .ok_or("the study's scenario needs [analysis] kind = \"free\"")?;
     let started = std::time::Instant::now();
     let designs = run_layer_study(&structure, &fs, &file.study)?;
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;

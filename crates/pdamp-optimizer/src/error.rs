@@ -1,0 +1,45 @@
+//! Typed errors of the design optimiser.
+
+use std::path::PathBuf;
+
+/// What went wrong in a design study.
+#[derive(Debug, thiserror::Error)]
+pub enum DesignError {
+    /// A key of the study file is missing, out of range or inconsistent; `key` is its dotted
+    /// path in the file (e.g. `damper.particle_radii_m[1]`).
+    #[error("{path}: {key}: {message}")]
+    Input {
+        /// The study file.
+        path: PathBuf,
+        /// Dotted key.
+        key: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// The study file or its scenario cannot be read or parsed.
+    #[error("{0}")]
+    Load(String),
+    /// The structure or a solver refused a design (unknown point, unstable step, …).
+    #[error("{0}")]
+    Solver(String),
+    /// No design satisfies the constraints.
+    #[error("no design satisfies the constraints: {0}")]
+    Empty(String),
+    /// Writing the results failed (nothing partial is left: every file is written atomically).
+    #[error("writing {path}: {message}")]
+    Output {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        message: String,
+    },
+}
+
+impl DesignError {
+    pub(crate) fn output(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
+        DesignError::Output {
+            path: path.into(),
+            message: e.to_string(),
+        }
+    }
+}

@@ -1,0 +1,409 @@
+//! The fidelity levels that evaluate a design, cheapest first.
+//!
+//! | level | name | what it computes | cost |
+//! |---|---|---|---|
+//! | 0 | `envelope` | the decay envelope / ζ(X) of the damped mode from the formulas' η̄ and m̄ at the current amplitude (D Eq. 3.33, 3.39, 3.51) | µs–ms |
+//! | 1 | `formulas_time` | the modal time simulation with the formula dampers updated at the events of D Sect. 3.3.1 (`pdamp couple`, approach 3); ζ from the log decrement (D Eq. 3.40, 3.41) | ms–s |
+//!
+//! Level 0 is the slowly-varying-amplitude form of level 1: for one mode k with dampers i at
+//! points with mode-shape values φ_i, the modal equation
+//! $(1 + \sum\varphi_i^2\bar m_i)\ddot q + (2\zeta_k\omega_k + \sum\varphi_i^2\bar d_i)\dot q + \omega_k^2 q = 0$
+//! gives $\bar\omega = \omega_k/\sqrt{1+\sum\varphi_i^2\bar m_i}$ (D Eq. 3.33) and
+//! $\zeta = (2\zeta_k\omega_k + \sum\varphi_i^2\bar d_i)/(2\bar\omega(1 + \sum\varphi_i^2\bar m_i))$
+//! with $\bar d_i = \tilde E_i/(\pi\bar\omega X_i^2)$ (D Eq. 3.39), which is D Eq. 3.51 for one
+//! damper without structural damping. The amplitude then falls by $e^{-\pi\zeta/\sqrt{1-\zeta^2}}$
+//! per half cycle, with η̄ and m̄ updated at every half cycle as the time simulation does at
+//! every zero crossing.
+
+use crate::DesignError;
+use crate::study::{DesignStudy, ObjectiveSpec};
+use pdamp_structure::free::{
+    self, CoupledDamper, FreeVibrationSpec, TimeHistory, UpdateRule, damping_per_cycle, decay_peaks,
+};
+use pdamp_structure::modal::ModalStructure;
+use std::f64::consts::PI;
+
+/// Damping ratio and effective angular frequency of mode `k` with the dampers at modal
+/// amplitude `q` (see the module docs; D Eq. 3.33, 3.39, 3.51).
+pub fn modal_damping(
+    structure: &ModalStructure,
+    k: usize,
+    dampers: &[CoupledDamper],
+    shapes: &[f64],
+    q: f64,
+) -> (f64, f64) {
+    let w0 = structure.modes[k].omega_rad_s();
+    let mut masses = vec![0.0; dampers.len()];
+    let mut omega = w0;
+    for _ in 0..50 {
+        for (i, d) in dampers.iter().enumerate() {
+            masses[i] = d
+                .model
+                .evaluate((shapes[i] * q).abs(), omega)
+                .effective_mass_kg;
+        }
+        let extra: f64 = shapes.iter().zip(&masses).map(|(p, m)| p * p * m).sum();
+        let w = w0 / (1.0 + extra).sqrt();
+        let done = (w - omega).abs() <= 1e-12 * w0;
+        omega = w;
+        if done {
+            break;
+        }
+    }
+    let mut modal_mass = 1.0;
+    let mut c = 2.0 * structure.modes[k].damping_ratio * w0;
+    for (i, d) in dampers.iter().enumerate() {
+        let x = (shapes[i] * q).abs();
+        let s = d.model.evaluate(x, omega);
+        modal_mass += shapes[i] * shapes[i] * s.effective_mass_kg;
+        c += shapes[i] * shapes[i] * s.viscous_damping_n_s_m(x, omega);
+    }
+    (c / (2.0 * omega * modal_mass), omega)
+}
+
+/// Half cycles between two updates of the dampers under an update rule: the time simulation
+/// updates at every zero crossing or peak (1), at the positive or the negative peaks only (2),
+/// or never (`None`: η̄ and m̄ of the initial amplitude throughout).
+pub fn half_cycles_per_update(rule: UpdateRule) -> Option<u32> {
+    match rule {
+        UpdateRule::ZeroCrossing | UpdateRule::EveryPeak => Some(1),
+        UpdateRule::NegativePeak | UpdateRule::PositivePeak => Some(2),
+        UpdateRule::Never => None,
+    }
+}
+
+/// The decay envelope of mode `k` released from a peak of modal amplitude `q0`: (time,
+/// modal amplitude, ω̄) at every peak of |q| (every half cycle), with the dampers updated as
+/// the time simulation updates them (see [`half_cycles_per_update`]), until `until_s` (or
+/// until the amplitude falls below `floor_q`).
+#[allow(clippy::too_many_arguments)]
+pub fn envelope(
+    structure: &ModalStructure,
+    k: usize,
+    dampers: &[CoupledDamper],
+    shapes: &[f64],
+    q0: f64,
+    until_s: f64,
+    floor_q: f64,
+    rule: UpdateRule,
+) -> Vec<(f64, f64, f64)> {
+    let mut t = 0.0;
+    let mut q = q0;
+    let mut out = Vec::new();
+    let frozen = modal_damping(structure, k, dampers, shapes, q0);
+    let halves = half_cycles_per_update(rule).unwrap_or(1);
+    let (mut z, mut w) = frozen;
+    // at most 10⁶ half cycles (a lightly damped high mode over a long time)
+    for i in 0..1_000_000u32 {
+        if i % halves == 0 && half_cycles_per_update(rule).is_some() {
+            (z, w) = modal_damping(structure, k, dampers, shapes, q);
+        }
+        out.push((t, q, w));
+        if t >= until_s || q <= floor_q {
+            break;
+        }
+        if z >= 1.0 {
+            // over-damped: the amplitude does not come back
+            out.push((t + PI / w, 0.0, w));
+            break;
+        }
+        let r = (1.0 - z * z).sqrt();
+        q *= (-PI * z / r).exp();
+        t += PI / (w * r);
+    }
+    out
+}
+
+/// The largest |q| of the envelope's peaks in `[from_s, to_s]` (the time simulation's stroke
+/// window); the amplitude at `from_s` if no peak falls inside.
+pub fn envelope_max(env: &[(f64, f64, f64)], from_s: f64, to_s: f64) -> f64 {
+    env.iter()
+        .filter(|e| e.0 >= from_s && e.0 <= to_s)
+        .map(|e| e.1)
+        .reduce(f64::max)
+        .unwrap_or_else(|| envelope_at(env, from_s))
+}
+
+/// Modal amplitude of the envelope at time `t` (log-linear between half cycles).
+pub fn envelope_at(env: &[(f64, f64, f64)], t: f64) -> f64 {
+    let Some(i) = env.iter().position(|e| e.0 > t) else {
+        return env.last().map_or(0.0, |e| e.1);
+    };
+    if i == 0 {
+        return env[0].1;
+    }
+    let (a, b) = (env[i - 1], env[i]);
+    if a.1 <= 0.0 || b.1 <= 0.0 {
+        return b.1;
+    }
+    let s = (t - a.0) / (b.0 - a.0);
+    a.1 * (b.1 / a.1).powf(s)
+}
+
+/// Shape values of the dampers' points in mode `k`.
+fn shapes(structure: &ModalStructure, k: usize, dampers: &[CoupledDamper]) -> Vec<f64> {
+    dampers
+        .iter()
+        .map(|d| structure.point(&d.point).map(|s| s[k]).unwrap_or(0.0))
+        .collect()
+}
+
+/// Initial modal amplitude of the free analysis (with D Eq. 5.19 if the scenario asks for it).
+fn initial_modal_amplitude(
+    structure: &ModalStructure,
+    free: &FreeVibrationSpec,
+    bed_mass_kg: f64,
+) -> f64 {
+    let k = free.mode;
+    let init = structure
+        .point(&free.initial_point)
+        .map(|s| s[k])
+        .unwrap_or(1.0);
+    let scale = if free.scale_initial_by_bed_mass {
+        free::bed_mass_scale(init, bed_mass_kg)
+    } else {
+        1.0
+    };
+    let w = structure.modes[k].omega_rad_s();
+    scale * (free.initial_displacement_m.powi(2) + (free.initial_velocity_m_s / w).powi(2)).sqrt()
+        / init.abs()
+}
+
+/// Log-spaced amplitudes of a max_damping objective.
+pub fn amplitude_grid(min_m: f64, max_m: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| min_m * (max_m / min_m).powf(i as f64 / (n - 1).max(1) as f64))
+        .collect()
+}
+
+/// What one evaluation found.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct Evaluation {
+    /// Objective value to minimise: the stroke (m) for min_stroke, −(mean ζ) for max_damping.
+    pub cost: f64,
+    /// min_stroke: the stroke at the evaluation time, m.
+    pub stroke_m: Option<f64>,
+    /// max_damping: mean ζ over the amplitude range per objective mode.
+    pub damping_ratio_per_mode: Vec<f64>,
+}
+
+/// Level 0: the envelope model.
+///
+/// # Errors
+/// Unknown points (validated before, so only for structures changed by a detuning).
+pub fn envelope_evaluation(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+) -> Result<Evaluation, DesignError> {
+    let bed: f64 = dampers.iter().map(|d| d.model.bed_mass_kg()).sum();
+    let out_shape = structure
+        .point(&study.free.output_point)
+        .map_err(DesignError::Solver)?
+        .to_vec();
+    match &study.file.objective {
+        ObjectiveSpec::MinStroke { evaluate_at_s } => {
+            let k = study.free.mode;
+            let sh = shapes(structure, k, dampers);
+            let q0 = initial_modal_amplitude(structure, &study.free, bed);
+            let env = envelope(
+                structure,
+                k,
+                dampers,
+                &sh,
+                q0,
+                *evaluate_at_s,
+                0.0,
+                study.free.update,
+            );
+            // the stroke: the largest |x| over the last 1.1 bare periods (the time
+            // simulation's window)
+            let period = 1.0 / structure.modes[k].frequency_hz;
+            let q = envelope_max(&env, evaluate_at_s - 1.1 * period, *evaluate_at_s);
+            let stroke = (out_shape[k] * q).abs();
+            Ok(Evaluation {
+                cost: stroke,
+                stroke_m: Some(stroke),
+                damping_ratio_per_mode: Vec::new(),
+            })
+        }
+        ObjectiveSpec::MaxDamping {
+            modes,
+            amplitude_min_m,
+            amplitude_max_m,
+            amplitudes,
+        } => {
+            let grid = amplitude_grid(*amplitude_min_m, *amplitude_max_m, *amplitudes);
+            let per_mode: Vec<f64> = modes
+                .iter()
+                .map(|&m| {
+                    let k = m - 1;
+                    let sh = shapes(structure, k, dampers);
+                    grid.iter()
+                        .map(|x| {
+                            let q = x / out_shape[k].abs().max(1e-300);
+                            modal_damping(structure, k, dampers, &sh, q).0
+                        })
+                        .sum::<f64>()
+                        / grid.len() as f64
+                })
+                .collect();
+            let mean = per_mode.iter().sum::<f64>() / per_mode.len() as f64;
+            Ok(Evaluation {
+                cost: -mean,
+                stroke_m: None,
+                damping_ratio_per_mode: per_mode,
+            })
+        }
+    }
+}
+
+/// ζ(X) of mode `k` at the output point from a simulated free decay that starts 10 % above
+/// the top of the range and runs until the envelope predicts 10 % below its bottom (at least
+/// 10, at most 3000 periods): (mean amplitude per cycle, ζ per cycle) [D Eq. 3.40, 3.41].
+///
+/// # Errors
+/// Solver errors.
+pub fn simulated_damping_curve(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+    amplitude_min_m: f64,
+    amplitude_max_m: f64,
+) -> Result<Vec<(f64, f64)>, DesignError> {
+    let out = &study.free.output_point;
+    let phi_out = structure.point(out).map_err(DesignError::Solver)?[k];
+    if phi_out == 0.0 {
+        return Err(DesignError::Solver(format!(
+            "the output point '{out}' is a node of mode {}: no amplitude range there",
+            k + 1
+        )));
+    }
+    let period = 1.0 / structure.modes[k].frequency_hz;
+    let sh = shapes(structure, k, dampers);
+    let q0 = 1.1 * amplitude_max_m / phi_out.abs();
+    let update = if study.free.update == UpdateRule::Never {
+        UpdateRule::ZeroCrossing
+    } else {
+        study.free.update
+    };
+    let env = envelope(
+        structure,
+        k,
+        dampers,
+        &sh,
+        q0,
+        3000.0 * period,
+        0.9 * amplitude_min_m / phi_out.abs(),
+        update,
+    );
+    let duration = env
+        .last()
+        .map_or(0.0, |e| e.0)
+        .clamp(10.0 * period, 3000.0 * period);
+    let spec = FreeVibrationSpec {
+        duration_s: duration,
+        time_step_s: period / 80.0,
+        mode: k,
+        initial_point: out.clone(),
+        initial_displacement_m: 1.1 * amplitude_max_m * phi_out.signum(),
+        initial_velocity_m_s: 0.0,
+        scale_initial_by_bed_mass: false,
+        output_point: out.clone(),
+        update,
+        sample_every: 1,
+    };
+    let hist = free::run_free_vibration(structure, dampers, &spec).map_err(DesignError::Solver)?;
+    let peaks = decay_peaks(&hist, 0.5 * period).map_err(DesignError::Solver)?;
+    Ok(damping_per_cycle(&peaks)
+        .iter()
+        .map(|c| (c.mean_amplitude_m, c.damping_ratio))
+        .collect())
+}
+
+/// ζ at amplitude `x` from a per-cycle curve (log-linear in X between the cycles that bracket
+/// it; the nearest cycle outside the simulated range).
+pub fn curve_at(curve: &[(f64, f64)], x: f64) -> f64 {
+    let mut pts: Vec<(f64, f64)> = curve.iter().copied().filter(|p| p.0 > 0.0).collect();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    match pts.as_slice() {
+        [] => 0.0,
+        [p] => p.1,
+        _ => {
+            if x <= pts[0].0 {
+                return pts[0].1;
+            }
+            if x >= pts[pts.len() - 1].0 {
+                return pts[pts.len() - 1].1;
+            }
+            let i = pts.partition_point(|p| p.0 < x);
+            let (a, b) = (pts[i - 1], pts[i]);
+            let s = (x / a.0).ln() / (b.0 / a.0).ln();
+            a.1 + (b.1 - a.1) * s
+        }
+    }
+}
+
+/// Level 1: the modal time simulation with the formula dampers. Returns the evaluation and,
+/// for min_stroke, the decay at the output point (for the plots).
+///
+/// # Errors
+/// Solver errors.
+pub fn time_evaluation(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+) -> Result<(Evaluation, Option<TimeHistory>), DesignError> {
+    match &study.file.objective {
+        ObjectiveSpec::MinStroke { evaluate_at_s } => {
+            let mut fs = study.free.clone();
+            fs.duration_s = *evaluate_at_s;
+            let hist =
+                free::run_free_vibration(structure, dampers, &fs).map_err(DesignError::Solver)?;
+            let k = fs.mode;
+            let period = 1.0 / structure.modes[k].frequency_hz;
+            // the layer study's window: one bare period + 10 % (the loaded structure is slower)
+            let stroke = pdamp_structure::study::stroke_at(&hist, *evaluate_at_s, 1.1 * period);
+            Ok((
+                Evaluation {
+                    cost: stroke,
+                    stroke_m: Some(stroke),
+                    damping_ratio_per_mode: Vec::new(),
+                },
+                Some(hist),
+            ))
+        }
+        ObjectiveSpec::MaxDamping {
+            modes,
+            amplitude_min_m,
+            amplitude_max_m,
+            amplitudes,
+        } => {
+            let grid = amplitude_grid(*amplitude_min_m, *amplitude_max_m, *amplitudes);
+            let mut per_mode = Vec::new();
+            for &m in modes {
+                let curve = simulated_damping_curve(
+                    study,
+                    structure,
+                    dampers,
+                    m - 1,
+                    *amplitude_min_m,
+                    *amplitude_max_m,
+                )?;
+                per_mode.push(
+                    grid.iter().map(|&x| curve_at(&curve, x)).sum::<f64>() / grid.len() as f64,
+                );
+            }
+            let mean = per_mode.iter().sum::<f64>() / per_mode.len() as f64;
+            Ok((
+                Evaluation {
+                    cost: -mean,
+                    stroke_m: None,
+                    damping_ratio_per_mode: per_mode,
+                },
+                None,
+            ))
+        }
+    }
+}

@@ -1,0 +1,493 @@
+//! The design-study file of `pdamp design STUDY.toml --out DIR`: the structure (through a
+//! coupling scenario), the objective, the design space of the damper, the materials, the
+//! constraints and the search settings. Every key carries its unit; [`DesignStudy::load`]
+//! checks them all and names the key of the first problem.
+//!
+//! ```toml
+//! scenario = "couple_ch5_free_formulas.toml"  # structure + [analysis] kind = "free"
+//!                                              # (its dampers are ignored)
+//! [objective]
+//! kind = "min_stroke"          # or "max_damping" (modes, amplitude range)
+//! evaluate_at_s = 4.0
+//!
+//! [damper]
+//! direction = "horizontal"     # rolling/bouncing layers (D Eq. 5.1–5.14, 6.12) | "vertical" (D Eq. 7.1–7.19)
+//! points = ["damper"]          # candidate structure points
+//! container_lengths_m = [0.12] # inner length along the excitation
+//! container_width_m = 0.04     # inner width across it
+//! layers = 3                   # separate layers (horizontal)
+//! particle_radii_m = [0.005]
+//!
+//! [[materials]]
+//! name = "steel"
+//! density_kg_m3 = 7900.0
+//!
+//! [constraints]
+//! max_bed_mass_kg = 0.6
+//! ```
+
+use crate::DesignError;
+use pdamp_structure::free::FreeVibrationSpec;
+use pdamp_structure::modal::ModalStructure;
+use pdamp_structure::scenario::CoupleScenario;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// What the optimiser minimises or maximises.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ObjectiveSpec {
+    /// Minimise the amplitude after time T: the largest |x| at the scenario's output point over
+    /// the last period before `evaluate_at_s` of the scenario's free decay (the criterion of
+    /// D Sect. 5.2.1 and 7.2.3).
+    MinStroke {
+        /// Evaluation time T, s (≤ the scenario's `analysis.duration_s`).
+        evaluate_at_s: f64,
+    },
+    /// Maximise the damping ratio of the chosen modes, averaged over the amplitude range of
+    /// the scenario's output point (log-spaced amplitudes, equal weights for every mode).
+    MaxDamping {
+        /// Modes (1-based).
+        modes: Vec<usize>,
+        /// Smallest amplitude of the range at the output point, m.
+        amplitude_min_m: f64,
+        /// Largest amplitude of the range at the output point, m.
+        amplitude_max_m: f64,
+        /// Amplitudes of the range (log-spaced, ≥ 2).
+        #[serde(default = "default_amplitudes")]
+        amplitudes: usize,
+    },
+}
+
+fn default_amplitudes() -> usize {
+    12
+}
+
+/// Excitation direction of the damper, i.e. which formula family models it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Horizontal: separate layers that roll (A < g, D Eq. 5.1–5.14) or bounce (A ≥ g,
+    /// D Eq. 6.12), one layer per shelf of the container.
+    Horizontal,
+    /// Vertical: the bed as one block, single/double collect-and-collide (D Eq. 7.1–7.19).
+    Vertical,
+}
+
+/// The design space of one container.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamperSpace {
+    /// Excitation direction.
+    pub direction: Direction,
+    /// Candidate structure points (names of `[[structure.points]]` or the single-mode point).
+    pub points: Vec<String>,
+    /// Candidate inner container lengths along the excitation L, m (D Eq. 5.1/7.4).
+    pub container_lengths_m: Vec<f64>,
+    /// Inner width across the excitation, m (particles across: ⌊W/2r⌋).
+    pub container_width_m: f64,
+    /// Vertical containers: the second horizontal dimension, m (default: the width).
+    #[serde(default)]
+    pub container_depth_m: Option<f64>,
+    /// Horizontal containers: number of separate layers (shelves), each filled independently.
+    #[serde(default = "one")]
+    pub layers: usize,
+    /// Candidate particle radii r, m.
+    pub particle_radii_m: Vec<f64>,
+    /// Increment of the particle number of a layer (default: one row across the width for
+    /// horizontal layers, one level of the cross-section for vertical beds).
+    #[serde(default)]
+    pub particle_count_step: Option<usize>,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// A particle material of the table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name (in designs.csv and the scenario files).
+    pub name: String,
+    /// Density, kg/m³.
+    pub density_kg_m3: f64,
+}
+
+/// Constraints on a design.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Constraints {
+    /// Largest particle bed mass, kg (the mass the structure can spare; the container's own
+    /// mass belongs to the structure model).
+    #[serde(default)]
+    pub max_bed_mass_kg: Option<f64>,
+    /// Smallest clearance h of a filled layer/bed, m (manufacturing, noise).
+    #[serde(default)]
+    pub min_clearance_m: Option<f64>,
+}
+
+/// How the design space is searched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Screening {
+    /// Enumerate when the space has at most `max_enumerated` designs, swarm otherwise.
+    #[default]
+    Auto,
+    /// Screen every design of the space with the envelope model.
+    Enumerate,
+    /// Particle-swarm search (argmin) over the fill fractions of every categorical choice.
+    Swarm,
+}
+
+/// `[search]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SearchSpec {
+    /// Screening strategy of the envelope fidelity.
+    #[serde(default)]
+    pub screening: Screening,
+    /// Largest space that `auto` enumerates.
+    #[serde(default = "default_max_enumerated")]
+    pub max_enumerated: usize,
+    /// Time simulations (fidelity 1) spent on the screened designs; default: 10 % of the
+    /// screened designs, at least 2 and at most 60.
+    #[serde(default)]
+    pub verifications: Option<usize>,
+    /// Designs listed in report.md and written as scenario files.
+    #[serde(default = "default_top")]
+    pub top: usize,
+    /// Detuning of the robustness check (structure frequencies × (1 ± d)).
+    #[serde(default = "default_detuning")]
+    pub detuning: f64,
+    /// Seed of the swarm.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Swarm particles per categorical choice.
+    #[serde(default = "default_swarm_particles")]
+    pub swarm_particles: usize,
+    /// Swarm iterations per categorical choice.
+    #[serde(default = "default_swarm_iterations")]
+    pub swarm_iterations: u64,
+}
+
+fn default_max_enumerated() -> usize {
+    200_000
+}
+fn default_top() -> usize {
+    5
+}
+fn default_detuning() -> f64 {
+    0.1
+}
+fn default_seed() -> u64 {
+    1
+}
+fn default_swarm_particles() -> usize {
+    24
+}
+fn default_swarm_iterations() -> u64 {
+    40
+}
+
+impl Default for SearchSpec {
+    fn default() -> Self {
+        SearchSpec {
+            screening: Screening::Auto,
+            max_enumerated: default_max_enumerated(),
+            verifications: None,
+            top: default_top(),
+            detuning: default_detuning(),
+            seed: default_seed(),
+            swarm_particles: default_swarm_particles(),
+            swarm_iterations: default_swarm_iterations(),
+        }
+    }
+}
+
+/// A design-study file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignStudyFile {
+    /// Coupling scenario (relative to the study file): the structure and a free analysis
+    /// (initial condition, time step, output point); its dampers are ignored.
+    pub scenario: PathBuf,
+    /// The objective.
+    pub objective: ObjectiveSpec,
+    /// The damper's design space.
+    pub damper: DamperSpace,
+    /// Particle materials (default: steel, 7900 kg/m³).
+    #[serde(default = "default_materials")]
+    pub materials: Vec<MaterialSpec>,
+    /// Constraints.
+    #[serde(default)]
+    pub constraints: Constraints,
+    /// Search settings.
+    #[serde(default)]
+    pub search: SearchSpec,
+}
+
+fn default_materials() -> Vec<MaterialSpec> {
+    vec![MaterialSpec {
+        name: "steel".into(),
+        density_kg_m3: 7900.0,
+    }]
+}
+
+/// A loaded and checked study: the file, the reduced structure and the free-vibration settings.
+#[derive(Debug, Clone)]
+pub struct DesignStudy {
+    /// The study file as read.
+    pub file: DesignStudyFile,
+    /// Where it was read from.
+    pub path: PathBuf,
+    /// The scenario's path (resolved).
+    pub scenario_path: PathBuf,
+    /// The structure, modally reduced.
+    pub structure: ModalStructure,
+    /// The scenario's free analysis.
+    pub free: FreeVibrationSpec,
+    /// The scenario's structure source for the scenario files written for verified designs:
+    /// the structure file (absolute) or `None` when the structure is inline in the scenario.
+    pub structure_file: Option<PathBuf>,
+}
+
+/// Largest particle count of one layer or bed (guards the enumeration against absurd inputs).
+pub const MAX_PARTICLES: usize = 10_000_000;
+
+impl DesignStudy {
+    /// Reads the study file, its scenario and its structure, and checks every key.
+    ///
+    /// # Errors
+    /// [`DesignError::Load`] for unreadable or malformed files, [`DesignError::Input`] naming the
+    /// key for out-of-range values.
+    pub fn load(path: &Path) -> Result<Self, DesignError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| DesignError::Load(format!("{}: {e}", path.display())))?;
+        let file: DesignStudyFile = toml::from_str(&text)
+            .map_err(|e| DesignError::Load(format!("{}: {e}", path.display())))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let scenario_path = if file.scenario.is_absolute() {
+            file.scenario.clone()
+        } else {
+            base.join(&file.scenario)
+        };
+        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::Load)?;
+        let structure = spec
+            .build(scenario_path.parent().unwrap_or(Path::new(".")))
+            .map_err(|m| {
+                DesignError::Load(pdamp_structure::scenario::locate(
+                    &scn.structure_source(&scenario_path),
+                    m,
+                ))
+            })?
+            .modal;
+        let free = scn.analysis.free_vibration_spec().ok_or_else(|| {
+            DesignError::Load(format!(
+                "{}: the design study's scenario needs [analysis] kind = \"free\" (initial \
+                 condition, time step and output point of the decay)",
+                scenario_path.display()
+            ))
+        })?;
+        let structure_file = scn
+            .structure_file
+            .as_ref()
+            .map(|_| scn.structure_source(&scenario_path))
+            .map(|p| std::fs::canonicalize(&p).unwrap_or(p));
+        let study = DesignStudy {
+            file,
+            path: path.to_path_buf(),
+            scenario_path,
+            structure,
+            free,
+            structure_file,
+        };
+        study.validate()?;
+        Ok(study)
+    }
+
+    fn input(&self, key: impl Into<String>, message: impl Into<String>) -> DesignError {
+        DesignError::Input {
+            path: self.path.clone(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    fn positive(&self, key: &str, v: f64, hi: f64) -> Result<(), DesignError> {
+        if v.is_finite() && v > 0.0 && v <= hi {
+            Ok(())
+        } else {
+            Err(self.input(
+                key,
+                format!("must be a finite number in (0, {hi:e}], got {v}"),
+            ))
+        }
+    }
+
+    /// Checks every key against the structure and the scenario.
+    ///
+    /// # Errors
+    /// [`DesignError::Input`] naming the first bad key.
+    pub fn validate(&self) -> Result<(), DesignError> {
+        let f = &self.file;
+        let d = &f.damper;
+        match &f.objective {
+            ObjectiveSpec::MinStroke { evaluate_at_s } => {
+                self.positive("objective.evaluate_at_s", *evaluate_at_s, 1e6)?;
+                if *evaluate_at_s > self.free.duration_s {
+                    return Err(self.input(
+                        "objective.evaluate_at_s",
+                        format!(
+                            "{evaluate_at_s} s lies beyond the scenario's analysis.duration_s = {} s",
+                            self.free.duration_s
+                        ),
+                    ));
+                }
+            }
+            ObjectiveSpec::MaxDamping {
+                modes,
+                amplitude_min_m,
+                amplitude_max_m,
+                amplitudes,
+            } => {
+                if modes.is_empty() {
+                    return Err(self.input("objective.modes", "give at least one mode (1-based)"));
+                }
+                for (i, &m) in modes.iter().enumerate() {
+                    if m == 0 || m > self.structure.modes.len() {
+                        return Err(self.input(
+                            format!("objective.modes[{i}]"),
+                            format!(
+                                "mode {m} does not exist: the structure has modes 1 … {}",
+                                self.structure.modes.len()
+                            ),
+                        ));
+                    }
+                }
+                self.positive("objective.amplitude_min_m", *amplitude_min_m, 10.0)?;
+                self.positive("objective.amplitude_max_m", *amplitude_max_m, 10.0)?;
+                if amplitude_min_m >= amplitude_max_m {
+                    return Err(self.input(
+                        "objective.amplitude_max_m",
+                        format!("must exceed amplitude_min_m = {amplitude_min_m} m"),
+                    ));
+                }
+                if !(2..=1000).contains(amplitudes) {
+                    return Err(self.input(
+                        "objective.amplitudes",
+                        format!("must be in [2, 1000], got {amplitudes}"),
+                    ));
+                }
+            }
+        }
+        if d.points.is_empty() {
+            return Err(self.input("damper.points", "give at least one structure point"));
+        }
+        for (i, p) in d.points.iter().enumerate() {
+            if let Err(m) = self.structure.point(p) {
+                return Err(self.input(format!("damper.points[{i}]"), m));
+            }
+        }
+        let output = self.structure.point(&self.free.output_point);
+        if let Err(m) = output {
+            return Err(self.input("scenario analysis.output_point", m));
+        }
+        if d.container_lengths_m.is_empty() {
+            return Err(self.input("damper.container_lengths_m", "give at least one length"));
+        }
+        for (i, &l) in d.container_lengths_m.iter().enumerate() {
+            self.positive(&format!("damper.container_lengths_m[{i}]"), l, 100.0)?;
+        }
+        self.positive("damper.container_width_m", d.container_width_m, 100.0)?;
+        if let Some(w) = d.container_depth_m {
+            self.positive("damper.container_depth_m", w, 100.0)?;
+        }
+        if d.layers == 0 || d.layers > 12 {
+            return Err(self.input(
+                "damper.layers",
+                format!("must be in [1, 12], got {}", d.layers),
+            ));
+        }
+        if d.direction == crate::study::Direction::Vertical && d.layers != 1 {
+            return Err(self.input(
+                "damper.layers",
+                "a vertical bed is one block (D Sect. 7.1.1): use layers = 1",
+            ));
+        }
+        if d.particle_radii_m.is_empty() {
+            return Err(self.input("damper.particle_radii_m", "give at least one radius"));
+        }
+        let min_len = d
+            .container_lengths_m
+            .iter()
+            .cloned()
+            .fold(f64::MAX, f64::min);
+        for (i, &r) in d.particle_radii_m.iter().enumerate() {
+            self.positive(&format!("damper.particle_radii_m[{i}]"), r, 1.0)?;
+            if 2.0 * r > d.container_width_m.min(min_len) {
+                return Err(self.input(
+                    format!("damper.particle_radii_m[{i}]"),
+                    format!(
+                        "a sphere of {r} m radius does not fit the container (width {} m, \
+                         shortest length {min_len} m)",
+                        d.container_width_m
+                    ),
+                ));
+            }
+        }
+        if d.particle_count_step == Some(0) {
+            return Err(self.input("damper.particle_count_step", "must be ≥ 1"));
+        }
+        if f.materials.is_empty() {
+            return Err(self.input("materials", "give at least one [[materials]] entry"));
+        }
+        for (i, m) in f.materials.iter().enumerate() {
+            self.positive(
+                &format!("materials[{i}].density_kg_m3"),
+                m.density_kg_m3,
+                1e5,
+            )?;
+            if m.name.trim().is_empty() {
+                return Err(self.input(format!("materials[{i}].name"), "must not be empty"));
+            }
+        }
+        if let Some(m) = f.constraints.max_bed_mass_kg {
+            self.positive("constraints.max_bed_mass_kg", m, 1e6)?;
+        }
+        if let Some(h) = f.constraints.min_clearance_m
+            && !(h.is_finite() && h >= 0.0)
+        {
+            return Err(self.input(
+                "constraints.min_clearance_m",
+                format!("must be a finite number ≥ 0, got {h}"),
+            ));
+        }
+        let s = &f.search;
+        if s.verifications == Some(0) {
+            return Err(self.input("search.verifications", "must be ≥ 1"));
+        }
+        if s.top == 0 || s.top > 100 {
+            return Err(self.input("search.top", format!("must be in [1, 100], got {}", s.top)));
+        }
+        if !(s.detuning.is_finite() && (0.0..0.5).contains(&s.detuning)) {
+            return Err(self.input(
+                "search.detuning",
+                format!("must be in [0, 0.5), got {}", s.detuning),
+            ));
+        }
+        if s.swarm_particles < 2 || s.swarm_particles > 10_000 {
+            return Err(self.input(
+                "search.swarm_particles",
+                format!("must be in [2, 10000], got {}", s.swarm_particles),
+            ));
+        }
+        if s.swarm_iterations == 0 || s.swarm_iterations > 100_000 {
+            return Err(self.input(
+                "search.swarm_iterations",
+                format!("must be in [1, 100000], got {}", s.swarm_iterations),
+            ));
+        }
+        Ok(())
+    }
+}
