@@ -258,9 +258,22 @@ pub fn envelope_evaluation(
     }
 }
 
+/// The structure reduced to its mode `k` alone (shapes of every point kept for that mode).
+pub fn single_mode(structure: &ModalStructure, k: usize) -> ModalStructure {
+    let mut s = structure.clone();
+    s.modes = vec![structure.modes[k]];
+    for p in &mut s.points {
+        p.shape = vec![p.shape[k]];
+    }
+    s
+}
+
 /// ζ(X) of mode `k` at the output point from a simulated free decay that starts 10 % above
 /// the top of the range and runs until the envelope predicts 10 % below its bottom (at least
 /// 10, at most 3000 periods): (mean amplitude per cycle, ζ per cycle) [D Eq. 3.40, 3.41].
+/// The decay runs on mode k alone ([`single_mode`]): the damping of that mode, as D measures
+/// it per mode, without the energy the dampers pass to the other modes (which would otherwise
+/// beat in the output point's peaks and spoil the log decrement).
 ///
 /// # Errors
 /// Solver errors.
@@ -273,11 +286,14 @@ pub fn simulated_damping_curve(
     amplitude_max_m: f64,
 ) -> Result<Vec<(f64, f64)>, DesignError> {
     let out = &study.free.output_point;
+    let structure = &single_mode(structure, k);
+    let mode = k;
+    let k = 0;
     let phi_out = structure.point(out).map_err(DesignError::Solver)?[k];
     if phi_out == 0.0 {
         return Err(DesignError::Solver(format!(
             "the output point '{out}' is a node of mode {}: no amplitude range there",
-            k + 1
+            mode + 1
         )));
     }
     let period = 1.0 / structure.modes[k].frequency_hz;

@@ -397,7 +397,7 @@ fn report_md(space: &Space, o: &SearchOutcome, s: &Value, top: &[&Candidate]) ->
     let _ = writeln!(r, "**Objective**: {objective}.\n");
     let _ = writeln!(
         r,
-        "**Search**: {:.0} designs in the space; {} envelope evaluations ({}), {} time \
+        "**Search**: {:.0} designs in the space (before the constraints); {} envelope evaluations ({}), {} time \
          simulations; wall time {:.2} s screening + {:.2} s verification.\n",
         o.space_size,
         o.envelope_evaluations,
