@@ -21,7 +21,9 @@ pub struct DesignArgs {
 }
 
 /// What `pdamp design` writes.
-const OUTPUTS: [&str; 13] = [
+const OUTPUTS: [&str; 15] = [
+    "dem",
+    "dem.csv",
     "designs.csv",
     "summary.json",
     "report.md",
@@ -46,7 +48,10 @@ pub fn run(args: DesignArgs) -> Result<()> {
     } = args;
     let traced = crate::Traced::start(Some(&study), 0);
     let s = crate::structure::in_out_dir(&out, false, overwrite, &OUTPUTS, &study, || {
-        let s = pdamp_optimizer::run_design_study_file(&study, &out).map_err(|e| anyhow!(e))?;
+        let s = pdamp_optimizer::run_design_study_file_with(&study, &out, &mut |m| {
+            eprintln!("pdamp design: {m}")
+        })
+        .map_err(|e| anyhow!(e))?;
         traced.write(&out)?;
         Ok(s)
     })?;

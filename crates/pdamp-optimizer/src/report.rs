@@ -175,6 +175,7 @@ pub fn write_outputs(
     outcome: &SearchOutcome,
     out: &Path,
     wall_s: f64,
+    progress: &mut dyn FnMut(&str),
 ) -> Result<Value, DesignError> {
     let st = space.study;
     let f = &st.file;
@@ -313,6 +314,38 @@ pub fn write_outputs(
             Err(e) => eprintln!("note: no decay.png: {e}"),
         }
     }
+    // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
+    let mut dem = Vec::new();
+    for (i, c) in top.iter().take(f.verification.dem_designs).enumerate() {
+        let s1 = c.time.as_ref().and_then(|t| t.stroke_m).unwrap_or(f64::NAN);
+        dem.push(crate::dem::verify_design(
+            space,
+            &c.design,
+            i + 1,
+            s1,
+            out,
+            progress,
+        )?);
+    }
+    if !dem.is_empty() {
+        let mut csv = String::from(
+            "rank,packing,stroke_m_coupled_dem,stroke_m_time_simulation,time_step_s,youngs_modulus_scale\n",
+        );
+        for d in &dem {
+            for (p, s) in d.stroke_m.iter().enumerate() {
+                let _ = writeln!(
+                    csv,
+                    "{},{},{s:e},{:e},{:e},{}",
+                    d.rank,
+                    p + 1,
+                    d.formulas_stroke_m,
+                    d.time_step_s,
+                    d.youngs_modulus_scale
+                );
+            }
+        }
+        write(out, "dem.csv", &csv)?;
+    }
     let (_, obj) = objective_names(space);
     let list: Vec<Value> = top
         .iter()
@@ -330,7 +363,8 @@ pub fn write_outputs(
                 format!("{obj}_envelope"): shown(space, c.envelope.cost),
                 format!("{obj}_time_simulation"): c.time.as_ref().map(|t| shown(space, t.cost)),
                 "damping_ratio_per_mode_time_simulation": c.time.as_ref().map(|t| t.damping_ratio_per_mode.clone()),
-                "confirmed_by": "formulas_time",
+                "confirmed_by": if dem.iter().any(|d| d.rank == i + 1) { "coupled_dem" } else { "formulas_time" },
+                "coupled_dem": dem.iter().find(|d| d.rank == i + 1),
                 "scenario": format!("scenarios/design_{}.toml", i + 1),
             })
         })
@@ -353,11 +387,22 @@ pub fn write_outputs(
             "screening_rank_of_best": screening_rank_of_best,
         },
         "robustness": {"detuning": d, "best_design_objective": detune},
+        "coupled_dem": dem,
+        "best_by_coupled_dem": dem
+            .iter()
+            .filter(|d| d.stroke.mean.is_finite())
+            .min_by(|a, b| a.stroke.mean.total_cmp(&b.stroke.mean))
+            .map(|d| json!({"rank": d.rank, "stroke_m_mean": d.stroke.mean,
+                "stroke_m_ci95_half_width": d.stroke.ci95_half_width})),
         "wall_time_s": {"screening": outcome.screening_wall_s,
             "verification": outcome.verification_wall_s, "total": wall_s},
         "plots": plots,
     });
-    write(out, "report.md", &report_md(space, outcome, &summary, &top))?;
+    write(
+        out,
+        "report.md",
+        &report_md(space, outcome, &summary, &top, &dem),
+    )?;
     write(
         out,
         "summary.json",
@@ -366,7 +411,13 @@ pub fn write_outputs(
     Ok(summary)
 }
 
-fn report_md(space: &Space, o: &SearchOutcome, s: &Value, top: &[&Candidate]) -> String {
+fn report_md(
+    space: &Space,
+    o: &SearchOutcome,
+    s: &Value,
+    top: &[&Candidate],
+    dem: &[crate::dem::DemVerification],
+) -> String {
     let st = space.study;
     let f = &st.file;
     let mut r = String::new();
@@ -451,6 +502,69 @@ fn report_md(space: &Space, o: &SearchOutcome, s: &Value, top: &[&Candidate]) ->
          and coupled DEM (approach 1) are the next levels: run the scenario of a design with a \
          `model = \"fields\"` or `model = \"dem\"` damper to confirm it.\n"
     );
+    if !dem.is_empty() {
+        let _ = writeln!(r, "## Coupled DEM (approach 1)\n");
+        let _ = writeln!(
+            r,
+            "Each design's damper as a DEM bed in its container, dropped {} times with \
+             independent seeds, coupled to the structure (`pdamp couple`, runs in `dem/`).{}\n",
+            f.verification.packings,
+            if f.verification.youngs_modulus_scale < 1.0 {
+                format!(
+                    " **Softened**: particle Young's modulus × {} (shorter runs; not the \
+                     reference fidelity).",
+                    f.verification.youngs_modulus_scale
+                )
+            } else {
+                String::new()
+            }
+        );
+        let _ = writeln!(
+            r,
+            "| rank | stroke (formulas, time simulation) | stroke (coupled DEM, mean ± 95 % CI) | \
+             packings | DEM − formulas | time step | wall time |\n|---|---|---|---|---|---|---|"
+        );
+        for d in dem {
+            let _ = writeln!(
+                r,
+                "| {} | {:.3} mm | {:.3} ± {:.3} mm | {} | {:+.1} % | {:.2e} s | {:.0} s |",
+                d.rank,
+                d.formulas_stroke_m * 1e3,
+                d.stroke.mean * 1e3,
+                d.stroke.ci95_half_width * 1e3,
+                d.stroke.count,
+                100.0 * (d.stroke.mean / d.formulas_stroke_m - 1.0),
+                d.time_step_s,
+                d.wall_s
+            );
+        }
+        if let Some(b) = dem
+            .iter()
+            .filter(|d| d.stroke.mean.is_finite())
+            .min_by(|a, b| a.stroke.mean.total_cmp(&b.stroke.mean))
+        {
+            let overlapping: Vec<String> = dem
+                .iter()
+                .filter(|d| d.rank != b.rank && d.stroke.ci95_low <= b.stroke.ci95_high)
+                .map(|d| d.rank.to_string())
+                .collect();
+            let _ = writeln!(
+                r,
+                "\nUnder coupled DEM the best of these is design {} ({:.3} mm){}.",
+                b.rank,
+                b.stroke.mean * 1e3,
+                if overlapping.is_empty() {
+                    ", its 95 % interval clear of the others'".to_string()
+                } else {
+                    format!(
+                        "; the intervals of design(s) {} overlap it: more packings decide",
+                        overlapping.join(", ")
+                    )
+                }
+            );
+        }
+        let _ = writeln!(r);
+    }
     let _ = writeln!(r, "## Robustness of the best design\n");
     let _ = writeln!(
         r,

@@ -1,0 +1,379 @@
+//! Level 3: coupled DEM (approach 1, D Sect. 3.3) on the best designs, with an ensemble of
+//! independently dropped beds per design and the 95 % confidence interval of the objective.
+//!
+//! For every design a damper scenario is written (a box of the design's inner dimensions built
+//! from one-sided planes, two-sided shelves between horizontal layers, the study's particle
+//! material with its Young's modulus, Poisson's ratio, restitution (Gonthier law) and
+//! friction, the container material of `[verification]`), and a coupling scenario with the
+//! study's structure and free analysis and that damper as `model = "dem"`. Each packing has its
+//! own seed: the drop-down inserts the particles at random and lets them fall in rounds — a
+//! horizontal layer is filled under gravity along −x (it collects against a wall, as the
+//! rolling layers of D Sect. 5.1 do once they roll) and then turned to −z; a vertical bed falls
+//! under −z. The run is `pdamp couple` itself ([`pdamp_structure::report::run_couple`]), so
+//! every output of a coupled DEM run (decay.csv, damping.csv, the energy exchange, ParaView
+//! frames) lies in `dem/design_N/packing_K/out/`.
+
+use crate::DesignError;
+use crate::space::{Design, Space};
+use crate::study::Direction;
+use pdamp_dem::contact::hertz::hertz_contact_time;
+use pdamp_design::ensemble::EnsembleStat;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// One design's coupled-DEM result.
+#[derive(Debug, Clone, Serialize)]
+pub struct DemVerification {
+    /// The design's rank among the verified designs (1-based).
+    pub rank: usize,
+    /// Stroke of every packing, m.
+    pub stroke_m: Vec<f64>,
+    /// Mean, spread and 95 % confidence interval of the stroke over the packings.
+    pub stroke: EnsembleStat,
+    /// The level-1 (formulas, time simulation) stroke of the same design, m.
+    pub formulas_stroke_m: f64,
+    /// DEM time step used, s.
+    pub time_step_s: f64,
+    /// Factor applied to the particles' Young's modulus.
+    pub youngs_modulus_scale: f64,
+    /// Wall time of all packings, s.
+    pub wall_s: f64,
+    /// Where the runs are (relative to the output directory).
+    pub dir: String,
+}
+
+/// Largest relative particle velocity expected in the study: twice the damper point's
+/// initial velocity amplitude X₀ω, plus a margin, m/s.
+fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
+    let a = space.peak_acceleration_m_s2(d);
+    let k = space.study.free.mode;
+    let w = space.study.structure.modes[k].omega_rad_s();
+    2.0 * a / w + 0.2
+}
+
+/// The DEM time step: `[verification] time_step_s` or 0.08 of the particle–particle Hertz
+/// contact time at the check velocity (D Eq. 4.8; pdamp refuses steps above 0.1).
+pub fn time_step_s(space: &Space, d: &Design) -> f64 {
+    let v = &space.study.file.verification;
+    if let Some(dt) = v.time_step_s {
+        return dt;
+    }
+    let g = space.geometry(d.choice);
+    let m = &space.study.file.materials[d.choice.material];
+    let e = m.youngs_modulus_pa * v.youngs_modulus_scale;
+    let e_eff = e / (2.0 * (1.0 - m.poisson_ratio * m.poisson_ratio));
+    let tc = hertz_contact_time(
+        e_eff,
+        0.5 * g.radius_m,
+        0.5 * g.particle_mass_kg,
+        check_velocity_m_s(space, d),
+    );
+    0.08 * tc
+}
+
+fn plane(s: &mut String, name: &str, point: [f64; 3], normal: [f64; 3], two_sided: bool) {
+    let _ = writeln!(
+        s,
+        "[[bodies.walls]]\nname = \"{name}\"\nmaterial = \"container\"\ngeometry = {{ type = \
+         \"plane\", point_m = [{:e}, {:e}, {:e}], normal = [{}, {}, {}], two_sided = {two_sided} \
+         }}\n",
+        point[0], point[1], point[2], normal[0], normal[1], normal[2]
+    );
+}
+
+/// The damper scenario of a design (TOML), for packing seed `seed`.
+pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
+    let st = space.study;
+    let f = &st.file;
+    let v = &f.verification;
+    let g = space.geometry(d.choice);
+    let m = &f.materials[d.choice.material];
+    let dt = time_step_s(space, d);
+    let vcheck = check_velocity_m_s(space, d);
+    let k = st.free.mode;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Coupled-DEM verification of a design of {} (pdamp design):\n# {}\n\
+         title = \"pdamp design verification\"\n\n[simulation]\nduration_s = 0.0\n\
+         time_step_s = {dt:e}\ngravity_m_s2 = [0.0, 0.0, -9.81]\nseed = {seed}\n\
+         check_impact_velocity_m_s = {vcheck}\n",
+        st.path.display(),
+        crate::report::describe(space, d)
+    );
+    let _ = writeln!(
+        s,
+        "[[materials]]\nname = \"particle\"\ndensity_kg_m3 = {}\nyoungs_modulus_pa = {:e}\n\
+         poisson_ratio = {}\n\n[[materials]]\nname = \"container\"\ndensity_kg_m3 = {}\n\
+         youngs_modulus_pa = {:e}\npoisson_ratio = {}\n",
+        m.density_kg_m3,
+        m.youngs_modulus_pa * v.youngs_modulus_scale,
+        m.poisson_ratio,
+        v.container.density_kg_m3,
+        v.container.youngs_modulus_pa,
+        v.container.poisson_ratio
+    );
+    let _ = writeln!(
+        s,
+        "[contact]\nnormal = {{ law = \"gonthier\", restitution = {}, min_impact_velocity_m_s = \
+         0.05 }}\nfriction = {{ law = \"regularized-sliding\", friction_coefficient = {}, \
+         regularization_s_m = 1000.0 }}\n\n[[contact.pairs]]\nmaterials = [\"particle\", \
+         \"container\"]\nnormal = {{ law = \"gonthier\", restitution = {}, \
+         min_impact_velocity_m_s = 0.05 }}\nfriction = {{ law = \"regularized-sliding\", \
+         friction_coefficient = {}, regularization_s_m = 1000.0 }}\n",
+        m.restitution, m.friction, m.wall_restitution, m.friction
+    );
+    let _ = writeln!(s, "[[bodies]]\nname = \"container\"\n");
+    let (l, w) = (g.length_m, f.damper.container_width_m);
+    let direction;
+    let mut groups: Vec<(usize, [f64; 3], [f64; 3])> = Vec::new();
+    let settle_gravity;
+    match f.damper.direction {
+        Direction::Horizontal => {
+            let h = v.layer_height_m.unwrap_or(2.2 * g.radius_m);
+            let top = h * d.particles.len() as f64;
+            plane(
+                &mut s,
+                "wall_x-",
+                [-l / 2.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_x+",
+                [l / 2.0, 0.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_y-",
+                [0.0, -w / 2.0, 0.0],
+                [0.0, 1.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_y+",
+                [0.0, w / 2.0, 0.0],
+                [0.0, -1.0, 0.0],
+                false,
+            );
+            plane(&mut s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
+            plane(&mut s, "lid", [0.0, 0.0, top], [0.0, 0.0, -1.0], false);
+            for i in 1..d.particles.len() {
+                plane(
+                    &mut s,
+                    &format!("shelf_{i}"),
+                    [0.0, 0.0, i as f64 * h],
+                    [0.0, 0.0, 1.0],
+                    true,
+                );
+            }
+            for (i, &n) in d.particles.iter().enumerate() {
+                if n > 0 {
+                    groups.push((
+                        n,
+                        [-l / 2.0, -w / 2.0, i as f64 * h],
+                        [l / 2.0, w / 2.0, (i + 1) as f64 * h],
+                    ));
+                }
+            }
+            direction = [1.0, 0.0, 0.0];
+            settle_gravity = Some([-9.81, 0.0, 0.0]);
+        }
+        Direction::Vertical => {
+            let depth = f.damper.container_depth_m.unwrap_or(w);
+            plane(
+                &mut s,
+                "wall_x-",
+                [-w / 2.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_x+",
+                [w / 2.0, 0.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_y-",
+                [0.0, -depth / 2.0, 0.0],
+                [0.0, 1.0, 0.0],
+                false,
+            );
+            plane(
+                &mut s,
+                "wall_y+",
+                [0.0, depth / 2.0, 0.0],
+                [0.0, -1.0, 0.0],
+                false,
+            );
+            plane(&mut s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
+            plane(&mut s, "lid", [0.0, 0.0, l], [0.0, 0.0, -1.0], false);
+            groups.push((
+                d.particles[0],
+                [-w / 2.0, -depth / 2.0, 0.0],
+                [w / 2.0, depth / 2.0, l],
+            ));
+            direction = [0.0, 0.0, 1.0];
+            settle_gravity = None;
+        }
+    }
+    for (n, lo, hi) in groups {
+        let _ = writeln!(
+            s,
+            "[[particles]]\nmaterial = \"particle\"\ncount = {n}\nsize = {{ type = \
+             \"monodisperse\", radius_m = {:e} }}\nplacement = {{ method = \"drop_down\", region \
+             = {{ type = \"box\", min_m = [{:e}, {:e}, {:e}], max_m = [{:e}, {:e}, {:e}] }} }}\n",
+            g.radius_m, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
+        );
+    }
+    let _ = writeln!(
+        s,
+        "[settle]\nmax_duration_s = 1.0\nkinetic_energy_per_particle_j = 1e-9{}\n",
+        settle_gravity.map_or(String::new(), |g| format!(
+            "\ngravity_m_s2 = [{}, {}, {}]\nturn_max_duration_s = 0.5",
+            g[0], g[1], g[2]
+        ))
+    );
+    let freq = st.structure.modes[k].frequency_hz;
+    let _ = writeln!(
+        s,
+        "[damper]\ncontainer_body = \"container\"\ncontainer_mass_kg = 0.0\ndirection = [{}, {}, \
+         {}]\nfrequency_hz = {freq}\namplitude_m = {:e}\ncycles = 2\ntransient_cycles = 1",
+        direction[0],
+        direction[1],
+        direction[2],
+        st.free.initial_displacement_m.abs().max(1e-6)
+    );
+    s
+}
+
+/// The coupling scenario of a design's DEM run (TOML): the study's structure and free analysis
+/// (duration = the evaluation time) with the DEM damper at the design's point.
+pub fn couple_scenario(
+    space: &Space,
+    d: &Design,
+    evaluate_at_s: f64,
+) -> Result<String, DesignError> {
+    let st = space.study;
+    let text = std::fs::read_to_string(&st.scenario_path)
+        .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
+    let mut table: toml::Table = toml::from_str(&text)
+        .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
+    if let Some(p) = &st.structure_file {
+        table.insert(
+            "structure_file".into(),
+            toml::Value::String(p.display().to_string()),
+        );
+    }
+    let point = &st.file.damper.points[d.choice.point];
+    let damper: toml::Table = toml::from_str(&format!(
+        "model = \"dem\"\npoint = \"{point}\"\nscenario = \"damper.toml\"\n"
+    ))
+    .map_err(|e| DesignError::Solver(e.to_string()))?;
+    table.insert(
+        "dampers".into(),
+        toml::Value::Array(vec![toml::Value::Table(damper)]),
+    );
+    if let Some(toml::Value::Table(a)) = table.get_mut("analysis") {
+        a.insert("duration_s".into(), toml::Value::Float(evaluate_at_s));
+        let dt = time_step_s(space, d);
+        // about 4000 samples of the decay
+        let every = ((evaluate_at_s / dt) / 4000.0).floor().max(1.0) as i64;
+        a.insert("sample_every".into(), toml::Value::Integer(every));
+    }
+    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
+}
+
+/// Runs the coupled DEM of `d` on `packings` beds in `dir` and returns the stroke of each.
+///
+/// # Errors
+/// Input, DEM and output errors (the message names the packing's directory).
+pub fn verify_design(
+    space: &Space,
+    d: &Design,
+    rank: usize,
+    formulas_stroke_m: f64,
+    out: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<DemVerification, DesignError> {
+    let st = space.study;
+    let crate::study::ObjectiveSpec::MinStroke { evaluate_at_s } = st.file.objective else {
+        return Err(DesignError::Solver(
+            "coupled-DEM verification: min_stroke objectives only".into(),
+        ));
+    };
+    let v = &st.file.verification;
+    let rel = PathBuf::from(format!("dem/design_{rank}"));
+    let started = std::time::Instant::now();
+    let k = st.free.mode;
+    let period = 1.0 / st.structure.modes[k].frequency_hz;
+    let mut strokes = Vec::new();
+    for p in 0..v.packings {
+        let dir = out.join(&rel).join(format!("packing_{}", p + 1));
+        std::fs::create_dir_all(&dir).map_err(|e| DesignError::output(&dir, e))?;
+        let seed = pdamp_io::prepare::packing_seed(st.file.search.seed, p);
+        let dscn = dir.join("damper.toml");
+        pdamp_io::atomic::write_atomic(&dscn, damper_scenario(space, d, seed).as_bytes())
+            .map_err(|e| DesignError::output(&dscn, e))?;
+        let cscn = dir.join("couple.toml");
+        pdamp_io::atomic::write_atomic(&cscn, couple_scenario(space, d, evaluate_at_s)?.as_bytes())
+            .map_err(|e| DesignError::output(&cscn, e))?;
+        progress(&format!(
+            "design {rank}, packing {}/{}: coupled DEM",
+            p + 1,
+            v.packings
+        ));
+        let run_out = dir.join("out");
+        let _ = std::fs::remove_dir_all(&run_out);
+        pdamp_structure::report::run_couple(
+            &cscn,
+            &run_out,
+            pdamp_io::run::RunOptions {
+                checkpoint_interval_s: 0.0,
+                resume: false,
+            },
+            &mut |_| {},
+        )
+        .map_err(|e| DesignError::Solver(format!("{}: {e}", cscn.display())))?;
+        let hist = read_decay(&run_out.join("decay.csv"))?;
+        strokes.push(pdamp_structure::study::stroke_at(
+            &hist,
+            evaluate_at_s,
+            1.1 * period,
+        ));
+    }
+    Ok(DemVerification {
+        rank,
+        stroke: EnsembleStat::of(&strokes),
+        stroke_m: strokes,
+        formulas_stroke_m,
+        time_step_s: time_step_s(space, d),
+        youngs_modulus_scale: v.youngs_modulus_scale,
+        wall_s: started.elapsed().as_secs_f64(),
+        dir: rel.display().to_string(),
+    })
+}
+
+/// Reads `decay.csv` (time_s, displacement_m, …) of a coupled run.
+fn read_decay(path: &Path) -> Result<pdamp_structure::free::TimeHistory, DesignError> {
+    let text = std::fs::read_to_string(path).map_err(|e| DesignError::output(path, e))?;
+    let mut h = pdamp_structure::free::TimeHistory::default();
+    for line in text.lines().skip(1) {
+        let mut it = line.split(',');
+        let t = it.next().and_then(|x| x.parse::<f64>().ok());
+        let x = it.next().and_then(|x| x.parse::<f64>().ok());
+        if let (Some(t), Some(x)) = (t, x) {
+            h.time_s.push(t);
+            h.displacement_m.push(x);
+        }
+    }
+    Ok(h)
+}
