@@ -48,7 +48,7 @@ pub struct DemVerification {
 fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
     let a = space.peak_acceleration_m_s2(d);
     let k = space.study.free.mode;
-    let w = space.study.structure.modes[k].omega_rad_s();
+    let w = space.structure(d.choice).modes[k].omega_rad_s();
     2.0 * a / w + 0.2
 }
 
@@ -242,7 +242,7 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
             g[0], g[1], g[2]
         ))
     );
-    let freq = st.structure.modes[k].frequency_hz;
+    let freq = space.structure(d.choice).modes[k].frequency_hz;
     let _ = writeln!(
         s,
         "[damper]\ncontainer_body = \"container\"\ncontainer_mass_kg = 0.0\ndirection = [{}, {}, \
@@ -262,18 +262,8 @@ pub fn couple_scenario(
     d: &Design,
     evaluate_at_s: f64,
 ) -> Result<String, DesignError> {
-    let st = space.study;
-    let text = std::fs::read_to_string(&st.scenario_path)
-        .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
-    let mut table: toml::Table = toml::from_str(&text)
-        .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
-    if let Some(p) = &st.structure_file {
-        table.insert(
-            "structure_file".into(),
-            toml::Value::String(p.display().to_string()),
-        );
-    }
-    let point = &st.file.damper.points[d.choice.point];
+    let mut table = crate::report::scenario_table(space, d)?;
+    let point = &space.location(d.choice).point;
     let damper: toml::Table = toml::from_str(&format!(
         "model = \"dem\"\npoint = \"{point}\"\nscenario = \"damper.toml\"\n"
     ))
@@ -314,7 +304,7 @@ pub fn verify_design(
     let rel = PathBuf::from(format!("dem/design_{rank}"));
     let started = std::time::Instant::now();
     let k = st.free.mode;
-    let period = 1.0 / st.structure.modes[k].frequency_hz;
+    let period = 1.0 / space.structure(d.choice).modes[k].frequency_hz;
     let mut strokes = Vec::new();
     for p in 0..v.packings {
         let dir = out.join(&rel).join(format!("packing_{}", p + 1));

@@ -176,6 +176,145 @@ pub fn amplitude_grid(min_m: f64, max_m: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Several equivalent dampers at one point acting as one (energies and effective masses add),
+/// for the single-damper steady-state schemes of D Fig. 3.7 and Eq. 3.44.
+#[derive(Debug)]
+struct Combined<'a>(&'a [CoupledDamper]);
+
+impl pdamp_structure::effective::EffectiveDamper for Combined<'_> {
+    fn evaluate(
+        &self,
+        amplitude_m: f64,
+        omega_rad_s: f64,
+    ) -> pdamp_structure::effective::EffectiveState {
+        let mut s = pdamp_structure::effective::EffectiveState {
+            effective_mass_kg: 0.0,
+            dissipated_energy_per_cycle_j: 0.0,
+        };
+        for d in self.0 {
+            let e = d.model.evaluate(amplitude_m, omega_rad_s);
+            s.effective_mass_kg += e.effective_mass_kg;
+            s.dissipated_energy_per_cycle_j += e.dissipated_energy_per_cycle_j;
+        }
+        s
+    }
+    fn bed_mass_kg(&self) -> f64 {
+        self.0.iter().map(|d| d.model.bed_mass_kg()).sum()
+    }
+}
+
+/// Modal data of mode `k` for the steady-state schemes: the dampers' point (all dampers of a
+/// design share it), the study's excitation point and force.
+fn mode_coupling(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+) -> Result<pdamp_structure::forced::ModeCoupling, DesignError> {
+    let load = study
+        .load
+        .as_ref()
+        .ok_or_else(|| DesignError::Solver("min_frf_peak without a harmonic load".into()))?;
+    let phi_pd = match dampers.first() {
+        Some(d) => structure.point(&d.point).map_err(DesignError::Solver)?[k],
+        None => 0.0,
+    };
+    Ok(pdamp_structure::forced::ModeCoupling {
+        omega_rad_s: structure.modes[k].omega_rad_s(),
+        damping_ratio: structure.modes[k].damping_ratio,
+        phi_pd,
+        phi_ex: structure
+            .point(&load.excitation_point)
+            .map_err(DesignError::Solver)?[k],
+        force_amplitude_n: load.force_n,
+    })
+}
+
+/// The bare structure's resonance peak of mode `k` at the output point (the scenario's
+/// structure, the reference of min_frf_peak): $|\varphi_{out}\varphi_{ex}|F/(2\zeta_k\omega_k^2)$, m.
+pub fn bare_peak_m(study: &DesignStudy, k: usize) -> Result<f64, DesignError> {
+    let st = &study.structure;
+    let load = study
+        .load
+        .as_ref()
+        .ok_or_else(|| DesignError::Solver("min_frf_peak without a harmonic load".into()))?;
+    let phi_out = st
+        .point(&study.free.output_point)
+        .map_err(DesignError::Solver)?[k];
+    let phi_ex = st
+        .point(&load.excitation_point)
+        .map_err(DesignError::Solver)?[k];
+    let m = &st.modes[k];
+    Ok((phi_out * phi_ex * load.force_n).abs()
+        / (2.0 * m.damping_ratio.max(1e-12) * m.omega_rad_s().powi(2)))
+}
+
+/// Resonance peak of mode `k` at the output point from the equilibrium of D Fig. 3.7
+/// (level 0): $|\varphi_{out}|Q$ with $Q = R/(2m\zeta\bar\omega^2)$ (D Eq. 3.48), and the
+/// equilibrium's ζ.
+fn equilibrium_peak(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+) -> Result<(f64, f64), DesignError> {
+    let c = mode_coupling(study, structure, dampers, k)?;
+    let phi_out = structure
+        .point(&study.free.output_point)
+        .map_err(DesignError::Solver)?[k];
+    let r = (c.phi_ex * c.force_amplitude_n).abs();
+    if dampers.is_empty() || c.phi_pd == 0.0 {
+        let q = r / (2.0 * c.damping_ratio.max(1e-12) * c.omega_rad_s.powi(2));
+        return Ok(((phi_out * q).abs(), c.damping_ratio));
+    }
+    let e = pdamp_structure::forced::resonance_equilibrium(&c, &Combined(dampers), 400);
+    let q = e.amplitude_m / c.phi_pd.abs();
+    Ok(((phi_out * q).abs(), e.damping_ratio))
+}
+
+/// Resonance peak of mode `k` from the steady-state FRF (D Eq. 3.44, level 1) over ±`band`
+/// around the equilibrium frequency, `n` frequencies: (peak at the output point (m), peak of
+/// the modal coordinate Q_max).
+fn frf_peak(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+    n: usize,
+    band: f64,
+) -> Result<(f64, f64), DesignError> {
+    let c = mode_coupling(study, structure, dampers, k)?;
+    let phi_out = structure
+        .point(&study.free.output_point)
+        .map_err(DesignError::Solver)?[k];
+    let f0 = if dampers.is_empty() || c.phi_pd == 0.0 {
+        structure.modes[k].frequency_hz
+    } else {
+        pdamp_structure::forced::resonance_equilibrium(&c, &Combined(dampers), 400).frequency_hz
+    };
+    let none: [CoupledDamper; 0] = [];
+    let model = Combined(if c.phi_pd == 0.0 { &none } else { dampers });
+    // the band, then three zooms around its highest point (a lightly damped peak is far
+    // narrower than the band's spacing)
+    let (mut lo, mut hi) = (f0 * (1.0 - band), f0 * (1.0 + band));
+    let mut q_max: f64 = 0.0;
+    for _ in 0..4 {
+        let freqs: Vec<f64> = (0..n)
+            .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+            .collect();
+        let pts = pdamp_structure::forced::steady_state_frf(&c, &model, &freqs);
+        let (i_max, q) = pts
+            .iter()
+            .map(|p| p.modal_amplitude.abs())
+            .enumerate()
+            .fold((0, 0.0), |a, (i, p)| if p > a.1 { (i, p) } else { a });
+        q_max = q_max.max(q);
+        let df = (hi - lo) / (n - 1) as f64;
+        (lo, hi) = (freqs[i_max] - 2.0 * df, freqs[i_max] + 2.0 * df);
+    }
+    Ok(((phi_out * q_max).abs(), q_max))
+}
+
 /// What one evaluation found.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Evaluation {
@@ -183,8 +322,11 @@ pub struct Evaluation {
     pub cost: f64,
     /// min_stroke: the stroke at the evaluation time, m.
     pub stroke_m: Option<f64>,
-    /// max_damping: mean ζ over the amplitude range per objective mode.
+    /// max_damping: mean ζ over the amplitude range per objective mode; min_frf_peak: ζ at the
+    /// resonance equilibrium per mode (level 0).
     pub damping_ratio_per_mode: Vec<f64>,
+    /// min_frf_peak: the resonance peak at the output point per objective mode, m.
+    pub peak_amplitude_per_mode_m: Vec<f64>,
 }
 
 /// Level 0: the envelope model.
@@ -224,7 +366,7 @@ pub fn envelope_evaluation(
             Ok(Evaluation {
                 cost: stroke,
                 stroke_m: Some(stroke),
-                damping_ratio_per_mode: Vec::new(),
+                ..Default::default()
             })
         }
         ObjectiveSpec::MaxDamping {
@@ -253,6 +395,30 @@ pub fn envelope_evaluation(
                 cost: -mean,
                 stroke_m: None,
                 damping_ratio_per_mode: per_mode,
+                peak_amplitude_per_mode_m: Vec::new(),
+            })
+        }
+        ObjectiveSpec::MinFrfPeak { modes, .. }
+        | ObjectiveSpec::MaxResonanceDamping { modes, .. } => {
+            let mut peaks = Vec::new();
+            let mut zetas = Vec::new();
+            let mut rel = 0.0;
+            for &m in modes {
+                let (p, z) = equilibrium_peak(study, structure, dampers, m - 1)?;
+                rel += p / bare_peak_m(study, m - 1)?;
+                peaks.push(p);
+                zetas.push(z);
+            }
+            let n = modes.len() as f64;
+            let cost = match study.file.objective {
+                ObjectiveSpec::MinFrfPeak { .. } => rel / n,
+                _ => -zetas.iter().sum::<f64>() / n,
+            };
+            Ok(Evaluation {
+                cost,
+                stroke_m: None,
+                damping_ratio_per_mode: zetas,
+                peak_amplitude_per_mode_m: peaks,
             })
         }
     }
@@ -385,7 +551,7 @@ pub fn time_evaluation(
                 Evaluation {
                     cost: stroke,
                     stroke_m: Some(stroke),
-                    damping_ratio_per_mode: Vec::new(),
+                    ..Default::default()
                 },
                 Some(hist),
             ))
@@ -417,6 +583,50 @@ pub fn time_evaluation(
                     cost: -mean,
                     stroke_m: None,
                     damping_ratio_per_mode: per_mode,
+                    peak_amplitude_per_mode_m: Vec::new(),
+                },
+                None,
+            ))
+        }
+        ObjectiveSpec::MinFrfPeak {
+            modes,
+            frequencies,
+            band,
+        }
+        | ObjectiveSpec::MaxResonanceDamping {
+            modes,
+            frequencies,
+            band,
+        } => {
+            let load = study.load.as_ref().ok_or_else(|| {
+                DesignError::Solver("a forced objective without a harmonic load".into())
+            })?;
+            let mut peaks = Vec::new();
+            let mut zetas = Vec::new();
+            let mut rel = 0.0;
+            for &m in modes {
+                let k = m - 1;
+                let (p, q_max) = frf_peak(study, structure, dampers, k, *frequencies, *band)?;
+                rel += p / bare_peak_m(study, k)?;
+                peaks.push(p);
+                // D Eq. 3.47 with m = ω_k²/Ω_R² (Eq. 3.33): ζ = R/(2 Q_max ω_k²)
+                let phi_ex = structure
+                    .point(&load.excitation_point)
+                    .map_err(DesignError::Solver)?[k];
+                let wk = structure.modes[k].omega_rad_s();
+                zetas.push((phi_ex * load.force_n).abs() / (2.0 * q_max.max(1e-300) * wk * wk));
+            }
+            let n = modes.len() as f64;
+            let cost = match study.file.objective {
+                ObjectiveSpec::MinFrfPeak { .. } => rel / n,
+                _ => -zetas.iter().sum::<f64>() / n,
+            };
+            Ok((
+                Evaluation {
+                    cost,
+                    stroke_m: None,
+                    damping_ratio_per_mode: zetas,
+                    peak_amplitude_per_mode_m: peaks,
                 },
                 None,
             ))

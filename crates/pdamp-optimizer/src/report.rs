@@ -32,12 +32,12 @@ pub fn describe(space: &Space, d: &Design) -> String {
         Direction::Vertical => format!("vertical bed of {}", counts.join("/")),
     };
     format!(
-        "{what} × {} r = {:.3} mm (n_max = {}), L = {:.1} mm at '{}'",
+        "{what} × {} r = {:.3} mm (n_max = {}), L = {:.1} mm at {}",
         f.materials[d.choice.material].name,
         g.radius_m * 1e3,
         g.capacity,
         g.length_m * 1e3,
-        f.damper.points[d.choice.point]
+        space.location(d.choice).label
     )
 }
 
@@ -51,14 +51,34 @@ fn objective_names(space: &Space) -> (Vec<String>, &'static str) {
                 .collect(),
             "mean_damping_ratio",
         ),
+        ObjectiveSpec::MinFrfPeak { modes, .. } => (
+            modes.iter().map(|m| format!("peak_mode_{m}_m")).collect(),
+            "relative_peak",
+        ),
+        ObjectiveSpec::MaxResonanceDamping { modes, .. } => (
+            modes
+                .iter()
+                .map(|m| format!("resonance_damping_ratio_mode_{m}"))
+                .collect(),
+            "mean_resonance_damping_ratio",
+        ),
+    }
+}
+
+/// The per-mode values behind the objective: mean ζ (max_damping) or peak amplitudes
+/// (min_frf_peak).
+fn per_mode_values<'a>(space: &Space, e: &'a crate::fidelity::Evaluation) -> &'a [f64] {
+    match space.study.file.objective {
+        ObjectiveSpec::MinFrfPeak { .. } => &e.peak_amplitude_per_mode_m,
+        _ => &e.damping_ratio_per_mode,
     }
 }
 
 /// The objective as a user reads it: the stroke (m) or the mean ζ.
 fn shown(space: &Space, cost: f64) -> f64 {
     match space.study.file.objective {
-        ObjectiveSpec::MinStroke { .. } => cost,
-        ObjectiveSpec::MaxDamping { .. } => -cost,
+        ObjectiveSpec::MinStroke { .. } | ObjectiveSpec::MinFrfPeak { .. } => cost,
+        ObjectiveSpec::MaxDamping { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => -cost,
     }
 }
 
@@ -96,7 +116,7 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
             } else {
                 "envelope".into()
             },
-            f.damper.points[c.design.choice.point].clone(),
+            space.location(c.design.choice).label.replace(',', ";"),
             f.materials[c.design.choice.material].name.clone(),
             format!("{:e}", g.radius_m),
             format!("{:e}", g.length_m),
@@ -117,9 +137,9 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
                 .map_or(String::new(), |t| format!("{:e}", shown(space, t.cost))),
         );
         for k in 0..per_mode.len() {
-            row.push(format!("{:e}", c.envelope.damping_ratio_per_mode[k]));
+            row.push(format!("{:e}", per_mode_values(space, &c.envelope)[k]));
             row.push(c.time.as_ref().map_or(String::new(), |t| {
-                format!("{:e}", t.damping_ratio_per_mode[k])
+                format!("{:e}", per_mode_values(space, t)[k])
             }));
         }
         row.push(c.verified_as.map_or(String::new(), |v| (v + 1).to_string()));
@@ -130,18 +150,38 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
 
 /// A ready-to-run `pdamp couple` scenario of a design: the study's scenario with its dampers
 /// replaced (the structure file referenced by its absolute path).
-fn scenario_toml(space: &Space, d: &Design, rank: usize) -> Result<String, DesignError> {
+/// The study's coupling scenario as a table, with the structure of the design's location: the
+/// structure file by its absolute path, or inline (`[structure]`) for a position along a beam.
+pub fn scenario_table(space: &Space, d: &Design) -> Result<toml::Table, DesignError> {
     let st = space.study;
     let text = std::fs::read_to_string(&st.scenario_path)
         .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
     let mut table: toml::Table = toml::from_str(&text)
         .map_err(|e| DesignError::Load(format!("{}: {e}", st.scenario_path.display())))?;
-    if let Some(p) = &st.structure_file {
-        table.insert(
-            "structure_file".into(),
-            toml::Value::String(p.display().to_string()),
-        );
+    match &space.location(d.choice).spec {
+        Some(spec) => {
+            table.remove("structure_file");
+            table.insert(
+                "structure".into(),
+                toml::Value::try_from(spec)
+                    .map_err(|e| DesignError::Solver(format!("serialising the structure: {e}")))?,
+            );
+        }
+        None => {
+            if let Some(p) = &st.structure_file {
+                table.insert(
+                    "structure_file".into(),
+                    toml::Value::String(p.display().to_string()),
+                );
+            }
+        }
     }
+    Ok(table)
+}
+
+fn scenario_toml(space: &Space, d: &Design, rank: usize) -> Result<String, DesignError> {
+    let st = space.study;
+    let mut table = scenario_table(space, d)?;
     let dampers = toml::Value::try_from(space.damper_specs(d))
         .map_err(|e| DesignError::Solver(format!("serialising the dampers: {e}")))?;
     table.insert("dampers".into(), dampers);
@@ -218,11 +258,12 @@ pub fn write_outputs(
     let dampers = space
         .coupled_dampers(&best.design)
         .map_err(DesignError::Solver)?;
+    let best_structure = space.structure(best.design.choice);
     let d = f.search.detuning;
     let mut rob = String::from("case,frequency_scale,objective_time_simulation\n");
     let mut detune = Vec::new();
     for (case, s) in [("minus", 1.0 - d), ("nominal", 1.0), ("plus", 1.0 + d)] {
-        let (e, _) = time_evaluation(st, &detuned(&st.structure, s), &dampers)?;
+        let (e, _) = time_evaluation(st, &detuned(best_structure, s), &dampers)?;
         let _ = writeln!(rob, "{case},{s},{:e}", shown(space, e.cost));
         detune.push(json!({"case": case, "frequency_scale": s, "objective": shown(space, e.cost)}));
     }
@@ -252,6 +293,9 @@ pub fn write_outputs(
             amplitude_max_m,
             ..
         } => (modes.clone(), *amplitude_min_m, *amplitude_max_m),
+        ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
+            (Vec::new(), 0.0, 0.0)
+        }
     };
     let mut curve_csv =
         String::from("mode,amplitude_m,damping_ratio_time_simulation,damping_ratio_bare\n");
@@ -265,7 +309,8 @@ pub fn write_outputs(
             let dm = space
                 .coupled_dampers(&c.design)
                 .map_err(DesignError::Solver)?;
-            let curve = simulated_damping_curve(st, &st.structure, &dm, m - 1, lo, hi)?;
+            let curve =
+                simulated_damping_curve(st, space.structure(c.design.choice), &dm, m - 1, lo, hi)?;
             let ys: Vec<f64> = grid.iter().map(|&x| curve_at(&curve, x)).collect();
             if label == 0 {
                 let zb = st.structure.modes[m - 1].damping_ratio;
@@ -280,11 +325,13 @@ pub fn write_outputs(
             ));
         }
     }
-    write(out, "damping_curve.csv", &curve_csv)?;
     let mut plots = Vec::new();
-    match line_plot(out.join("damping"), &plot) {
-        Ok(_) => plots.push("damping.png"),
-        Err(e) => eprintln!("note: no damping.png: {e}"),
+    if !curve_modes.is_empty() {
+        write(out, "damping_curve.csv", &curve_csv)?;
+        match line_plot(out.join("damping"), &plot) {
+            Ok(_) => plots.push("damping.png"),
+            Err(e) => eprintln!("note: no damping.png: {e}"),
+        }
     }
     if let Some(bh) = &bare_hist {
         let mut p = LinePlot::new(
@@ -301,7 +348,7 @@ pub fn write_outputs(
             let dm = space
                 .coupled_dampers(&c.design)
                 .map_err(DesignError::Solver)?;
-            if let (_, Some(h)) = time_evaluation(st, &st.structure, &dm)? {
+            if let (_, Some(h)) = time_evaluation(st, space.structure(c.design.choice), &dm)? {
                 p.series.push(Series::new(
                     format!("design {}", i + 1),
                     h.time_s.clone(),
@@ -354,7 +401,7 @@ pub fn write_outputs(
             json!({
                 "rank": i + 1,
                 "design": describe(space, &c.design),
-                "point": f.damper.points[c.design.choice.point],
+                "location": space.location(c.design.choice).label,
                 "material": f.materials[c.design.choice.material].name,
                 "particle_radius_m": space.geometry(c.design.choice).radius_m,
                 "container_length_m": space.geometry(c.design.choice).length_m,
@@ -363,6 +410,7 @@ pub fn write_outputs(
                 format!("{obj}_envelope"): shown(space, c.envelope.cost),
                 format!("{obj}_time_simulation"): c.time.as_ref().map(|t| shown(space, t.cost)),
                 "damping_ratio_per_mode_time_simulation": c.time.as_ref().map(|t| t.damping_ratio_per_mode.clone()),
+                "peak_amplitude_per_mode_m_time_simulation": c.time.as_ref().map(|t| t.peak_amplitude_per_mode_m.clone()),
                 "confirmed_by": if dem.iter().any(|d| d.rank == i + 1) { "coupled_dem" } else { "formulas_time" },
                 "coupled_dem": dem.iter().find(|d| d.rank == i + 1),
                 "scenario": format!("scenarios/design_{}.toml", i + 1),
@@ -443,6 +491,18 @@ fn report_md(
         } => format!(
             "largest mean damping ratio of mode(s) {modes:?} over X = {amplitude_min_m} … \
              {amplitude_max_m} m at the output point"
+        ),
+        ObjectiveSpec::MinFrfPeak { modes, band, .. } => format!(
+            "smallest resonance peak(s) of mode(s) {modes:?} at the output point under the \
+             scenario's harmonic force, relative to the bare structure's (level 0: the \
+             equilibrium of D Fig. 3.7; level 1: the steady-state FRF, D Eq. 3.44, over ±{:.0} %)",
+            band * 100.0
+        ),
+        ObjectiveSpec::MaxResonanceDamping { modes, band, .. } => format!(
+            "largest damping ratio at resonance of mode(s) {modes:?} under the scenario's \
+             harmonic force (level 0: the equilibrium ζ of D Fig. 3.7 / Eq. 3.49; level 1: ζ \
+             from the steady-state FRF's peak, D Eq. 3.44/3.47, over ±{:.0} %)",
+            band * 100.0
         ),
     };
     let _ = writeln!(r, "**Objective**: {objective}.\n");

@@ -12,7 +12,6 @@ use crate::space::{Choice, Design, Space};
 use crate::study::Screening;
 use argmin::core::{CostFunction, Executor};
 use argmin::solver::particleswarm::ParticleSwarm;
-use pdamp_structure::modal::ModalStructure;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 use rayon::prelude::*;
@@ -64,26 +63,18 @@ pub struct SearchOutcome {
 ///
 /// # Errors
 /// A damper spec the structure refuses.
-pub fn screen(
-    space: &Space,
-    structure: &ModalStructure,
-    d: &Design,
-) -> Result<Evaluation, DesignError> {
+pub fn screen(space: &Space, d: &Design) -> Result<Evaluation, DesignError> {
     let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
-    envelope_evaluation(space.study, structure, &dampers)
+    envelope_evaluation(space.study, space.structure(d.choice), &dampers)
 }
 
 /// Level-1 evaluation of a design.
 ///
 /// # Errors
 /// Solver errors.
-pub fn verify(
-    space: &Space,
-    structure: &ModalStructure,
-    d: &Design,
-) -> Result<Evaluation, DesignError> {
+pub fn verify(space: &Space, d: &Design) -> Result<Evaluation, DesignError> {
     let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
-    Ok(time_evaluation(space.study, structure, &dampers)?.0)
+    Ok(time_evaluation(space.study, space.structure(d.choice), &dampers)?.0)
 }
 
 /// Cost the swarm sees: level 0 of the rounded design (cached), a penalty for infeasible ones.
@@ -106,8 +97,7 @@ impl CostFunction for SwarmProblem<'_, '_> {
         if let Some(e) = self.cache.lock().expect("cache").get(&d) {
             return Ok(e.cost);
         }
-        let e = screen(self.space, &self.space.study.structure, &d)
-            .map_err(|e| argmin::core::Error::msg(e.to_string()))?;
+        let e = screen(self.space, &d).map_err(|e| argmin::core::Error::msg(e.to_string()))?;
         let c = e.cost;
         self.cache.lock().expect("cache").insert(d, e);
         Ok(c)
@@ -126,7 +116,6 @@ fn screen_space(space: &Space) -> Result<Screened, DesignError> {
         Screening::Swarm => false,
         Screening::Auto => size <= s.max_enumerated as f64,
     };
-    let structure = &space.study.structure;
     if enumerate {
         if size > 1e7 {
             return Err(DesignError::Input {
@@ -145,7 +134,7 @@ fn screen_space(space: &Space) -> Result<Screened, DesignError> {
             .collect();
         let evals: Vec<Evaluation> = designs
             .par_iter()
-            .map(|d| screen(space, structure, d))
+            .map(|d| screen(space, d))
             .collect::<Result<_, _>>()?;
         return Ok((designs.into_iter().zip(evals).collect(), "enumerate"));
     }
@@ -181,7 +170,6 @@ pub fn default_verifications(screened: usize) -> usize {
 /// # Errors
 /// No feasible design; solver errors.
 pub fn run_search(space: &Space) -> Result<SearchOutcome, DesignError> {
-    let structure = &space.study.structure;
     let t0 = std::time::Instant::now();
     let (mut screened, how) = screen_space(space)?;
     if screened.is_empty() {
@@ -211,7 +199,7 @@ pub fn run_search(space: &Space) -> Result<SearchOutcome, DesignError> {
         .collect();
     let evals: Vec<Evaluation> = first
         .par_iter()
-        .map(|d| verify(space, structure, d))
+        .map(|d| verify(space, d))
         .collect::<Result<_, _>>()?;
     for (d, e) in first.into_iter().zip(evals) {
         let n = verified.len();
@@ -233,7 +221,7 @@ pub fn run_search(space: &Space) -> Result<SearchOutcome, DesignError> {
             let cost = match level0.get(&n) {
                 Some(e) => e.cost,
                 None => {
-                    let e = screen(space, structure, &n)?;
+                    let e = screen(space, &n)?;
                     envelope_evaluations += 1;
                     let c = e.cost;
                     level0.insert(n.clone(), e);
@@ -259,7 +247,7 @@ pub fn run_search(space: &Space) -> Result<SearchOutcome, DesignError> {
                 }
             }
         };
-        let e = verify(space, structure, &d)?;
+        let e = verify(space, &d)?;
         let n = verified.len();
         verified.insert(d, (e, n));
     }

@@ -71,11 +71,21 @@ impl<'a> Space<'a> {
         Space { study }
     }
 
+    /// The location of a choice.
+    pub fn location(&self, c: Choice) -> &crate::study::Location {
+        &self.study.locations[c.point]
+    }
+
+    /// The structure with the damper at the choice's location.
+    pub fn structure(&self, c: Choice) -> &pdamp_structure::modal::ModalStructure {
+        &self.study.locations[c.point].structure
+    }
+
     /// Every categorical choice, in a fixed order.
     pub fn choices(&self) -> Vec<Choice> {
         let d = &self.study.file.damper;
         let mut out = Vec::new();
-        for point in 0..d.points.len() {
+        for point in 0..self.study.locations.len() {
             for length in 0..d.container_lengths_m.len() {
                 for material in 0..self.study.file.materials.len() {
                     for radius in 0..d.particle_radii_m.len() {
@@ -236,7 +246,7 @@ impl<'a> Space<'a> {
         }
         let f = &self.study.file;
         let lens = [
-            f.damper.points.len(),
+            self.study.locations.len(),
             f.damper.container_lengths_m.len(),
             f.materials.len(),
             f.damper.particle_radii_m.len(),
@@ -273,8 +283,8 @@ impl<'a> Space<'a> {
     /// amplitude (min_stroke) or the top of the amplitude range (max_damping) times ω_k².
     pub fn peak_acceleration_m_s2(&self, d: &Design) -> f64 {
         let c = d.choice;
-        let st = &self.study.structure;
-        let point = &self.study.file.damper.points[c.point];
+        let st = self.structure(c);
+        let point = &self.location(c).point;
         let phi = st.point(point).expect("validated point");
         let out = st
             .point(&self.study.free.output_point)
@@ -311,6 +321,22 @@ impl<'a> Space<'a> {
                     amplitude_max_m / out[k].abs().max(1e-300) * phi[k].abs() * w * w
                 })
                 .fold(0.0, f64::max),
+            // the bare structure's resonance: an upper bound, $|\varphi_{pd}\varphi_{ex}|F/(2\zeta_k)$
+            ObjectiveSpec::MinFrfPeak { modes, .. }
+            | ObjectiveSpec::MaxResonanceDamping { modes, .. } => {
+                let Some(load) = &self.study.load else {
+                    return 0.0;
+                };
+                let ex = st.point(&load.excitation_point).expect("validated point");
+                modes
+                    .iter()
+                    .map(|&m| {
+                        let k = m - 1;
+                        (phi[k] * ex[k] * load.force_n).abs()
+                            / (2.0 * st.modes[k].damping_ratio.max(1e-12))
+                    })
+                    .fold(0.0, f64::max)
+            }
         }
     }
 
@@ -322,7 +348,7 @@ impl<'a> Space<'a> {
     /// designs contain, and what the time simulation runs.
     pub fn damper_specs(&self, d: &Design) -> Vec<DamperSpec> {
         let g = self.geometry(d.choice);
-        let point = self.study.file.damper.points[d.choice.point].clone();
+        let point = self.location(d.choice).point.clone();
         let filled: Vec<usize> = d.particles.iter().copied().filter(|&n| n > 0).collect();
         match self.study.file.damper.direction {
             Direction::Vertical => filled
@@ -378,7 +404,7 @@ impl<'a> Space<'a> {
         let mut out = Vec::new();
         for spec in self.damper_specs(d) {
             let model: Box<dyn EffectiveDamper> = spec
-                .effective_model(base, &self.study.structure, self.study.free.mode)?
+                .effective_model(base, self.structure(d.choice), self.study.free.mode)?
                 .ok_or("design: a damper without an equivalent model")?;
             out.push(CoupledDamper {
                 point: spec.point().to_string(),

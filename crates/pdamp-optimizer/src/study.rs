@@ -29,7 +29,7 @@
 use crate::DesignError;
 use pdamp_structure::free::FreeVibrationSpec;
 use pdamp_structure::modal::ModalStructure;
-use pdamp_structure::scenario::CoupleScenario;
+use pdamp_structure::scenario::{CoupleScenario, PointSpec, StructureSpec};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -57,6 +57,59 @@ pub enum ObjectiveSpec {
         #[serde(default = "default_amplitudes")]
         amplitudes: usize,
     },
+    /// Minimise the resonance peaks of the chosen modes at the scenario's output point under
+    /// its harmonic force (`[analysis] kind = "steady_state"`: force, excitation and output
+    /// points), each relative to the bare structure's peak, averaged over the modes.
+    MinFrfPeak {
+        /// Modes (1-based).
+        modes: Vec<usize>,
+        /// Frequencies of the steady-state FRF around each resonance (level 1).
+        #[serde(default = "default_frf_points")]
+        frequencies: usize,
+        /// Half-width of that band relative to the damped resonance frequency.
+        #[serde(default = "default_frf_band")]
+        band: f64,
+    },
+    /// Maximise the damping ratio at resonance of the chosen modes under the scenario's
+    /// harmonic force (`steady_state` scenario), averaged over the modes: level 0 the
+    /// equilibrium ζ of D Fig. 3.7 / Eq. 3.49 (the measure of `pdamp structure
+    /// damper-positions`), level 1 ζ from the steady-state FRF's peak by D Eq. 3.47.
+    MaxResonanceDamping {
+        /// Modes (1-based).
+        modes: Vec<usize>,
+        /// Frequencies of the steady-state FRF around each resonance (level 1).
+        #[serde(default = "default_frf_points")]
+        frequencies: usize,
+        /// Half-width of that band relative to the damped resonance frequency.
+        #[serde(default = "default_frf_band")]
+        band: f64,
+    },
+}
+
+impl ObjectiveSpec {
+    /// Whether the objective needs a `steady_state` scenario (a harmonic force).
+    pub fn is_forced(&self) -> bool {
+        matches!(
+            self,
+            ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. }
+        )
+    }
+}
+
+fn default_frf_points() -> usize {
+    121
+}
+fn default_frf_band() -> f64 {
+    0.15
+}
+
+/// The harmonic load of a `steady_state` scenario (min_frf_peak).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HarmonicLoad {
+    /// Force amplitude F, N.
+    pub force_n: f64,
+    /// Excitation point.
+    pub excitation_point: String,
 }
 
 fn default_amplitudes() -> usize {
@@ -81,7 +134,20 @@ pub struct DamperSpace {
     /// Excitation direction.
     pub direction: Direction,
     /// Candidate structure points (names of `[[structure.points]]` or the single-mode point).
+    #[serde(default)]
     pub points: Vec<String>,
+    /// Candidate positions along a `[structure.beam]`, m: a damper point placed there (the FE
+    /// snaps it to the nearest node), in the dof of `position_dof`.
+    #[serde(default)]
+    pub positions_m: Vec<f64>,
+    /// Dof of the damper point at `positions_m` (default: the dof of the scenario's output
+    /// point).
+    #[serde(default)]
+    pub position_dof: Option<String>,
+    /// Position of a `[structure.beam]` point mass (the container) that moves with the damper
+    /// to each of `positions_m`, m.
+    #[serde(default)]
+    pub move_mass_at_m: Option<f64>,
     /// Candidate inner container lengths along the excitation L, m (D Eq. 5.1/7.4).
     pub container_lengths_m: Vec<f64>,
     /// Inner width across the excitation, m (particles across: ⌊W/2r⌋).
@@ -364,6 +430,24 @@ fn default_materials() -> Vec<MaterialSpec> {
     }]
 }
 
+/// A candidate damper location: a named point of the structure, or a position along a beam
+/// (with its own structure: the point added, the container mass moved).
+#[derive(Debug, Clone)]
+pub struct Location {
+    /// How reports name it (`'damper'`, `x = 1.760 m`).
+    pub label: String,
+    /// The structure point the damper sits at.
+    pub point: String,
+    /// The reduced structure with the damper there.
+    pub structure: ModalStructure,
+    /// The structure spec when it differs from the scenario's (positions along a beam): the
+    /// scenario files of a design carry it inline.
+    pub spec: Option<StructureSpec>,
+}
+
+/// Name of the damper point placed at `damper.positions_m`.
+pub const POSITION_POINT: &str = "design_damper";
+
 /// A loaded and checked study: the file, the reduced structure and the free-vibration settings.
 #[derive(Debug, Clone)]
 pub struct DesignStudy {
@@ -375,11 +459,16 @@ pub struct DesignStudy {
     pub scenario_path: PathBuf,
     /// The structure, modally reduced.
     pub structure: ModalStructure,
-    /// The scenario's free analysis.
+    /// The scenario's free analysis (for a `steady_state` scenario: its output point, a
+    /// placeholder for the rest).
     pub free: FreeVibrationSpec,
+    /// The harmonic load of a `steady_state` scenario.
+    pub load: Option<HarmonicLoad>,
     /// The scenario's structure source for the scenario files written for verified designs:
     /// the structure file (absolute) or `None` when the structure is inline in the scenario.
     pub structure_file: Option<PathBuf>,
+    /// The candidate locations: `damper.points`, then `damper.positions_m`.
+    pub locations: Vec<Location>,
 }
 
 /// Largest particle count of one layer or bed (guards the enumeration against absurd inputs).
@@ -412,28 +501,148 @@ impl DesignStudy {
                 ))
             })?
             .modal;
-        let free = scn.analysis.free_vibration_spec().ok_or_else(|| {
-            DesignError::Load(format!(
-                "{}: the design study's scenario needs [analysis] kind = \"free\" (initial \
-                 condition, time step and output point of the decay)",
-                scenario_path.display()
-            ))
-        })?;
+        let load = match &scn.analysis {
+            pdamp_structure::scenario::AnalysisSpec::SteadyState {
+                force_amplitude_n,
+                base_amplitude_m,
+                excitation_point,
+                ..
+            } => Some(HarmonicLoad {
+                force_n: pdamp_structure::scenario::ForceSpec {
+                    force_amplitude_n: *force_amplitude_n,
+                    base_amplitude_m: *base_amplitude_m,
+                }
+                .force_n(&spec)
+                .map_err(|m| DesignError::Load(format!("{}: {m}", scenario_path.display())))?,
+                excitation_point: excitation_point.clone(),
+            }),
+            _ => None,
+        };
+        let free = match (&scn.analysis, scn.analysis.free_vibration_spec()) {
+            (_, Some(f)) => f,
+            (pdamp_structure::scenario::AnalysisSpec::SteadyState { output_point, .. }, None) => {
+                FreeVibrationSpec {
+                    duration_s: 1.0,
+                    time_step_s: 1e-3,
+                    mode: 0,
+                    initial_point: output_point.clone(),
+                    initial_displacement_m: 0.0,
+                    initial_velocity_m_s: 0.0,
+                    scale_initial_by_bed_mass: false,
+                    output_point: output_point.clone(),
+                    update: pdamp_structure::free::UpdateRule::ZeroCrossing,
+                    sample_every: 1,
+                }
+            }
+            _ => {
+                return Err(DesignError::Load(format!(
+                    "{}: the design study's scenario needs [analysis] kind = \"free\" (initial \
+                     condition, time step and output point of a decay) or kind = \
+                     \"steady_state\" (force, excitation and output point; objective \
+                     min_frf_peak)",
+                    scenario_path.display()
+                )));
+            }
+        };
         let structure_file = scn
             .structure_file
             .as_ref()
             .map(|_| scn.structure_source(&scenario_path))
             .map(|p| std::fs::canonicalize(&p).unwrap_or(p));
-        let study = DesignStudy {
+        let mut study = DesignStudy {
             file,
             path: path.to_path_buf(),
             scenario_path,
             structure,
             free,
+            load,
             structure_file,
+            locations: Vec::new(),
         };
         study.validate()?;
+        study.locations = study.locations(&spec)?;
         Ok(study)
+    }
+
+    /// The candidate locations: the named points on the scenario's structure, and for every
+    /// position along the beam the structure rebuilt with the damper point there (and the
+    /// container mass moved, `damper.move_mass_at_m`).
+    fn locations(&self, spec: &StructureSpec) -> Result<Vec<Location>, DesignError> {
+        let d = &self.file.damper;
+        let mut out: Vec<Location> = d
+            .points
+            .iter()
+            .map(|p| Location {
+                label: format!("'{p}'"),
+                point: p.clone(),
+                structure: self.structure.clone(),
+                spec: None,
+            })
+            .collect();
+        if d.positions_m.is_empty() {
+            return Ok(out);
+        }
+        let Some(beam) = &spec.beam else {
+            return Err(self.input(
+                "damper.positions_m",
+                "positions along a beam need a [structure.beam] structure; name points instead",
+            ));
+        };
+        let dof = match &d.position_dof {
+            Some(dof) => dof.clone(),
+            None => spec
+                .points
+                .iter()
+                .find(|p| p.name == self.free.output_point)
+                .map_or_else(|| "uy".to_string(), |p| p.dof.clone()),
+        };
+        let moved = match d.move_mass_at_m {
+            Some(x) => Some(
+                beam.masses
+                    .iter()
+                    .position(|m| (m.position_m - x).abs() < 1e-9)
+                    .ok_or_else(|| {
+                        self.input(
+                            "damper.move_mass_at_m",
+                            format!("no [structure.beam] mass at {x} m"),
+                        )
+                    })?,
+            ),
+            None => None,
+        };
+        let base = self.scenario_path.parent().unwrap_or(Path::new("."));
+        for (i, &x) in d.positions_m.iter().enumerate() {
+            let key = format!("damper.positions_m[{i}]");
+            pdamp_structure::scenario::on_beam(&key, x, beam.length_m)
+                .map_err(|m| self.input(&key, m))?;
+            let mut st = spec.clone();
+            st.points.retain(|p| p.name != POSITION_POINT);
+            st.points.push(PointSpec {
+                name: POSITION_POINT.into(),
+                position_m: Some(x),
+                node: None,
+                dof: dof.clone(),
+            });
+            if let (Some(m), Some(b)) = (moved, st.beam.as_mut()) {
+                b.masses[m].position_m = x;
+            }
+            let structure = st
+                .build(base)
+                .map_err(|m| {
+                    self.input(
+                        &key,
+                        format!("building the beam with the damper at {x} m: {m}"),
+                    )
+                })?
+                .modal;
+            out.push(Location {
+                label: format!("x = {x:.3} m"),
+                point: POSITION_POINT.into(),
+                structure,
+                spec: Some(st),
+            });
+        }
+        Ok(out)
     }
 
     fn input(&self, key: impl Into<String>, message: impl Into<String>) -> DesignError {
@@ -455,6 +664,24 @@ impl DesignStudy {
         }
     }
 
+    fn check_modes(&self, modes: &[usize]) -> Result<(), DesignError> {
+        if modes.is_empty() {
+            return Err(self.input("objective.modes", "give at least one mode (1-based)"));
+        }
+        for (i, &m) in modes.iter().enumerate() {
+            if m == 0 || m > self.structure.modes.len() {
+                return Err(self.input(
+                    format!("objective.modes[{i}]"),
+                    format!(
+                        "mode {m} does not exist: the structure has modes 1 … {}",
+                        self.structure.modes.len()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Checks every key against the structure and the scenario.
     ///
     /// # Errors
@@ -462,7 +689,51 @@ impl DesignStudy {
     pub fn validate(&self) -> Result<(), DesignError> {
         let f = &self.file;
         let d = &f.damper;
+        let forced = f.objective.is_forced();
+        if forced != self.load.is_some() {
+            return Err(self.input(
+                "objective.kind",
+                if forced {
+                    "min_frf_peak and max_resonance_damping need a scenario with [analysis] kind = \
+                     \"steady_state\" (the force)"
+                } else {
+                    "min_stroke and max_damping need a scenario with [analysis] kind = \"free\"; \
+                     a steady_state scenario goes with kind = \"min_frf_peak\" or \
+                     \"max_resonance_damping\""
+                },
+            ));
+        }
         match &f.objective {
+            ObjectiveSpec::MinFrfPeak {
+                modes,
+                frequencies,
+                band,
+            }
+            | ObjectiveSpec::MaxResonanceDamping {
+                modes,
+                frequencies,
+                band,
+            } => {
+                self.check_modes(modes)?;
+                if !(11..=100_000).contains(frequencies) {
+                    return Err(self.input(
+                        "objective.frequencies",
+                        format!("must be in [11, 100000], got {frequencies}"),
+                    ));
+                }
+                if !(band.is_finite() && *band > 0.0 && *band < 0.9) {
+                    return Err(self.input(
+                        "objective.band",
+                        format!("must lie in (0, 0.9), got {band}"),
+                    ));
+                }
+                if let Some(l) = &self.load {
+                    if let Err(m) = self.structure.point(&l.excitation_point) {
+                        return Err(self.input("scenario analysis.excitation_point", m));
+                    }
+                    self.positive("scenario analysis force", l.force_n.abs(), 1e12)?;
+                }
+            }
             ObjectiveSpec::MinStroke { evaluate_at_s } => {
                 self.positive("objective.evaluate_at_s", *evaluate_at_s, 1e6)?;
                 if *evaluate_at_s > self.free.duration_s {
@@ -481,20 +752,7 @@ impl DesignStudy {
                 amplitude_max_m,
                 amplitudes,
             } => {
-                if modes.is_empty() {
-                    return Err(self.input("objective.modes", "give at least one mode (1-based)"));
-                }
-                for (i, &m) in modes.iter().enumerate() {
-                    if m == 0 || m > self.structure.modes.len() {
-                        return Err(self.input(
-                            format!("objective.modes[{i}]"),
-                            format!(
-                                "mode {m} does not exist: the structure has modes 1 … {}",
-                                self.structure.modes.len()
-                            ),
-                        ));
-                    }
-                }
+                self.check_modes(modes)?;
                 self.positive("objective.amplitude_min_m", *amplitude_min_m, 10.0)?;
                 self.positive("objective.amplitude_max_m", *amplitude_max_m, 10.0)?;
                 if amplitude_min_m >= amplitude_max_m {
@@ -511,8 +769,14 @@ impl DesignStudy {
                 }
             }
         }
-        if d.points.is_empty() {
-            return Err(self.input("damper.points", "give at least one structure point"));
+        if d.points.is_empty() && d.positions_m.is_empty() {
+            return Err(self.input(
+                "damper.points",
+                "give at least one structure point (or positions_m along a beam)",
+            ));
+        }
+        if d.points.len() + d.positions_m.len() > 10_000 {
+            return Err(self.input("damper.positions_m", "at most 10 000 candidate locations"));
         }
         for (i, p) in d.points.iter().enumerate() {
             if let Err(m) = self.structure.point(p) {
