@@ -82,6 +82,17 @@ fn plane(s: &mut String, name: &str, point: [f64; 3], normal: [f64; 3], two_side
     );
 }
 
+/// The six walls of a box container, x ∈ [−a/2, a/2], y ∈ [−b/2, b/2], z ∈ [0, c], as one-sided
+/// planes facing inwards.
+fn box_walls(s: &mut String, a: f64, b: f64, c: f64) {
+    plane(s, "wall_x-", [-a / 2.0, 0.0, 0.0], [1.0, 0.0, 0.0], false);
+    plane(s, "wall_x+", [a / 2.0, 0.0, 0.0], [-1.0, 0.0, 0.0], false);
+    plane(s, "wall_y-", [0.0, -b / 2.0, 0.0], [0.0, 1.0, 0.0], false);
+    plane(s, "wall_y+", [0.0, b / 2.0, 0.0], [0.0, -1.0, 0.0], false);
+    plane(s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
+    plane(s, "lid", [0.0, 0.0, c], [0.0, 0.0, -1.0], false);
+}
+
 /// The damper scenario of a design (TOML), for packing seed `seed`.
 pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
     let st = space.study;
@@ -133,36 +144,7 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
         Direction::Horizontal => {
             let h = v.layer_height_m.unwrap_or(2.2 * g.radius_m);
             let top = h * d.particles.len() as f64;
-            plane(
-                &mut s,
-                "wall_x-",
-                [-l / 2.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_x+",
-                [l / 2.0, 0.0, 0.0],
-                [-1.0, 0.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_y-",
-                [0.0, -w / 2.0, 0.0],
-                [0.0, 1.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_y+",
-                [0.0, w / 2.0, 0.0],
-                [0.0, -1.0, 0.0],
-                false,
-            );
-            plane(&mut s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
-            plane(&mut s, "lid", [0.0, 0.0, top], [0.0, 0.0, -1.0], false);
+            box_walls(&mut s, l, w, top);
             for i in 1..d.particles.len() {
                 plane(
                     &mut s,
@@ -186,36 +168,7 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
         }
         Direction::Vertical => {
             let depth = f.damper.container_depth_m.unwrap_or(w);
-            plane(
-                &mut s,
-                "wall_x-",
-                [-w / 2.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_x+",
-                [w / 2.0, 0.0, 0.0],
-                [-1.0, 0.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_y-",
-                [0.0, -depth / 2.0, 0.0],
-                [0.0, 1.0, 0.0],
-                false,
-            );
-            plane(
-                &mut s,
-                "wall_y+",
-                [0.0, depth / 2.0, 0.0],
-                [0.0, -1.0, 0.0],
-                false,
-            );
-            plane(&mut s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
-            plane(&mut s, "lid", [0.0, 0.0, l], [0.0, 0.0, -1.0], false);
+            box_walls(&mut s, w, depth, l);
             groups.push((
                 d.particles[0],
                 [-w / 2.0, -depth / 2.0, 0.0],

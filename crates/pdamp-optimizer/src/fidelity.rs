@@ -315,6 +315,16 @@ fn frf_peak(
     Ok(((phi_out * q_max).abs(), q_max))
 }
 
+/// Cost of a forced objective: the mean relative peak (min_frf_peak) or −(mean ζ)
+/// (max_resonance_damping), from the sum of the relative peaks and the ζ per mode.
+fn forced_cost(study: &DesignStudy, relative_peak_sum: f64, zetas: &[f64]) -> f64 {
+    let n = zetas.len().max(1) as f64;
+    match study.file.objective {
+        ObjectiveSpec::MinFrfPeak { .. } => relative_peak_sum / n,
+        _ => -zetas.iter().sum::<f64>() / n,
+    }
+}
+
 /// What one evaluation found.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Evaluation {
@@ -409,11 +419,7 @@ pub fn envelope_evaluation(
                 peaks.push(p);
                 zetas.push(z);
             }
-            let n = modes.len() as f64;
-            let cost = match study.file.objective {
-                ObjectiveSpec::MinFrfPeak { .. } => rel / n,
-                _ => -zetas.iter().sum::<f64>() / n,
-            };
+            let cost = forced_cost(study, rel, &zetas);
             Ok(Evaluation {
                 cost,
                 stroke_m: None,
@@ -616,11 +622,7 @@ pub fn time_evaluation(
                 let wk = structure.modes[k].omega_rad_s();
                 zetas.push((phi_ex * load.force_n).abs() / (2.0 * q_max.max(1e-300) * wk * wk));
             }
-            let n = modes.len() as f64;
-            let cost = match study.file.objective {
-                ObjectiveSpec::MinFrfPeak { .. } => rel / n,
-                _ => -zetas.iter().sum::<f64>() / n,
-            };
+            let cost = forced_cost(study, rel, &zetas);
             Ok((
                 Evaluation {
                     cost,
