@@ -14,8 +14,9 @@
 //! frames) lies in `dem/design_N/packing_K/out/`.
 
 use crate::DesignError;
+use crate::fidelity::DecayPlan;
 use crate::space::{Design, Space};
-use crate::study::Direction;
+use crate::study::{Direction, ObjectiveSpec};
 use pdamp_dem::contact::hertz::hertz_contact_time;
 use pdamp_design::ensemble::EnsembleStat;
 use serde::Serialize;
@@ -27,20 +28,58 @@ use std::path::{Path, PathBuf};
 pub struct DemVerification {
     /// The design's rank among the verified designs (1-based).
     pub rank: usize,
-    /// Stroke of every packing, m.
-    pub stroke_m: Vec<f64>,
-    /// Mean, spread and 95 % confidence interval of the stroke over the packings.
-    pub stroke: EnsembleStat,
-    /// The level-1 (formulas, time simulation) stroke of the same design, m.
-    pub formulas_stroke_m: f64,
+    /// The objective's value: `stroke_m` (min_stroke, smaller is better) or
+    /// `mean_damping_ratio` (max_damping: ζ averaged over the amplitude grid and the modes,
+    /// larger is better).
+    pub objective: &'static str,
+    /// The objective of every packing.
+    pub values: Vec<f64>,
+    /// Mean, spread and 95 % confidence interval of the objective over the packings.
+    pub stat: EnsembleStat,
+    /// The level-1 (formulas, time simulation) value of the same design.
+    pub time_simulation: f64,
+    /// max_damping: each mode's ζ̄ over the packings and ζ(X) on the amplitude grid.
+    pub modes: Vec<DemModeDamping>,
     /// DEM time step used, s.
     pub time_step_s: f64,
     /// Factor applied to the particles' Young's modulus.
     pub youngs_modulus_scale: f64,
+    /// Particles of the bed.
+    pub particles: usize,
+    /// Estimated cost before the runs: particles × DEM steps of all runs.
+    pub estimated_particle_steps: f64,
+    /// Largest energy closure of the runs (bed ledger and coupling, relative to the energy
+    /// dissipated; `pdamp couple`'s `energy_exchange`).
+    pub energy_closure: f64,
     /// Wall time of all packings, s.
     pub wall_s: f64,
     /// Where the runs are (relative to the output directory).
     pub dir: String,
+}
+
+impl DemVerification {
+    /// Whether a larger objective is better (damping) or a smaller one (stroke).
+    pub fn larger_is_better(&self) -> bool {
+        self.objective == "mean_damping_ratio"
+    }
+}
+
+/// One mode's damping from the coupled-DEM decays of a design (max_damping).
+#[derive(Debug, Clone, Serialize)]
+pub struct DemModeDamping {
+    /// Mode number (1-based).
+    pub mode: usize,
+    /// ζ averaged over the amplitude grid, per packing.
+    pub damping_ratio: Vec<f64>,
+    /// Its ensemble statistics.
+    pub stat: EnsembleStat,
+    /// The level-1 value of the same design.
+    pub time_simulation: f64,
+    /// ζ(X) over the packings on the amplitude grid: (X in m, statistics).
+    pub curve: Vec<(f64, EnsembleStat)>,
+    /// Smallest and largest cycle amplitude the decays reached (the grid outside it takes the
+    /// nearest cycle's ζ), m.
+    pub covered_amplitude_m: (f64, f64),
 }
 
 /// Largest relative particle velocity expected in the study: twice the damper point's
@@ -235,74 +274,295 @@ pub fn couple_scenario(
     toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
 }
 
-/// Runs the coupled DEM of `d` on `packings` beds in `dir` and returns the stroke of each.
+/// The coupling scenario of a design's damping decay in one mode (max_damping, TOML): the
+/// [`DecayPlan`]'s single-mode structure written inline as `[structure.modal]`, its free
+/// analysis over `duration_s`, and the DEM damper at the design's point.
+pub fn decay_scenario(
+    space: &Space,
+    d: &Design,
+    plan: &DecayPlan,
+    duration_s: f64,
+) -> Result<String, DesignError> {
+    let mut table = crate::report::scenario_table(space, d)?;
+    table.remove("structure_file");
+    let s = &plan.structure;
+    let points: Vec<toml::Value> = s
+        .points
+        .iter()
+        .map(|p| {
+            let mut t = toml::Table::new();
+            t.insert("name".into(), toml::Value::String(p.name.clone()));
+            t.insert(
+                "shape".into(),
+                toml::Value::Array(p.shape.iter().map(|&v| toml::Value::Float(v)).collect()),
+            );
+            toml::Value::Table(t)
+        })
+        .collect();
+    let floats = |v: Vec<f64>| toml::Value::Array(v.into_iter().map(toml::Value::Float).collect());
+    let mut modal = toml::Table::new();
+    modal.insert(
+        "frequencies_hz".into(),
+        floats(s.modes.iter().map(|m| m.frequency_hz).collect()),
+    );
+    modal.insert(
+        "damping_ratios".into(),
+        floats(s.modes.iter().map(|m| m.damping_ratio).collect()),
+    );
+    modal.insert("points".into(), toml::Value::Array(points));
+    let mut structure = toml::Table::new();
+    structure.insert("n_modes".into(), toml::Value::Integer(1));
+    structure.insert("modal".into(), toml::Value::Table(modal));
+    table.insert("structure".into(), toml::Value::Table(structure));
+    let point = &space.location(d.choice).point;
+    let damper: toml::Table = toml::from_str(&format!(
+        "model = \"dem\"\npoint = \"{point}\"\nscenario = \"damper.toml\"\n"
+    ))
+    .map_err(|e| DesignError::Solver(e.to_string()))?;
+    table.insert(
+        "dampers".into(),
+        toml::Value::Array(vec![toml::Value::Table(damper)]),
+    );
+    let f = &plan.spec;
+    let dt = time_step_s(space, d);
+    let every = ((duration_s / dt) / 4000.0).floor().max(1.0) as i64;
+    let analysis: toml::Table = toml::from_str(&format!(
+        "kind = \"free\"\nduration_s = {duration_s:e}\ntime_step_s = {:e}\nmode = 1\n\
+         initial_point = \"{}\"\ninitial_displacement_m = {:e}\noutput_point = \"{}\"\n\
+         sample_every = {every}\n",
+        f.time_step_s, f.initial_point, f.initial_displacement_m, f.output_point
+    ))
+    .map_err(|e| DesignError::Solver(e.to_string()))?;
+    table.insert("analysis".into(), toml::Value::Table(analysis));
+    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
+}
+
+/// How much longer than the formulas' decay a DEM decay runs: a DEM bed that damps less than
+/// the formulas predict still reaches (most of) the bottom of the amplitude range.
+pub const DEM_DECAY_MARGIN: f64 = 1.25;
+
+/// One coupled DEM run of a packing: writes the damper and coupling scenarios to `dir`, runs
+/// `pdamp couple` into `dir/out` and returns the decay at the output point and the run's
+/// energy closure (the larger of the bed ledger's and the coupling's, from `summary.json`).
+fn run_one(
+    space: &Space,
+    d: &Design,
+    dir: &Path,
+    seed: u64,
+    couple: &str,
+) -> Result<(pdamp_structure::free::TimeHistory, f64), DesignError> {
+    std::fs::create_dir_all(dir).map_err(|e| DesignError::output(dir, e))?;
+    let dscn = dir.join("damper.toml");
+    pdamp_io::atomic::write_atomic(&dscn, damper_scenario(space, d, seed).as_bytes())
+        .map_err(|e| DesignError::output(&dscn, e))?;
+    let cscn = dir.join("couple.toml");
+    pdamp_io::atomic::write_atomic(&cscn, couple.as_bytes())
+        .map_err(|e| DesignError::output(&cscn, e))?;
+    let run_out = dir.join("out");
+    let _ = std::fs::remove_dir_all(&run_out);
+    pdamp_structure::report::run_couple(
+        &cscn,
+        &run_out,
+        pdamp_io::run::RunOptions {
+            checkpoint_interval_s: 0.0,
+            resume: false,
+        },
+        &mut |_| {},
+    )
+    .map_err(|e| DesignError::Solver(format!("{}: {e}", cscn.display())))?;
+    let sp = run_out.join("summary.json");
+    let summary: serde_json::Value = std::fs::read_to_string(&sp)
+        .map_err(|e| DesignError::output(&sp, e))
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| DesignError::output(&sp, e)))?;
+    let e = &summary["energy_exchange"];
+    let closure = ["bed_ledger_closure", "coupling_closure"]
+        .iter()
+        .map(|k| e[*k].as_f64().unwrap_or(f64::NAN))
+        .fold(0.0_f64, |a, b| if b.is_nan() { f64::NAN } else { a.max(b) });
+    Ok((read_decay(&run_out.join("decay.csv"))?, closure))
+}
+
+/// Runs the coupled DEM of `d` on `[verification] packings` beds in `out/dem/design_RANK` and
+/// returns the objective of each: the stroke at the evaluation time (min_stroke), or ζ(X) of
+/// every mode from a free decay over the amplitude range (max_damping, one run per mode and
+/// packing, [`DecayPlan`] × [`DEM_DECAY_MARGIN`]). `level1` is the design's time-simulation
+/// evaluation (compared in the result). The cost (particles × steps) is reported through
+/// `progress` before the first run.
 ///
 /// # Errors
-/// Input, DEM and output errors (the message names the packing's directory).
+/// Input, DEM and output errors (the message names the packing's directory); forced
+/// objectives (no coupled-DEM verification for them yet).
 pub fn verify_design(
     space: &Space,
     d: &Design,
     rank: usize,
-    formulas_stroke_m: f64,
+    level1: &crate::fidelity::Evaluation,
     out: &Path,
     progress: &mut dyn FnMut(&str),
 ) -> Result<DemVerification, DesignError> {
     let st = space.study;
-    let crate::study::ObjectiveSpec::MinStroke { evaluate_at_s } = st.file.objective else {
-        return Err(DesignError::Solver(
-            "coupled-DEM verification: min_stroke objectives only".into(),
-        ));
-    };
     let v = &st.file.verification;
     let rel = PathBuf::from(format!("dem/design_{rank}"));
     let started = std::time::Instant::now();
-    let k = st.free.mode;
-    let period = 1.0 / space.structure(d.choice).modes[k].frequency_hz;
-    let mut strokes = Vec::new();
-    for p in 0..v.packings {
-        let dir = out.join(&rel).join(format!("packing_{}", p + 1));
-        std::fs::create_dir_all(&dir).map_err(|e| DesignError::output(&dir, e))?;
-        let seed = pdamp_io::prepare::packing_seed(st.file.search.seed, p);
-        let dscn = dir.join("damper.toml");
-        pdamp_io::atomic::write_atomic(&dscn, damper_scenario(space, d, seed).as_bytes())
-            .map_err(|e| DesignError::output(&dscn, e))?;
-        let cscn = dir.join("couple.toml");
-        pdamp_io::atomic::write_atomic(&cscn, couple_scenario(space, d, evaluate_at_s)?.as_bytes())
-            .map_err(|e| DesignError::output(&cscn, e))?;
+    let dt = time_step_s(space, d);
+    let particles: usize = d.particles.iter().sum();
+    let seed = |p: usize| pdamp_io::prepare::packing_seed(st.file.search.seed, p);
+    let announce = |progress: &mut dyn FnMut(&str), runs: usize, simulated_s: f64| {
+        let ps = particles as f64 * simulated_s / dt;
         progress(&format!(
-            "design {rank}, packing {}/{}: coupled DEM",
-            p + 1,
-            v.packings
+            "design {rank}: coupled DEM, {runs} runs of {particles} particles, {:.3} s simulated \
+             at dt = {dt:.2e} s: {ps:.2e} particle-steps (≈ {:.0} min at 5e6 particle-steps/s; \
+             bed preparation extra)",
+            simulated_s,
+            ps / 5e6 / 60.0
         ));
-        let run_out = dir.join("out");
-        let _ = std::fs::remove_dir_all(&run_out);
-        pdamp_structure::report::run_couple(
-            &cscn,
-            &run_out,
-            pdamp_io::run::RunOptions {
-                checkpoint_interval_s: 0.0,
-                resume: false,
-            },
-            &mut |_| {},
-        )
-        .map_err(|e| DesignError::Solver(format!("{}: {e}", cscn.display())))?;
-        let hist = read_decay(&run_out.join("decay.csv"))?;
-        strokes.push(pdamp_structure::study::stroke_at(
-            &hist,
-            evaluate_at_s,
-            1.1 * period,
-        ));
-    }
-    Ok(DemVerification {
+        ps
+    };
+    let mut result = DemVerification {
         rank,
-        stroke: EnsembleStat::of(&strokes),
-        stroke_m: strokes,
-        formulas_stroke_m,
-        time_step_s: time_step_s(space, d),
+        objective: "stroke_m",
+        values: Vec::new(),
+        stat: EnsembleStat::of(&[]),
+        time_simulation: level1.stroke_m.unwrap_or(f64::NAN),
+        modes: Vec::new(),
+        time_step_s: dt,
         youngs_modulus_scale: v.youngs_modulus_scale,
-        wall_s: started.elapsed().as_secs_f64(),
+        particles,
+        estimated_particle_steps: 0.0,
+        energy_closure: 0.0,
+        wall_s: 0.0,
         dir: rel.display().to_string(),
-    })
+    };
+    match &st.file.objective {
+        ObjectiveSpec::MinStroke { evaluate_at_s } => {
+            let k = st.free.mode;
+            let period = 1.0 / space.structure(d.choice).modes[k].frequency_hz;
+            result.estimated_particle_steps =
+                announce(progress, v.packings, v.packings as f64 * evaluate_at_s);
+            let couple = couple_scenario(space, d, *evaluate_at_s)?;
+            for p in 0..v.packings {
+                progress(&format!(
+                    "design {rank}, packing {}/{}: coupled DEM",
+                    p + 1,
+                    v.packings
+                ));
+                let dir = out.join(&rel).join(format!("packing_{}", p + 1));
+                let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
+                result.energy_closure = result.energy_closure.max(closure);
+                result.values.push(pdamp_structure::study::stroke_at(
+                    &hist,
+                    *evaluate_at_s,
+                    1.1 * period,
+                ));
+            }
+        }
+        ObjectiveSpec::MaxDamping {
+            modes,
+            amplitude_min_m,
+            amplitude_max_m,
+            amplitudes,
+        } => {
+            result.objective = "mean_damping_ratio";
+            result.time_simulation = -level1.cost;
+            let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+            let structure = space.structure(d.choice);
+            let plans = modes
+                .iter()
+                .map(|&m| {
+                    crate::fidelity::damping_decay_plan(
+                        st,
+                        structure,
+                        &dampers,
+                        m - 1,
+                        *amplitude_min_m,
+                        *amplitude_max_m,
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let simulated: f64 = plans
+                .iter()
+                .map(|p| DEM_DECAY_MARGIN * p.spec.duration_s)
+                .sum();
+            result.estimated_particle_steps = announce(
+                progress,
+                v.packings * plans.len(),
+                v.packings as f64 * simulated,
+            );
+            let grid =
+                crate::fidelity::amplitude_grid(*amplitude_min_m, *amplitude_max_m, *amplitudes);
+            let mut per_mode: Vec<Vec<Vec<(f64, f64)>>> = vec![Vec::new(); plans.len()];
+            for p in 0..v.packings {
+                for (i, (plan, &m)) in plans.iter().zip(modes).enumerate() {
+                    progress(&format!(
+                        "design {rank}, packing {}/{}, mode {m}: coupled DEM decay",
+                        p + 1,
+                        v.packings
+                    ));
+                    let dir = out
+                        .join(&rel)
+                        .join(format!("packing_{}", p + 1))
+                        .join(format!("mode_{m}"));
+                    let duration = DEM_DECAY_MARGIN * plan.spec.duration_s;
+                    let couple = decay_scenario(space, d, plan, duration)?;
+                    let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
+                    result.energy_closure = result.energy_closure.max(closure);
+                    per_mode[i].push(crate::fidelity::damping_curve_of(&hist, plan.period_s)?);
+                }
+            }
+            let mean_of = |curve: &[(f64, f64)]| {
+                grid.iter()
+                    .map(|&x| crate::fidelity::curve_at(curve, x))
+                    .sum::<f64>()
+                    / grid.len() as f64
+            };
+            for (i, &m) in modes.iter().enumerate() {
+                let curves = &per_mode[i];
+                let zeta: Vec<f64> = curves.iter().map(|c| mean_of(c)).collect();
+                let covered = curves
+                    .iter()
+                    .flatten()
+                    .fold((f64::INFINITY, 0.0_f64), |a, c| {
+                        (a.0.min(c.0), a.1.max(c.0))
+                    });
+                let curve = grid
+                    .iter()
+                    .map(|&x| {
+                        let z: Vec<f64> = curves
+                            .iter()
+                            .map(|c| crate::fidelity::curve_at(c, x))
+                            .collect();
+                        (x, EnsembleStat::of(&z))
+                    })
+                    .collect();
+                result.modes.push(DemModeDamping {
+                    mode: m,
+                    stat: EnsembleStat::of(&zeta),
+                    damping_ratio: zeta,
+                    time_simulation: level1
+                        .damping_ratio_per_mode
+                        .get(i)
+                        .copied()
+                        .unwrap_or(f64::NAN),
+                    curve,
+                    covered_amplitude_m: covered,
+                });
+            }
+            result.values = (0..v.packings)
+                .map(|p| {
+                    result.modes.iter().map(|m| m.damping_ratio[p]).sum::<f64>()
+                        / result.modes.len() as f64
+                })
+                .collect();
+        }
+        ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
+            return Err(DesignError::Solver(
+                "coupled-DEM verification of forced objectives is not available".into(),
+            ));
+        }
+    }
+    result.stat = EnsembleStat::of(&result.values);
+    result.wall_s = started.elapsed().as_secs_f64();
+    Ok(result)
 }
 
 /// Reads `decay.csv` (time_s, displacement_m, …) of a coupled run.

@@ -440,25 +440,37 @@ pub fn single_mode(structure: &ModalStructure, k: usize) -> ModalStructure {
     s
 }
 
-/// ζ(X) of mode `k` at the output point from a simulated free decay that starts 10 % above
-/// the top of the range and runs until the envelope predicts 10 % below its bottom (at least
-/// 10, at most 3000 periods): (mean amplitude per cycle, ζ per cycle) [D Eq. 3.40, 3.41].
-/// The decay runs on mode k alone ([`single_mode`]): the damping of that mode, as D measures
+/// The free decay that measures ζ(X) of mode `k` at the output point: the structure reduced
+/// to mode `k` alone ([`single_mode`]), released 10 % above the top of the amplitude range,
+/// run until the envelope of the design's dampers predicts 10 % below its bottom (at least 10,
+/// at most 3000 periods). On mode k alone the decay is the damping of that mode as D measures
 /// it per mode, without the energy the dampers pass to the other modes (which would otherwise
-/// beat in the output point's peaks and spoil the log decrement).
+/// beat in the output point's peaks and spoil the log decrement). Level 1 runs it with the
+/// formula dampers, level 3 ([`crate::dem`]) with the coupled DEM.
+#[derive(Debug, Clone)]
+pub struct DecayPlan {
+    /// The structure reduced to the mode (its only mode, index 0).
+    pub structure: ModalStructure,
+    /// The free analysis (mode 0, from the output point).
+    pub spec: FreeVibrationSpec,
+    /// The mode's period, s.
+    pub period_s: f64,
+}
+
+/// The [`DecayPlan`] of mode `k` (0-based) over `[amplitude_min_m, amplitude_max_m]`.
 ///
 /// # Errors
-/// Solver errors.
-pub fn simulated_damping_curve(
+/// The output point is a node of the mode, or it is missing.
+pub fn damping_decay_plan(
     study: &DesignStudy,
     structure: &ModalStructure,
     dampers: &[CoupledDamper],
     k: usize,
     amplitude_min_m: f64,
     amplitude_max_m: f64,
-) -> Result<Vec<(f64, f64)>, DesignError> {
+) -> Result<DecayPlan, DesignError> {
     let out = &study.free.output_point;
-    let structure = &single_mode(structure, k);
+    let structure = single_mode(structure, k);
     let mode = k;
     let k = 0;
     let phi_out = structure.point(out).map_err(DesignError::Solver)?[k];
@@ -469,7 +481,7 @@ pub fn simulated_damping_curve(
         )));
     }
     let period = 1.0 / structure.modes[k].frequency_hz;
-    let sh = shapes(structure, k, dampers);
+    let sh = shapes(&structure, k, dampers);
     let q0 = 1.1 * amplitude_max_m / phi_out.abs();
     let update = if study.free.update == UpdateRule::Never {
         UpdateRule::ZeroCrossing
@@ -477,7 +489,7 @@ pub fn simulated_damping_curve(
         study.free.update
     };
     let env = envelope(
-        structure,
+        &structure,
         k,
         dampers,
         &sh,
@@ -502,12 +514,50 @@ pub fn simulated_damping_curve(
         update,
         sample_every: 1,
     };
-    let hist = free::run_free_vibration(structure, dampers, &spec).map_err(DesignError::Solver)?;
-    let peaks = decay_peaks(&hist, 0.5 * period).map_err(DesignError::Solver)?;
+    Ok(DecayPlan {
+        structure,
+        spec,
+        period_s: period,
+    })
+}
+
+/// ζ per cycle of a decay at the output point: (mean amplitude per cycle, ζ per cycle)
+/// [D Eq. 3.40, 3.41], peaks closer than half a period merged.
+///
+/// # Errors
+/// A history that is not uniformly sampled.
+pub fn damping_curve_of(hist: &TimeHistory, period_s: f64) -> Result<Vec<(f64, f64)>, DesignError> {
+    let peaks = decay_peaks(hist, 0.5 * period_s).map_err(DesignError::Solver)?;
     Ok(damping_per_cycle(&peaks)
         .iter()
         .map(|c| (c.mean_amplitude_m, c.damping_ratio))
         .collect())
+}
+
+/// ζ(X) of mode `k` at the output point from the [`DecayPlan`]'s decay simulated with the
+/// formula dampers (level 1).
+///
+/// # Errors
+/// Solver errors.
+pub fn simulated_damping_curve(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+    amplitude_min_m: f64,
+    amplitude_max_m: f64,
+) -> Result<Vec<(f64, f64)>, DesignError> {
+    let plan = damping_decay_plan(
+        study,
+        structure,
+        dampers,
+        k,
+        amplitude_min_m,
+        amplitude_max_m,
+    )?;
+    let hist = free::run_free_vibration(&plan.structure, dampers, &plan.spec)
+        .map_err(DesignError::Solver)?;
+    damping_curve_of(&hist, plan.period_s)
 }
 
 /// ζ at amplitude `x` from a per-cycle curve (log-linear in X between the cycles that bracket

@@ -25,6 +25,7 @@ pub mod fidelity;
 pub mod report;
 pub mod search;
 pub mod space;
+pub mod spec;
 pub mod study;
 
 pub use error::DesignError;

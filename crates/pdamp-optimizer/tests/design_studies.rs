@@ -319,7 +319,8 @@ fn coupled_dem_verifies_the_best_design_on_an_ensemble() {
     std::fs::remove_file(&p).unwrap();
     let s = s.unwrap();
     let d = &s["coupled_dem"][0];
-    let strokes: Vec<f64> = d["stroke_m"]
+    assert_eq!(d["objective"], "stroke_m");
+    let strokes: Vec<f64> = d["values"]
         .as_array()
         .unwrap()
         .iter()
@@ -327,10 +328,11 @@ fn coupled_dem_verifies_the_best_design_on_an_ensemble() {
         .collect();
     assert_eq!(strokes.len(), 2);
     assert!(strokes[0] != strokes[1], "{strokes:?}");
-    let mean = d["stroke"]["mean"].as_f64().unwrap();
-    let formulas = d["formulas_stroke_m"].as_f64().unwrap();
+    let mean = d["stat"]["mean"].as_f64().unwrap();
+    let formulas = d["time_simulation"].as_f64().unwrap();
     assert!((mean / formulas - 1.0).abs() < 0.25, "{mean} vs {formulas}");
-    assert!(d["stroke"]["ci95_half_width"].as_f64().unwrap().is_finite());
+    assert!(d["stat"]["ci95_half_width"].as_f64().unwrap().is_finite());
+    assert!(d["estimated_particle_steps"].as_f64().unwrap() > 0.0);
     assert_eq!(s["best"]["confirmed_by"], "coupled_dem");
     for k in 1..=2 {
         let run = out.join(format!("dem/design_1/packing_{k}"));
@@ -347,6 +349,113 @@ fn coupled_dem_verifies_the_best_design_on_an_ensemble() {
     assert!(report.contains("**Softened**"), "{report}");
     assert!(out.join("dem.csv").is_file());
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Level 3 for a damping objective: the best design of the Ch. 7 vertical beam posed as
+/// max_damping (mode 1, ζ averaged over 10–50 mm) as a dropped DEM bed, two packings,
+/// softened × 0.01 for a test of seconds. Each packing's free decay of the single-mode
+/// structure gives ζ(X) by the log decrement per cycle (the same procedure as level 1);
+/// measured: formulas ζ̄ 0.068, DEM 0.076 ± 0.013 (+11 %), tolerance 30 %. The decays cover
+/// part of the range, the runs' energy ledgers close to 1e-3, and the per-amplitude ensemble
+/// curve is written.
+#[test]
+fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
+    let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
+        .unwrap()
+        .replace(
+            "kind = \"min_stroke\"\nevaluate_at_s = 0.8",
+            "kind = \"max_damping\"\nmodes = [1]\namplitude_min_m = 0.01\n\
+             amplitude_max_m = 0.05\namplitudes = 6",
+        );
+    assert!(text.contains("max_damping"));
+    let p = examples().join(format!("_test_dem_damping_{}.toml", std::process::id()));
+    std::fs::write(
+        &p,
+        format!(
+            "{text}\n[verification]\ndem_designs = 1\npackings = 2\nyoungs_modulus_scale = 0.01\n"
+        ),
+    )
+    .unwrap();
+    let out = temp_dir("dem_damping");
+    let s = run_design_study_file(&p, &out);
+    std::fs::remove_file(&p).unwrap();
+    let s = s.unwrap();
+    let d = &s["coupled_dem"][0];
+    assert_eq!(d["objective"], "mean_damping_ratio");
+    let z: Vec<f64> = d["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(z.len(), 2);
+    assert!(z[0] != z[1], "{z:?}");
+    let mean = d["stat"]["mean"].as_f64().unwrap();
+    let formulas = d["time_simulation"].as_f64().unwrap();
+    let best = s["best"]["mean_damping_ratio_time_simulation"]
+        .as_f64()
+        .unwrap();
+    assert!((formulas - best).abs() < 1e-15, "{formulas} vs {best}");
+    assert!((mean / formulas - 1.0).abs() < 0.3, "{mean} vs {formulas}");
+    let closure = d["energy_closure"].as_f64().unwrap();
+    assert!(closure <= 1e-3, "energy closure {closure}");
+    let m = &d["modes"][0];
+    assert_eq!(m["mode"], 1);
+    assert_eq!(m["curve"].as_array().unwrap().len(), 6);
+    let (lo, hi) = (
+        m["covered_amplitude_m"][0].as_f64().unwrap(),
+        m["covered_amplitude_m"][1].as_f64().unwrap(),
+    );
+    assert!(lo < 0.05 && hi > 0.01 && lo < hi, "{lo} {hi}");
+    for k in 1..=2 {
+        let run = out.join(format!("dem/design_1/packing_{k}/mode_1"));
+        let cscn = std::fs::read_to_string(run.join("couple.toml")).unwrap();
+        assert!(cscn.contains("[structure.modal]"), "{cscn}");
+        assert!(run.join("out/decay.csv").is_file());
+    }
+    let csv = std::fs::read_to_string(out.join("dem_damping_curve.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 6);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Per mode") && report.contains("**Softened**"));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// A user-style structure from another FE program (the cantilever plate of
+/// structure_plate.toml, Matrix Market K and M): the optimiser puts the damper at the free-edge
+/// corner, where both the bending and the torsion mode move most; at the free edge's middle
+/// (a node line of the torsion mode) the time simulation gives mode 2 the bare structure's
+/// damping (1e-6 relative). Formulas only; the closing note of the design issue has the DEM run.
+#[test]
+fn plate_study_puts_the_damper_at_the_free_corner() {
+    let p = variant("design_plate.toml", "plate", "");
+    let text = std::fs::read_to_string(&p).unwrap().replace(
+        "[verification]\ndem_designs = 3",
+        "[verification]\ndem_designs = 0",
+    );
+    std::fs::write(&p, text).unwrap();
+    let study = DesignStudy::load(&p);
+    std::fs::remove_file(&p).unwrap();
+    let study = study.unwrap();
+    let space = Space::new(&study);
+    let o = run_search(&space).unwrap();
+    let best = &o.candidates[0];
+    assert_eq!(space.location(best.design.choice).point, "corner");
+    // the bare structure through the same decay procedure (its discretisation: 0.001998 for the
+    // modal 0.002)
+    let (bare_eval, _) = time_evaluation(&study, &study.structure, &[]).unwrap();
+    let bare = bare_eval.damping_ratio_per_mode[1];
+    assert!((bare / study.structure.modes[1].damping_ratio - 1.0).abs() < 0.01);
+    let middle = o
+        .candidates
+        .iter()
+        .filter(|c| c.time.is_some())
+        .find(|c| space.location(c.design.choice).point == "edge_middle");
+    if let Some(c) = middle {
+        let z2 = c.time.as_ref().unwrap().damping_ratio_per_mode[1];
+        assert!((z2 / bare - 1.0).abs() < 1e-6, "{z2} vs bare {bare}");
+    }
+    let z = &best.time.as_ref().unwrap().damping_ratio_per_mode;
+    assert!(z[0] > 3.0 * bare && z[1] > 3.0 * bare, "{z:?}");
 }
 
 /// D Sect. 8.2.3 (Fig. 8.27) posed to the optimiser: the vertical formula damper of

@@ -1,6 +1,6 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
-use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_free, run_dem_sweep};
+use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
@@ -193,11 +193,26 @@ pub fn run_couple(
     let mut summary = match &scn.analysis {
         AnalysisSpec::Free { .. } => {
             let spec = scn.analysis.free_vibration_spec().expect("a free analysis");
-            let hist = match &dem {
-                Some((p, d, o)) => run_dem_free(&structure, d, p, &spec, o, progress, Some(&ck))?,
-                None => free::run_free_vibration(&structure, &dampers, &spec)?,
+            let (hist, energy) = match &dem {
+                Some((p, d, o)) => {
+                    let (h, e) = crate::dem::run_dem_free_with_energy(
+                        &structure,
+                        d,
+                        p,
+                        &spec,
+                        o,
+                        progress,
+                        Some(&ck),
+                    )?;
+                    (h, Some(e))
+                }
+                None => (free::run_free_vibration(&structure, &dampers, &spec)?, None),
             };
-            free_outputs(&structure, &scn, &spec, &hist, out)?
+            let mut v = free_outputs(&structure, &scn, &spec, &hist, out)?;
+            if let Some(e) = energy {
+                v["energy_exchange"] = energy_exchange_json(&e);
+            }
+            v
         }
         AnalysisSpec::Sweep {
             start_hz,
@@ -638,6 +653,23 @@ fn free_outputs(
         "last_cycle": cyc.last(),
         "updates": hist.updates.len(),
     }))
+}
+
+/// The energy exchange of a coupled DEM run for `summary.json`, with its two closures: the
+/// bed's ledger, $|W_{walls} - \Delta E_{bed} - E_{diss}|$, and the coupling,
+/// $|W_{s\to b} - W_{walls}|$ (the structure's work on the bed against the walls' work on the
+/// particles), each relative to the energy dissipated in the bed.
+pub fn energy_exchange_json(e: &crate::dem::DemEnergy) -> serde_json::Value {
+    let scale = e.dissipated_j.abs().max(e.wall_work_j.abs()).max(1e-300);
+    json!({
+        "structure_work_on_bed_j": e.structure_work_on_bed_j,
+        "wall_work_j": e.wall_work_j,
+        "bed_energy_change_j": e.bed_energy_change_j,
+        "dissipated_j": e.dissipated_j,
+        "structure_energy_change_j": e.structure_energy_change_j,
+        "bed_ledger_closure": (e.wall_work_j - e.bed_energy_change_j - e.dissipated_j).abs() / scale,
+        "coupling_closure": (e.structure_work_on_bed_j - e.wall_work_j).abs() / scale,
+    })
 }
 
 /// Modal parameters of an FRF for `summary.json`: for every structural mode inside the band,

@@ -5,6 +5,7 @@
 
 pub mod beam;
 pub mod hex8;
+pub mod plate;
 
 use crate::sparse::SparseSym;
 use nalgebra::{DMatrix, Vector3};
