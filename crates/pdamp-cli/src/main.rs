@@ -1085,8 +1085,34 @@ fn check_design_study(path: &std::path::Path) -> Option<Result<()>> {
             || "10 % of the screened designs (2 … 60)".to_string(),
             |v| v.to_string(),
         );
+        let v = &study.file.verification;
+        let dem = if v.dem_designs == 0 {
+            String::new()
+        } else {
+            let per_design = match &study.file.objective {
+                pdamp_optimizer::study::ObjectiveSpec::MaxDamping { modes, .. } => modes.len(),
+                _ => 1,
+            };
+            format!(
+                "; coupled DEM: {} runs ({} designs × {} packings{}), each one's cost \
+                 (particles × steps) printed before it starts{}",
+                v.dem_designs * v.packings * per_design,
+                v.dem_designs,
+                v.packings,
+                if per_design > 1 {
+                    format!(" × {per_design} modes")
+                } else {
+                    String::new()
+                },
+                if v.youngs_modulus_scale < 1.0 {
+                    format!(", softened × {}", v.youngs_modulus_scale)
+                } else {
+                    String::new()
+                }
+            )
+        };
         println!(
-            "{}: a design study, OK — {screened}; time simulations: {verify}; run it with \
+            "{}: a design study, OK — {screened}; time simulations: {verify}{dem}; run it with \
              `pdamp design FILE --out DIR` (docs/design.md)",
             path.display()
         );

@@ -702,10 +702,30 @@ fn report_md(
                     );
                 }
             }
+            let short: Vec<String> = dem
+                .iter()
+                .flat_map(|d| d.modes.iter().map(move |m| (d.rank, m)))
+                .filter(|(_, m)| {
+                    let (lo, hi) = (m.curve[0].0, m.curve[m.curve.len() - 1].0);
+                    m.covered_amplitude_m.0 > 1.1 * lo || m.covered_amplitude_m.1 < hi / 1.1
+                })
+                .map(|(rank, m)| format!("design {rank} mode {}", m.mode))
+                .collect();
             let _ = writeln!(
                 r,
                 "\nζ(X) of the DEM ensembles: `dem_damping_curve.csv` and the `coupled DEM` \
-                 curves of `damping.png`."
+                 curves of `damping.png`.{}",
+                if short.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " The decays of {} did not cover the whole amplitude range (first cycle \
+                         below the top: the bed's first impacts; last cycle above the bottom: \
+                         the bed damps less than the formulas predicted): outside the covered \
+                         amplitudes the grid takes the nearest cycle's ζ.",
+                        short.join(", ")
+                    )
+                }
             );
         }
         if let Some(b) = best_by_dem(dem) {

@@ -514,3 +514,56 @@ fn ch8_positions_screening_agrees_with_the_damper_position_study() {
         );
     }
 }
+
+/// Every shipped design study, coupling scenario and structure in `examples/` loads, checks and
+/// reduces its structure (what `pdamp design`, `pdamp couple` and `pdamp structure modes` do
+/// first), so an example never fails on a key a change made wrong.
+#[test]
+fn every_design_couple_and_structure_example_loads() {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(examples())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    entries.sort();
+    let (mut designs, mut couples, mut structures) = (0, 0, 0);
+    let mut failures = Vec::new();
+    for path in entries {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if name.starts_with("_test_")
+            || text
+                .parse::<toml::Table>()
+                .is_ok_and(|t| t.contains_key("simulation"))
+        {
+            continue; // another test's temporary variant; DEM scenarios (pdamp-io's examples_check)
+        }
+        let result = if name.starts_with("design_") {
+            designs += 1;
+            DesignStudy::load(&path)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        } else if name.starts_with("couple_") {
+            couples += 1;
+            pdamp_structure::scenario::CoupleScenario::load(&path)
+                .and_then(|(_, spec)| spec.build(&examples()).map(|_| ()))
+        } else if name.starts_with("structure_") {
+            structures += 1;
+            std::fs::read_to_string(&path)
+                .map_err(|e| e.to_string())
+                .and_then(|t| {
+                    toml::from_str::<pdamp_structure::scenario::StructureFile>(&t)
+                        .map_err(|e| e.to_string())
+                })
+                .and_then(|f| f.structure.build(&examples()).map(|_| ()))
+        } else {
+            continue;
+        };
+        if let Err(e) = result {
+            failures.push(format!("{name}: {e}"));
+        }
+    }
+    println!("{designs} design studies, {couples} coupling scenarios, {structures} structures");
+    assert!(designs >= 5 && couples >= 19 && structures >= 8);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
