@@ -31,6 +31,12 @@ pub fn describe(space: &Space, d: &Design) -> String {
         Direction::Horizontal => format!("{} layer(s) {}", d.particles.len(), counts.join("/")),
         Direction::Vertical => format!("vertical bed of {}", counts.join("/")),
     };
+    let n = space.location(d.choice).points.len();
+    let what = if n > 1 {
+        format!("{n} containers, each a {what}")
+    } else {
+        what
+    };
     format!(
         "{what} × {} r = {:.3} mm (n_max = {}), L = {:.1} mm at {}",
         f.materials[d.choice.material].name,
@@ -363,7 +369,13 @@ pub fn write_outputs(
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
     let mut dem = Vec::new();
+    let mut dem_skipped = Vec::new();
     for (i, c) in top.iter().take(f.verification.dem_designs).enumerate() {
+        if space.location(c.design.choice).points.len() > 1 {
+            // `pdamp couple` couples one DEM bed per run
+            dem_skipped.push(i + 1);
+            continue;
+        }
         let level1 = c.time.as_ref().expect("verified");
         dem.push(crate::dem::verify_design(
             space,
@@ -450,6 +462,7 @@ pub fn write_outputs(
         },
         "robustness": {"detuning": d, "best_design_objective": detune},
         "coupled_dem": dem,
+        "coupled_dem_skipped_several_containers": dem_skipped,
         "best_by_coupled_dem": best_by_dem(&dem)
             .map(|d| json!({"rank": d.rank, "objective": d.objective, "mean": d.stat.mean,
                 "ci95_half_width": d.stat.ci95_half_width})),
@@ -611,6 +624,17 @@ fn report_md(
          and coupled DEM (approach 1) are the next levels: run the scenario of a design with a \
          `model = \"fields\"` or `model = \"dem\"` damper to confirm it.\n"
     );
+    if let Some(skipped) = s["coupled_dem_skipped_several_containers"].as_array()
+        && !skipped.is_empty()
+    {
+        let ranks: Vec<String> = skipped.iter().map(|v| v.to_string()).collect();
+        let _ = writeln!(
+            r,
+            "Design(s) {} have several containers: coupled DEM couples one DEM bed per run, so \
+             they are confirmed by the formulas only.\n",
+            ranks.join(", ")
+        );
+    }
     if !dem.is_empty() {
         let _ = writeln!(r, "## Coupled DEM (approach 1)\n");
         let _ = writeln!(

@@ -133,10 +133,11 @@ impl<'a> Space<'a> {
         (0..=g.capacity).step_by(g.step).collect()
     }
 
-    /// Bed mass of a design, kg.
+    /// Bed mass of a design (all its containers), kg.
     pub fn bed_mass_kg(&self, d: &Design) -> f64 {
         let g = self.geometry(d.choice);
-        d.particles.iter().sum::<usize>() as f64 * g.particle_mass_kg
+        let containers = self.location(d.choice).points.len();
+        (containers * d.particles.iter().sum::<usize>()) as f64 * g.particle_mass_kg
     }
 
     /// Whether a design satisfies the constraints (and carries particles).
@@ -279,12 +280,21 @@ impl<'a> Space<'a> {
         out
     }
 
-    /// Largest acceleration amplitude the damper point sees in the study, m/s²: the initial
-    /// amplitude (min_stroke) or the top of the amplitude range (max_damping) times ω_k².
+    /// Largest acceleration amplitude the design's damper points see in the study, m/s²
+    /// (the largest over its containers, [`Self::peak_acceleration_at_m_s2`]).
     pub fn peak_acceleration_m_s2(&self, d: &Design) -> f64 {
+        self.location(d.choice)
+            .points
+            .iter()
+            .map(|p| self.peak_acceleration_at_m_s2(d, p))
+            .fold(0.0, f64::max)
+    }
+
+    /// Largest acceleration amplitude the structure point `point` sees in the study, m/s²: the
+    /// initial amplitude (min_stroke) or the top of the amplitude range (max_damping) times ω_k².
+    pub fn peak_acceleration_at_m_s2(&self, d: &Design, point: &str) -> f64 {
         let c = d.choice;
         let st = self.structure(c);
-        let point = &self.location(c).point;
         let phi = st.point(point).expect("validated point");
         let out = st
             .point(&self.study.free.output_point)
@@ -347,8 +357,17 @@ impl<'a> Space<'a> {
     /// (D Eq. 7.1–7.19). These specs are exactly what the scenario files of the verified
     /// designs contain, and what the time simulation runs.
     pub fn damper_specs(&self, d: &Design) -> Vec<DamperSpec> {
+        self.location(d.choice)
+            .points
+            .iter()
+            .flat_map(|p| self.container_specs(d, p))
+            .collect()
+    }
+
+    /// [`Self::damper_specs`] of the design's container at `point`.
+    fn container_specs(&self, d: &Design, point: &str) -> Vec<DamperSpec> {
         let g = self.geometry(d.choice);
-        let point = self.location(d.choice).point.clone();
+        let point = point.to_string();
         let filled: Vec<usize> = d.particles.iter().copied().filter(|&n| n > 0).collect();
         match self.study.file.damper.direction {
             Direction::Vertical => filled
@@ -362,7 +381,9 @@ impl<'a> Space<'a> {
                     max_particles: Some(g.capacity as f64),
                 })
                 .collect(),
-            Direction::Horizontal if self.peak_acceleration_m_s2(d) < STANDARD_GRAVITY_M_S2 => {
+            Direction::Horizontal
+                if self.peak_acceleration_at_m_s2(d, &point) < STANDARD_GRAVITY_M_S2 =>
+            {
                 vec![DamperSpec::Rolling {
                     point,
                     layers: filled

@@ -112,6 +112,12 @@ pub struct DamperSpace {
     /// snaps it to the nearest node), in the dof of `position_dof`.
     #[serde(default)]
     pub positions_m: Vec<f64>,
+    /// Numbers of identical containers to consider (default `[1]`): with n ≥ 2 every set of n
+    /// different `points` carries one container each, all with the same design; their bed
+    /// masses add (the constraints apply to the sum) and the formulas add their energies
+    /// (D Eq. 3.39). Free-decay objectives only.
+    #[serde(default = "one_container")]
+    pub containers: Vec<usize>,
     /// Dof of the damper point at `positions_m` (default: the dof of the scenario's output
     /// point).
     #[serde(default)]
@@ -138,6 +144,9 @@ pub struct DamperSpace {
     pub particle_count_step: Option<usize>,
 }
 
+fn one_container() -> Vec<usize> {
+    vec![1]
+}
 fn one() -> usize {
     1
 }

@@ -39,8 +39,10 @@ use std::path::{Path, PathBuf};
 pub struct Location {
     /// How reports name it (`'damper'`, `x = 1.760 m`).
     pub label: String,
-    /// The structure point the damper sits at.
+    /// The structure point the damper sits at (the first container's).
     pub point: String,
+    /// Every container's point (one entry unless `damper.containers` asks for several).
+    pub points: Vec<String>,
     /// The reduced structure with the damper there.
     pub structure: ModalStructure,
     /// The structure spec when it differs from the scenario's (positions along a beam): the
@@ -172,16 +174,25 @@ impl DesignStudy {
     /// container mass moved, `damper.move_mass_at_m`).
     fn locations(&self, spec: &StructureSpec) -> Result<Vec<Location>, DesignError> {
         let d = &self.file.damper;
-        let mut out: Vec<Location> = d
-            .points
-            .iter()
-            .map(|p| Location {
-                label: format!("'{p}'"),
-                point: p.clone(),
-                structure: self.structure.clone(),
-                spec: None,
-            })
-            .collect();
+        let named = |set: &[usize]| Location {
+            label: set
+                .iter()
+                .map(|&i| format!("'{}'", d.points[i]))
+                .collect::<Vec<_>>()
+                .join(" + "),
+            point: d.points[set[0]].clone(),
+            points: set.iter().map(|&i| d.points[i].clone()).collect(),
+            structure: self.structure.clone(),
+            spec: None,
+        };
+        let mut out: Vec<Location> = Vec::new();
+        let mut counts = d.containers.clone();
+        counts.sort_unstable();
+        for &n in &counts {
+            for set in combinations(d.points.len(), n) {
+                out.push(named(&set));
+            }
+        }
         if d.positions_m.is_empty() {
             return Ok(out);
         }
@@ -241,6 +252,7 @@ impl DesignStudy {
             out.push(Location {
                 label: format!("x = {x:.3} m"),
                 point: POSITION_POINT.into(),
+                points: vec![POSITION_POINT.into()],
                 structure,
                 spec: Some(st),
             });
@@ -380,6 +392,41 @@ impl DesignStudy {
         }
         if d.points.len() + d.positions_m.len() > 10_000 {
             return Err(self.input("damper.positions_m", "at most 10 000 candidate locations"));
+        }
+        if d.containers.is_empty() {
+            return Err(self.input("damper.containers", "give at least one number, e.g. [1]"));
+        }
+        for (i, &n) in d.containers.iter().enumerate() {
+            let key = format!("damper.containers[{i}]");
+            if !(1..=4).contains(&n) {
+                return Err(self.input(key, format!("must be in 1..=4, got {n}")));
+            }
+            if d.containers[..i].contains(&n) {
+                return Err(self.input(key, format!("{n} is listed twice")));
+            }
+            if n >= 2 && n > d.points.len() {
+                return Err(self.input(
+                    key,
+                    format!(
+                        "{n} containers need at least {n} different damper.points (one each), \
+                         got {}",
+                        d.points.len()
+                    ),
+                ));
+            }
+            if n >= 2 && f.objective.is_forced() {
+                return Err(self.input(
+                    key,
+                    "several containers: free-decay objectives only (min_stroke, max_damping); \
+                     the steady-state schemes of D Fig. 3.7 / Eq. 3.44 take one damper point",
+                ));
+            }
+        }
+        if !d.positions_m.is_empty() && !d.containers.contains(&1) {
+            return Err(self.input(
+                "damper.containers",
+                "positions_m carry one container each: include 1",
+            ));
         }
         for (i, p) in d.points.iter().enumerate() {
             if let Err(m) = self.structure.point(p) {
@@ -552,4 +599,24 @@ impl DesignStudy {
         }
         Ok(())
     }
+}
+
+/// Every n-subset of 0..len, ascending, in lexicographic order.
+fn combinations(len: usize, n: usize) -> Vec<Vec<usize>> {
+    fn rec(start: usize, len: usize, n: usize, cur: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
+        if cur.len() == n {
+            out.push(cur.clone());
+            return;
+        }
+        for i in start..len {
+            cur.push(i);
+            rec(i + 1, len, n, cur, out);
+            cur.pop();
+        }
+    }
+    let mut out = Vec::new();
+    if n > 0 && n <= len {
+        rec(0, len, n, &mut Vec::new(), &mut out);
+    }
+    out
 }

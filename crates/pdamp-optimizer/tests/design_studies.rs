@@ -204,6 +204,17 @@ fn bad_study_keys_are_named() {
             "evaluate_at_s = 9.0",
             "objective.evaluate_at_s",
         ),
+        // two containers need two points; five are too many
+        (
+            "points = [\"damper\"]",
+            "points = [\"damper\"]\ncontainers = [1, 2]",
+            "damper.containers[1]",
+        ),
+        (
+            "points = [\"damper\"]",
+            "points = [\"damper\"]\ncontainers = [5]",
+            "damper.containers[0]",
+        ),
     ] {
         let p = examples().join(format!("_test_badkey_{}.toml", std::process::id()));
         std::fs::write(&p, text.replace(from, to)).unwrap();
@@ -456,6 +467,73 @@ fn plate_study_puts_the_damper_at_the_free_corner() {
     }
     let z = &best.time.as_ref().unwrap().damping_ratio_per_mode;
     assert!(z[0] > 3.0 * bare && z[1] > 3.0 * bare, "{z:?}");
+}
+
+/// Several containers (`damper.containers = [1, 2]`) on the plate: two identical containers at
+/// two of the points are one design, their bed masses add under the 100 g limit, and the
+/// level-1 value of a two-container design is the time simulation of the two single
+/// containers' dampers together (1e-12); its scenario file carries both dampers. Mode 2
+/// (torsion) moves the two free corners in opposite directions, mode 1 together; both are
+/// damped by the pair.
+#[test]
+fn two_containers_are_one_design_with_both_dampers() {
+    let p = variant("design_plate.toml", "two", "");
+    let text = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace(
+            "points = [\"corner\", \"edge_quarter\", \"edge_middle\", \"centre\"]",
+            "points = [\"corner\", \"corner_far\", \"edge_middle\"]\ncontainers = [1, 2]",
+        )
+        .replace(
+            "[verification]\ndem_designs = 3",
+            "[verification]\ndem_designs = 0",
+        );
+    assert!(text.contains("containers = [1, 2]"));
+    std::fs::write(&p, text).unwrap();
+    let study = DesignStudy::load(&p);
+    std::fs::remove_file(&p).unwrap();
+    let study = study.unwrap();
+    // 3 single points + 3 pairs
+    assert_eq!(study.locations.len(), 6);
+    assert_eq!(study.locations[3].points, ["corner", "corner_far"]);
+    let space = Space::new(&study);
+    let o = run_search(&space).unwrap();
+    let pair = o
+        .candidates
+        .iter()
+        .filter(|c| c.time.is_some())
+        .find(|c| space.location(c.design.choice).points == ["corner", "corner_far"])
+        .expect("a verified two-container design at both corners");
+    let bed = space.bed_mass_kg(&pair.design);
+    assert!(bed <= 0.1 * (1.0 + 1e-12), "{bed}");
+    let mut single = pair.design.clone();
+    single.choice.point = 0; // 'corner' alone
+    assert!((space.bed_mass_kg(&single) * 2.0 - bed).abs() < 1e-15);
+    let mut dampers = space.coupled_dampers(&single).unwrap();
+    let mut far = single.clone();
+    far.choice.point = 1; // 'corner_far' alone
+    dampers.extend(space.coupled_dampers(&far).unwrap());
+    let (e, _) = time_evaluation(&study, &study.structure, &dampers).unwrap();
+    let t = pair.time.as_ref().unwrap();
+    assert!(
+        (e.cost - t.cost).abs() < 1e-12 * t.cost.abs(),
+        "{} vs {}",
+        e.cost,
+        t.cost
+    );
+    let (bare, _) = time_evaluation(&study, &study.structure, &[]).unwrap();
+    for k in 0..2 {
+        assert!(
+            t.damping_ratio_per_mode[k] > 2.0 * bare.damping_ratio_per_mode[k],
+            "mode {}: {:?}",
+            k + 1,
+            t.damping_ratio_per_mode
+        );
+    }
+    let specs = space.damper_specs(&pair.design);
+    assert_eq!(specs.len(), 2);
+    assert_eq!(specs[0].point(), "corner");
+    assert_eq!(specs[1].point(), "corner_far");
 }
 
 /// D Sect. 8.2.3 (Fig. 8.27) posed to the optimiser: the vertical formula damper of
