@@ -46,6 +46,8 @@ pub struct DemVerification {
     pub youngs_modulus_scale: f64,
     /// Particles of the bed.
     pub particles: usize,
+    /// Coupled runs made (packings, × modes for max_damping).
+    pub runs: usize,
     /// Estimated cost before the runs: particles × DEM steps of all runs.
     pub estimated_particle_steps: f64,
     /// Largest energy closure of the runs (bed ledger and coupling, relative to the energy
@@ -428,6 +430,7 @@ pub fn verify_design(
         time_step_s: dt,
         youngs_modulus_scale: v.youngs_modulus_scale,
         particles,
+        runs: 0,
         estimated_particle_steps: 0.0,
         energy_closure: 0.0,
         wall_s: 0.0,
@@ -448,6 +451,7 @@ pub fn verify_design(
                 ));
                 let dir = out.join(&rel).join(format!("packing_{}", p + 1));
                 let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
+                result.runs += 1;
                 result.energy_closure = result.energy_closure.max(closure);
                 result.values.push(pdamp_structure::study::stroke_at(
                     &hist,
@@ -505,6 +509,7 @@ pub fn verify_design(
                     let duration = DEM_DECAY_MARGIN * plan.spec.duration_s;
                     let couple = decay_scenario(space, d, plan, duration)?;
                     let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
+                    result.runs += 1;
                     result.energy_closure = result.energy_closure.max(closure);
                     per_mode[i].push(crate::fidelity::damping_curve_of(&hist, plan.period_s)?);
                 }

@@ -223,6 +223,7 @@ pub fn write_outputs(
     wall_s: f64,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Value, DesignError> {
+    let started = std::time::Instant::now();
     let st = space.study;
     let f = &st.file;
     std::fs::create_dir_all(out.join("scenarios")).map_err(|e| DesignError::output(out, e))?;
@@ -463,12 +464,14 @@ pub fn write_outputs(
         "robustness": {"detuning": d, "best_design_objective": detune},
         "coupled_dem": dem,
         "coupled_dem_skipped_several_containers": dem_skipped,
+        "coupled_dem_runs": dem.iter().map(|d| d.runs).sum::<usize>(),
         "best_by_coupled_dem": best_by_dem(&dem)
             .map(|d| json!({"rank": d.rank, "objective": d.objective, "mean": d.stat.mean,
                 "ci95_half_width": d.stat.ci95_half_width})),
         "wall_time_s": {"screening": outcome.screening_wall_s,
             "verification": outcome.verification_wall_s,
-            "coupled_dem": dem.iter().map(|d| d.wall_s).sum::<f64>(), "total": wall_s},
+            "coupled_dem": dem.iter().map(|d| d.wall_s).sum::<f64>(),
+            "total": wall_s + started.elapsed().as_secs_f64()},
         "plots": plots,
     });
     write(
@@ -571,13 +574,22 @@ fn report_md(
     let _ = writeln!(
         r,
         "**Search**: {:.0} designs in the space (before the constraints); {} envelope evaluations ({}), {} time \
-         simulations; wall time {:.2} s screening + {:.2} s verification.\n",
+         simulations; wall time {:.2} s screening + {:.2} s verification{}.\n",
         o.space_size,
         o.envelope_evaluations,
         o.screening,
         o.time_evaluations,
         o.screening_wall_s,
-        o.verification_wall_s
+        o.verification_wall_s,
+        if dem.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " + {:.0} s coupled DEM ({} runs)",
+                dem.iter().map(|d| d.wall_s).sum::<f64>(),
+                s["coupled_dem_runs"].as_u64().unwrap_or(0)
+            )
+        }
     );
     let (_, obj) = objective_names(space);
     let _ = writeln!(r, "## Best designs\n");

@@ -410,6 +410,9 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     assert!((mean / formulas - 1.0).abs() < 0.3, "{mean} vs {formulas}");
     let closure = d["energy_closure"].as_f64().unwrap();
     assert!(closure <= 1e-3, "energy closure {closure}");
+    assert_eq!(d["runs"], 2);
+    let w = &s["wall_time_s"];
+    assert!(w["total"].as_f64().unwrap() >= w["coupled_dem"].as_f64().unwrap());
     let m = &d["modes"][0];
     assert_eq!(m["mode"], 1);
     assert_eq!(m["curve"].as_array().unwrap().len(), 6);
