@@ -408,18 +408,6 @@ pub fn verify_design(
     let started = std::time::Instant::now();
     let dt = time_step_s(space, d);
     let particles: usize = d.particles.iter().sum();
-    let seed = |p: usize| pdamp_io::prepare::packing_seed(st.file.search.seed, p);
-    let announce = |progress: &mut dyn FnMut(&str), runs: usize, simulated_s: f64| {
-        let ps = particles as f64 * simulated_s / dt;
-        progress(&format!(
-            "design {rank}: coupled DEM, {runs} runs of {particles} particles, {:.3} s simulated \
-             at dt = {dt:.2e} s: {ps:.2e} particle-steps (≈ {:.0} min at 5e6 particle-steps/s; \
-             bed preparation extra)",
-            simulated_s,
-            ps / 5e6 / 60.0
-        ));
-        ps
-    };
     let mut result = DemVerification {
         rank,
         objective: "stroke_m",
@@ -440,8 +428,12 @@ pub fn verify_design(
         ObjectiveSpec::MinStroke { evaluate_at_s } => {
             let k = st.free.mode;
             let period = 1.0 / space.structure(d.choice).modes[k].frequency_hz;
-            result.estimated_particle_steps =
-                announce(progress, v.packings, v.packings as f64 * evaluate_at_s);
+            result.estimated_particle_steps = announce(
+                progress,
+                &result,
+                v.packings,
+                v.packings as f64 * evaluate_at_s,
+            );
             let couple = couple_scenario(space, d, *evaluate_at_s)?;
             for p in 0..v.packings {
                 progress(&format!(
@@ -450,7 +442,7 @@ pub fn verify_design(
                     v.packings
                 ));
                 let dir = out.join(&rel).join(format!("packing_{}", p + 1));
-                let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
+                let (hist, closure) = run_one(space, d, &dir, seed(space, p), &couple)?;
                 result.runs += 1;
                 result.energy_closure = result.energy_closure.max(closure);
                 result.values.push(pdamp_structure::study::stroke_at(
@@ -460,104 +452,8 @@ pub fn verify_design(
                 ));
             }
         }
-        ObjectiveSpec::MaxDamping {
-            modes,
-            amplitude_min_m,
-            amplitude_max_m,
-            amplitudes,
-        } => {
-            result.objective = "mean_damping_ratio";
-            result.time_simulation = -level1.cost;
-            let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
-            let structure = space.structure(d.choice);
-            let plans = modes
-                .iter()
-                .map(|&m| {
-                    crate::fidelity::damping_decay_plan(
-                        st,
-                        structure,
-                        &dampers,
-                        m - 1,
-                        *amplitude_min_m,
-                        *amplitude_max_m,
-                    )
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            let simulated: f64 = plans
-                .iter()
-                .map(|p| DEM_DECAY_MARGIN * p.spec.duration_s)
-                .sum();
-            result.estimated_particle_steps = announce(
-                progress,
-                v.packings * plans.len(),
-                v.packings as f64 * simulated,
-            );
-            let grid =
-                crate::fidelity::amplitude_grid(*amplitude_min_m, *amplitude_max_m, *amplitudes);
-            let mut per_mode: Vec<Vec<Vec<(f64, f64)>>> = vec![Vec::new(); plans.len()];
-            for p in 0..v.packings {
-                for (i, (plan, &m)) in plans.iter().zip(modes).enumerate() {
-                    progress(&format!(
-                        "design {rank}, packing {}/{}, mode {m}: coupled DEM decay",
-                        p + 1,
-                        v.packings
-                    ));
-                    let dir = out
-                        .join(&rel)
-                        .join(format!("packing_{}", p + 1))
-                        .join(format!("mode_{m}"));
-                    let duration = DEM_DECAY_MARGIN * plan.spec.duration_s;
-                    let couple = decay_scenario(space, d, plan, duration)?;
-                    let (hist, closure) = run_one(space, d, &dir, seed(p), &couple)?;
-                    result.runs += 1;
-                    result.energy_closure = result.energy_closure.max(closure);
-                    per_mode[i].push(crate::fidelity::damping_curve_of(&hist, plan.period_s)?);
-                }
-            }
-            let mean_of = |curve: &[(f64, f64)]| {
-                grid.iter()
-                    .map(|&x| crate::fidelity::curve_at(curve, x))
-                    .sum::<f64>()
-                    / grid.len() as f64
-            };
-            for (i, &m) in modes.iter().enumerate() {
-                let curves = &per_mode[i];
-                let zeta: Vec<f64> = curves.iter().map(|c| mean_of(c)).collect();
-                let covered = curves
-                    .iter()
-                    .flatten()
-                    .fold((f64::INFINITY, 0.0_f64), |a, c| {
-                        (a.0.min(c.0), a.1.max(c.0))
-                    });
-                let curve = grid
-                    .iter()
-                    .map(|&x| {
-                        let z: Vec<f64> = curves
-                            .iter()
-                            .map(|c| crate::fidelity::curve_at(c, x))
-                            .collect();
-                        (x, EnsembleStat::of(&z))
-                    })
-                    .collect();
-                result.modes.push(DemModeDamping {
-                    mode: m,
-                    stat: EnsembleStat::of(&zeta),
-                    damping_ratio: zeta,
-                    time_simulation: level1
-                        .damping_ratio_per_mode
-                        .get(i)
-                        .copied()
-                        .unwrap_or(f64::NAN),
-                    curve,
-                    covered_amplitude_m: covered,
-                });
-            }
-            result.values = (0..v.packings)
-                .map(|p| {
-                    result.modes.iter().map(|m| m.damping_ratio[p]).sum::<f64>()
-                        / result.modes.len() as f64
-                })
-                .collect();
+        ObjectiveSpec::MaxDamping { .. } => {
+            damping_decays(space, d, level1, out, &mut result, progress)?;
         }
         ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
             return Err(DesignError::Solver(
@@ -568,6 +464,150 @@ pub fn verify_design(
     result.stat = EnsembleStat::of(&result.values);
     result.wall_s = started.elapsed().as_secs_f64();
     Ok(result)
+}
+
+/// The cost of a verification in particle-steps (settling excluded), reported through
+/// `progress` before the runs.
+fn announce(
+    progress: &mut dyn FnMut(&str),
+    r: &DemVerification,
+    runs: usize,
+    simulated_s: f64,
+) -> f64 {
+    let ps = r.particles as f64 * simulated_s / r.time_step_s;
+    progress(&format!(
+        "design {}: coupled DEM, {runs} runs of {} particles, {simulated_s:.3} s simulated at \
+         dt = {:.2e} s: {ps:.2e} particle-steps (≈ {:.0} min at 5e6 particle-steps/s; bed \
+         preparation extra)",
+        r.rank,
+        r.particles,
+        r.time_step_s,
+        ps / 5e6 / 60.0
+    ));
+    ps
+}
+
+fn seed(space: &Space, packing: usize) -> u64 {
+    pdamp_io::prepare::packing_seed(space.study.file.search.seed, packing)
+}
+
+/// max_damping: one free decay per packing and mode ([`DecayPlan`] × [`DEM_DECAY_MARGIN`]),
+/// ζ(X) per cycle, averaged over the amplitude grid; fills `result`'s values and modes.
+fn damping_decays(
+    space: &Space,
+    d: &Design,
+    level1: &crate::fidelity::Evaluation,
+    out: &Path,
+    result: &mut DemVerification,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(), DesignError> {
+    let st = space.study;
+    let v = &st.file.verification;
+    let rank = result.rank;
+    let rel = PathBuf::from(&result.dir);
+    let ObjectiveSpec::MaxDamping {
+        modes,
+        amplitude_min_m,
+        amplitude_max_m,
+        amplitudes,
+    } = &st.file.objective
+    else {
+        return Err(DesignError::Solver(
+            "damping decays: a max_damping objective".into(),
+        ));
+    };
+    result.objective = "mean_damping_ratio";
+    result.time_simulation = -level1.cost;
+    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let structure = space.structure(d.choice);
+    let plans = modes
+        .iter()
+        .map(|&m| {
+            crate::fidelity::damping_decay_plan(
+                st,
+                structure,
+                &dampers,
+                m - 1,
+                *amplitude_min_m,
+                *amplitude_max_m,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let simulated: f64 = plans
+        .iter()
+        .map(|p| DEM_DECAY_MARGIN * p.spec.duration_s)
+        .sum();
+    result.estimated_particle_steps = announce(
+        progress,
+        result,
+        v.packings * plans.len(),
+        v.packings as f64 * simulated,
+    );
+    let grid = crate::fidelity::amplitude_grid(*amplitude_min_m, *amplitude_max_m, *amplitudes);
+    let mut per_mode: Vec<Vec<Vec<(f64, f64)>>> = vec![Vec::new(); plans.len()];
+    for p in 0..v.packings {
+        for (i, (plan, &m)) in plans.iter().zip(modes).enumerate() {
+            progress(&format!(
+                "design {rank}, packing {}/{}, mode {m}: coupled DEM decay",
+                p + 1,
+                v.packings
+            ));
+            let dir = out
+                .join(&rel)
+                .join(format!("packing_{}", p + 1))
+                .join(format!("mode_{m}"));
+            let duration = DEM_DECAY_MARGIN * plan.spec.duration_s;
+            let couple = decay_scenario(space, d, plan, duration)?;
+            let (hist, closure) = run_one(space, d, &dir, seed(space, p), &couple)?;
+            result.runs += 1;
+            result.energy_closure = result.energy_closure.max(closure);
+            per_mode[i].push(crate::fidelity::damping_curve_of(&hist, plan.period_s)?);
+        }
+    }
+    let mean_of = |curve: &[(f64, f64)]| {
+        grid.iter()
+            .map(|&x| crate::fidelity::curve_at(curve, x))
+            .sum::<f64>()
+            / grid.len() as f64
+    };
+    for (i, &m) in modes.iter().enumerate() {
+        let curves = &per_mode[i];
+        let zeta: Vec<f64> = curves.iter().map(|c| mean_of(c)).collect();
+        let covered = curves
+            .iter()
+            .flatten()
+            .fold((f64::INFINITY, 0.0_f64), |a, c| {
+                (a.0.min(c.0), a.1.max(c.0))
+            });
+        let curve = grid
+            .iter()
+            .map(|&x| {
+                let z: Vec<f64> = curves
+                    .iter()
+                    .map(|c| crate::fidelity::curve_at(c, x))
+                    .collect();
+                (x, EnsembleStat::of(&z))
+            })
+            .collect();
+        result.modes.push(DemModeDamping {
+            mode: m,
+            stat: EnsembleStat::of(&zeta),
+            damping_ratio: zeta,
+            time_simulation: level1
+                .damping_ratio_per_mode
+                .get(i)
+                .copied()
+                .unwrap_or(f64::NAN),
+            curve,
+            covered_amplitude_m: covered,
+        });
+    }
+    result.values = (0..v.packings)
+        .map(|p| {
+            result.modes.iter().map(|m| m.damping_ratio[p]).sum::<f64>() / result.modes.len() as f64
+        })
+        .collect();
+    Ok(())
 }
 
 /// Reads `decay.csv` (time_s, displacement_m, …) of a coupled run.

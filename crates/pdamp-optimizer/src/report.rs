@@ -275,71 +275,7 @@ pub fn write_outputs(
         detune.push(json!({"case": case, "frequency_scale": s, "objective": shown(space, e.cost)}));
     }
     write(out, "robustness.csv", &rob)?;
-    let (curve_modes, lo, hi) = match &f.objective {
-        ObjectiveSpec::MinStroke { .. } => {
-            let out_phi = st
-                .structure
-                .point(&st.free.output_point)
-                .map_err(DesignError::Solver)?;
-            let init_phi = st
-                .structure
-                .point(&st.free.initial_point)
-                .map_err(DesignError::Solver)?;
-            let k = st.free.mode;
-            let x0 = (st.free.initial_displacement_m * out_phi[k] / init_phi[k]).abs();
-            let x1 = best
-                .time
-                .as_ref()
-                .and_then(|t| t.stroke_m)
-                .unwrap_or(x0 / 10.0);
-            (vec![k + 1], (0.5 * x1).max(x0 * 1e-3), x0)
-        }
-        ObjectiveSpec::MaxDamping {
-            modes,
-            amplitude_min_m,
-            amplitude_max_m,
-            ..
-        } => (modes.clone(), *amplitude_min_m, *amplitude_max_m),
-        ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
-            (Vec::new(), 0.0, 0.0)
-        }
-    };
-    let mut curve_csv =
-        String::from("mode,amplitude_m,damping_ratio_time_simulation,damping_ratio_bare\n");
-    let mut plot = LinePlot::new(
-        Axis::log("amplitude at the output point X (m)"),
-        Axis::linear("damping ratio ζ (-)"),
-    );
-    for &m in &curve_modes {
-        let grid = amplitude_grid(lo, hi, 16);
-        for (label, c) in verified.iter().take(3).enumerate() {
-            let dm = space
-                .coupled_dampers(&c.design)
-                .map_err(DesignError::Solver)?;
-            let curve =
-                simulated_damping_curve(st, space.structure(c.design.choice), &dm, m - 1, lo, hi)?;
-            let ys: Vec<f64> = grid.iter().map(|&x| curve_at(&curve, x)).collect();
-            if label == 0 {
-                let zb = st.structure.modes[m - 1].damping_ratio;
-                for (x, y) in grid.iter().zip(&ys) {
-                    let _ = writeln!(curve_csv, "{m},{x:e},{y:e},{zb:e}");
-                }
-            }
-            plot.series.push(Series::new(
-                format!("mode {m}, design {}", label + 1),
-                grid.clone(),
-                ys,
-            ));
-        }
-    }
-    let mut plots = Vec::new();
-    if !curve_modes.is_empty() {
-        write(out, "damping_curve.csv", &curve_csv)?;
-        match line_plot(out.join("damping"), &plot) {
-            Ok(_) => plots.push("damping.png"),
-            Err(e) => eprintln!("note: no damping.png: {e}"),
-        }
-    }
+    let (mut plot, mut plots) = level1_damping_curves(space, &verified, out)?;
     if let Some(bh) = &bare_hist {
         let mut p = LinePlot::new(
             Axis::linear("time t (s)"),
@@ -369,57 +305,7 @@ pub fn write_outputs(
         }
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
-    let mut dem = Vec::new();
-    let mut dem_skipped = Vec::new();
-    for (i, c) in top.iter().take(f.verification.dem_designs).enumerate() {
-        if space.location(c.design.choice).points.len() > 1 {
-            // `pdamp couple` couples one DEM bed per run
-            dem_skipped.push(i + 1);
-            continue;
-        }
-        let level1 = c.time.as_ref().expect("verified");
-        dem.push(crate::dem::verify_design(
-            space,
-            &c.design,
-            i + 1,
-            level1,
-            out,
-            progress,
-        )?);
-    }
-    if !dem.is_empty() {
-        write(out, "dem.csv", &dem_csv(&dem))?;
-    }
-    if dem.iter().any(|d| !d.modes.is_empty()) {
-        let mut csv = String::from(
-            "rank,mode,amplitude_m,damping_ratio_coupled_dem_mean,damping_ratio_coupled_dem_ci95_half_width,packings\n",
-        );
-        for d in &dem {
-            for m in &d.modes {
-                for (x, z) in &m.curve {
-                    let _ = writeln!(
-                        csv,
-                        "{},{},{x:e},{:e},{:e},{}",
-                        d.rank, m.mode, z.mean, z.ci95_half_width, z.count
-                    );
-                }
-                plot.series.push(Series::new(
-                    format!("mode {}, design {}, coupled DEM", m.mode, d.rank),
-                    m.curve.iter().map(|c| c.0).collect(),
-                    m.curve.iter().map(|c| c.1.mean).collect(),
-                ));
-            }
-        }
-        write(out, "dem_damping_curve.csv", &csv)?;
-        match line_plot(out.join("damping"), &plot) {
-            Ok(_) => {
-                if !plots.contains(&"damping.png") {
-                    plots.push("damping.png");
-                }
-            }
-            Err(e) => eprintln!("note: no damping.png: {e}"),
-        }
-    }
+    let (dem, dem_skipped) = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
     let (_, obj) = objective_names(space);
     let list: Vec<Value> = top
         .iter()
@@ -487,6 +373,152 @@ pub fn write_outputs(
     Ok(summary)
 }
 
+/// ζ(X) of the three best verified designs from level 1 (`damping_curve.csv` for the best,
+/// `damping.png` for all three): over the objective's amplitude range (max_damping) or from
+/// the release amplitude down to half the best stroke (min_stroke). Returns the plot (level 3
+/// adds its curves) and the plots written.
+fn level1_damping_curves(
+    space: &Space,
+    verified: &[&Candidate],
+    out: &Path,
+) -> Result<(LinePlot, Vec<&'static str>), DesignError> {
+    let st = space.study;
+    let f = &st.file;
+    let best = verified[0];
+    let (curve_modes, lo, hi) = match &f.objective {
+        ObjectiveSpec::MinStroke { .. } => {
+            let out_phi = st
+                .structure
+                .point(&st.free.output_point)
+                .map_err(DesignError::Solver)?;
+            let init_phi = st
+                .structure
+                .point(&st.free.initial_point)
+                .map_err(DesignError::Solver)?;
+            let k = st.free.mode;
+            let x0 = (st.free.initial_displacement_m * out_phi[k] / init_phi[k]).abs();
+            let x1 = best
+                .time
+                .as_ref()
+                .and_then(|t| t.stroke_m)
+                .unwrap_or(x0 / 10.0);
+            (vec![k + 1], (0.5 * x1).max(x0 * 1e-3), x0)
+        }
+        ObjectiveSpec::MaxDamping {
+            modes,
+            amplitude_min_m,
+            amplitude_max_m,
+            ..
+        } => (modes.clone(), *amplitude_min_m, *amplitude_max_m),
+        ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
+            (Vec::new(), 0.0, 0.0)
+        }
+    };
+    let mut curve_csv =
+        String::from("mode,amplitude_m,damping_ratio_time_simulation,damping_ratio_bare\n");
+    let mut plot = LinePlot::new(
+        Axis::log("amplitude at the output point X (m)"),
+        Axis::linear("damping ratio ζ (-)"),
+    );
+    for &m in &curve_modes {
+        let grid = amplitude_grid(lo, hi, 16);
+        for (label, c) in verified.iter().take(3).enumerate() {
+            let dm = space
+                .coupled_dampers(&c.design)
+                .map_err(DesignError::Solver)?;
+            let curve =
+                simulated_damping_curve(st, space.structure(c.design.choice), &dm, m - 1, lo, hi)?;
+            let ys: Vec<f64> = grid.iter().map(|&x| curve_at(&curve, x)).collect();
+            if label == 0 {
+                let zb = st.structure.modes[m - 1].damping_ratio;
+                for (x, y) in grid.iter().zip(&ys) {
+                    let _ = writeln!(curve_csv, "{m},{x:e},{y:e},{zb:e}");
+                }
+            }
+            plot.series.push(Series::new(
+                format!("mode {m}, design {}", label + 1),
+                grid.clone(),
+                ys,
+            ));
+        }
+    }
+    let mut plots = Vec::new();
+    if !curve_modes.is_empty() {
+        write(out, "damping_curve.csv", &curve_csv)?;
+        match line_plot(out.join("damping"), &plot) {
+            Ok(_) => plots.push("damping.png"),
+            Err(e) => eprintln!("note: no damping.png: {e}"),
+        }
+    }
+    Ok((plot, plots))
+}
+
+/// Level 3 of [`write_outputs`]: coupled DEM of the best single-container designs,
+/// `dem.csv`, and for max_damping `dem_damping_curve.csv` and the DEM curves in `damping.png`.
+/// Returns the verifications and the ranks skipped for having several containers.
+fn dem_level(
+    space: &Space,
+    top: &[&Candidate],
+    out: &Path,
+    plot: &mut LinePlot,
+    plots: &mut Vec<&'static str>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<crate::dem::DemVerification>, Vec<usize>), DesignError> {
+    let f = &space.study.file;
+    let mut dem = Vec::new();
+    let mut dem_skipped = Vec::new();
+    for (i, c) in top.iter().take(f.verification.dem_designs).enumerate() {
+        if space.location(c.design.choice).points.len() > 1 {
+            // `pdamp couple` couples one DEM bed per run
+            dem_skipped.push(i + 1);
+            continue;
+        }
+        let level1 = c.time.as_ref().expect("verified");
+        dem.push(crate::dem::verify_design(
+            space,
+            &c.design,
+            i + 1,
+            level1,
+            out,
+            progress,
+        )?);
+    }
+    if !dem.is_empty() {
+        write(out, "dem.csv", &dem_csv(&dem))?;
+    }
+    if dem.iter().any(|d| !d.modes.is_empty()) {
+        let mut csv = String::from(
+            "rank,mode,amplitude_m,damping_ratio_coupled_dem_mean,damping_ratio_coupled_dem_ci95_half_width,packings\n",
+        );
+        for d in &dem {
+            for m in &d.modes {
+                for (x, z) in &m.curve {
+                    let _ = writeln!(
+                        csv,
+                        "{},{},{x:e},{:e},{:e},{}",
+                        d.rank, m.mode, z.mean, z.ci95_half_width, z.count
+                    );
+                }
+                plot.series.push(Series::new(
+                    format!("mode {}, design {}, coupled DEM", m.mode, d.rank),
+                    m.curve.iter().map(|c| c.0).collect(),
+                    m.curve.iter().map(|c| c.1.mean).collect(),
+                ));
+            }
+        }
+        write(out, "dem_damping_curve.csv", &csv)?;
+        match line_plot(out.join("damping"), plot) {
+            Ok(_) => {
+                if !plots.contains(&"damping.png") {
+                    plots.push("damping.png");
+                }
+            }
+            Err(e) => eprintln!("note: no damping.png: {e}"),
+        }
+    }
+    Ok((dem, dem_skipped))
+}
+
 /// `dem.csv`: one row per design and packing.
 fn dem_csv(dem: &[crate::dem::DemVerification]) -> String {
     let obj = dem[0].objective;
@@ -522,6 +554,154 @@ fn best_by_dem(dem: &[crate::dem::DemVerification]) -> Option<&crate::dem::DemVe
     dem.iter()
         .filter(|d| d.stat.mean.is_finite())
         .min_by(|a, b| sign(a).total_cmp(&sign(b)))
+}
+
+/// The coupled-DEM section of `report.md`: the ensembles against the formulas, the energy
+/// closure, ζ per mode (max_damping) and the DEM best.
+fn dem_section(f: &crate::study::DesignStudyFile, dem: &[crate::dem::DemVerification]) -> String {
+    let mut r = String::new();
+    let _ = writeln!(r, "## Coupled DEM (approach 1)\n");
+    let _ = writeln!(
+        r,
+        "Each design's damper as a DEM bed in its container, dropped {} times with \
+         independent seeds, coupled to the structure (`pdamp couple`, runs in `dem/`).{}\n",
+        f.verification.packings,
+        if f.verification.youngs_modulus_scale < 1.0 {
+            format!(
+                " **Softened**: particle Young's modulus × {} (shorter runs; not the \
+                 reference fidelity).",
+                f.verification.youngs_modulus_scale
+            )
+        } else {
+            String::new()
+        }
+    );
+    let (unit, scale, name) = if dem[0].larger_is_better() {
+        ("", 1.0, "mean ζ")
+    } else {
+        (" mm", 1e3, "stroke")
+    };
+    let _ = writeln!(
+        r,
+        "| rank | {name} (formulas, time simulation) | {name} (coupled DEM, mean ± 95 % CI) \
+         | packings | DEM − formulas | particles | time step | particle-steps (estimated) \
+         | energy closure | wall time |\n|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for d in dem {
+        let _ = writeln!(
+            r,
+            "| {} | {:.4}{unit} | {:.4} ± {:.4}{unit} | {} | {:+.1} % | {} | {:.2e} s | \
+             {:.2e} | {:.1e} | {:.0} s |",
+            d.rank,
+            d.time_simulation * scale,
+            d.stat.mean * scale,
+            d.stat.ci95_half_width * scale,
+            d.stat.count,
+            100.0 * (d.stat.mean / d.time_simulation - 1.0),
+            d.particles,
+            d.time_step_s,
+            d.estimated_particle_steps,
+            d.energy_closure,
+            d.wall_s
+        );
+    }
+    let open: Vec<String> = dem
+        .iter()
+        .filter(|d| d.energy_closure.is_nan() || d.energy_closure > 1e-3)
+        .map(|d| d.rank.to_string())
+        .collect();
+    let _ = writeln!(
+        r,
+        "\nEnergy closure: the bed's ledger (wall work = bed energy change + dissipation) \
+         and the coupling (structure's work on the bed = walls' work), relative to the \
+         energy dissipated, largest over each design's runs (`energy_exchange` in each \
+         run's `summary.json`). {}",
+        if open.is_empty() {
+            "All ≤ 1e-3.".to_string()
+        } else {
+            format!(
+                "**Above 1e-3 for design(s) {}**: refine `[verification] time_step_s`.",
+                open.join(", ")
+            )
+        }
+    );
+    if dem.iter().any(|d| !d.modes.is_empty()) {
+        let _ = writeln!(
+            r,
+            "\nPer mode: ζ̄ over the amplitude grid from free decays of the structure \
+             reduced to that mode, released 10 % above the range (D Eq. 3.40/3.41 per \
+             cycle, the same procedure as the time simulation).\n\n| rank | mode | ζ̄ \
+             (formulas) | ζ̄ (coupled DEM, mean ± 95 % CI) | DEM − formulas | amplitudes \
+             the decays covered |\n|---|---|---|---|---|---|"
+        );
+        for d in dem {
+            for m in &d.modes {
+                let _ = writeln!(
+                    r,
+                    "| {} | {} | {:.4} | {:.4} ± {:.4} | {:+.1} % | {:.3}–{:.3} mm |",
+                    d.rank,
+                    m.mode,
+                    m.time_simulation,
+                    m.stat.mean,
+                    m.stat.ci95_half_width,
+                    100.0 * (m.stat.mean / m.time_simulation - 1.0),
+                    m.covered_amplitude_m.0 * 1e3,
+                    m.covered_amplitude_m.1 * 1e3
+                );
+            }
+        }
+        let short: Vec<String> = dem
+            .iter()
+            .flat_map(|d| d.modes.iter().map(move |m| (d.rank, m)))
+            .filter(|(_, m)| {
+                let (lo, hi) = (m.curve[0].0, m.curve[m.curve.len() - 1].0);
+                m.covered_amplitude_m.0 > 1.1 * lo || m.covered_amplitude_m.1 < hi / 1.1
+            })
+            .map(|(rank, m)| format!("design {rank} mode {}", m.mode))
+            .collect();
+        let _ = writeln!(
+            r,
+            "\nζ(X) of the DEM ensembles: `dem_damping_curve.csv` and the `coupled DEM` \
+             curves of `damping.png`.{}",
+            if short.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " The decays of {} did not cover the whole amplitude range (first cycle \
+                     below the top: the bed's first impacts; last cycle above the bottom: \
+                     the bed damps less than the formulas predicted): outside the covered \
+                     amplitudes the grid takes the nearest cycle's ζ.",
+                    short.join(", ")
+                )
+            }
+        );
+    }
+    if let Some(b) = best_by_dem(dem) {
+        let overlapping: Vec<String> = dem
+            .iter()
+            .filter(|d| {
+                d.rank != b.rank
+                    && d.stat.ci95_low <= b.stat.ci95_high
+                    && d.stat.ci95_high >= b.stat.ci95_low
+            })
+            .map(|d| d.rank.to_string())
+            .collect();
+        let _ = writeln!(
+            r,
+            "\nUnder coupled DEM the best of these is design {} ({name} {:.4}{unit}){}.",
+            b.rank,
+            b.stat.mean * scale,
+            if overlapping.is_empty() {
+                ", its 95 % interval clear of the others'".to_string()
+            } else {
+                format!(
+                    "; the intervals of design(s) {} overlap it: more packings decide",
+                    overlapping.join(", ")
+                )
+            }
+        );
+    }
+    r
 }
 
 fn report_md(
@@ -648,147 +828,7 @@ fn report_md(
         );
     }
     if !dem.is_empty() {
-        let _ = writeln!(r, "## Coupled DEM (approach 1)\n");
-        let _ = writeln!(
-            r,
-            "Each design's damper as a DEM bed in its container, dropped {} times with \
-             independent seeds, coupled to the structure (`pdamp couple`, runs in `dem/`).{}\n",
-            f.verification.packings,
-            if f.verification.youngs_modulus_scale < 1.0 {
-                format!(
-                    " **Softened**: particle Young's modulus × {} (shorter runs; not the \
-                     reference fidelity).",
-                    f.verification.youngs_modulus_scale
-                )
-            } else {
-                String::new()
-            }
-        );
-        let (unit, scale, name) = if dem[0].larger_is_better() {
-            ("", 1.0, "mean ζ")
-        } else {
-            (" mm", 1e3, "stroke")
-        };
-        let _ = writeln!(
-            r,
-            "| rank | {name} (formulas, time simulation) | {name} (coupled DEM, mean ± 95 % CI) \
-             | packings | DEM − formulas | particles | time step | particle-steps (estimated) \
-             | energy closure | wall time |\n|---|---|---|---|---|---|---|---|---|---|"
-        );
-        for d in dem {
-            let _ = writeln!(
-                r,
-                "| {} | {:.4}{unit} | {:.4} ± {:.4}{unit} | {} | {:+.1} % | {} | {:.2e} s | \
-                 {:.2e} | {:.1e} | {:.0} s |",
-                d.rank,
-                d.time_simulation * scale,
-                d.stat.mean * scale,
-                d.stat.ci95_half_width * scale,
-                d.stat.count,
-                100.0 * (d.stat.mean / d.time_simulation - 1.0),
-                d.particles,
-                d.time_step_s,
-                d.estimated_particle_steps,
-                d.energy_closure,
-                d.wall_s
-            );
-        }
-        let open: Vec<String> = dem
-            .iter()
-            .filter(|d| d.energy_closure.is_nan() || d.energy_closure > 1e-3)
-            .map(|d| d.rank.to_string())
-            .collect();
-        let _ = writeln!(
-            r,
-            "\nEnergy closure: the bed's ledger (wall work = bed energy change + dissipation) \
-             and the coupling (structure's work on the bed = walls' work), relative to the \
-             energy dissipated, largest over each design's runs (`energy_exchange` in each \
-             run's `summary.json`). {}",
-            if open.is_empty() {
-                "All ≤ 1e-3.".to_string()
-            } else {
-                format!(
-                    "**Above 1e-3 for design(s) {}**: refine `[verification] time_step_s`.",
-                    open.join(", ")
-                )
-            }
-        );
-        if dem.iter().any(|d| !d.modes.is_empty()) {
-            let _ = writeln!(
-                r,
-                "\nPer mode: ζ̄ over the amplitude grid from free decays of the structure \
-                 reduced to that mode, released 10 % above the range (D Eq. 3.40/3.41 per \
-                 cycle, the same procedure as the time simulation).\n\n| rank | mode | ζ̄ \
-                 (formulas) | ζ̄ (coupled DEM, mean ± 95 % CI) | DEM − formulas | amplitudes \
-                 the decays covered |\n|---|---|---|---|---|---|"
-            );
-            for d in dem {
-                for m in &d.modes {
-                    let _ = writeln!(
-                        r,
-                        "| {} | {} | {:.4} | {:.4} ± {:.4} | {:+.1} % | {:.3}–{:.3} mm |",
-                        d.rank,
-                        m.mode,
-                        m.time_simulation,
-                        m.stat.mean,
-                        m.stat.ci95_half_width,
-                        100.0 * (m.stat.mean / m.time_simulation - 1.0),
-                        m.covered_amplitude_m.0 * 1e3,
-                        m.covered_amplitude_m.1 * 1e3
-                    );
-                }
-            }
-            let short: Vec<String> = dem
-                .iter()
-                .flat_map(|d| d.modes.iter().map(move |m| (d.rank, m)))
-                .filter(|(_, m)| {
-                    let (lo, hi) = (m.curve[0].0, m.curve[m.curve.len() - 1].0);
-                    m.covered_amplitude_m.0 > 1.1 * lo || m.covered_amplitude_m.1 < hi / 1.1
-                })
-                .map(|(rank, m)| format!("design {rank} mode {}", m.mode))
-                .collect();
-            let _ = writeln!(
-                r,
-                "\nζ(X) of the DEM ensembles: `dem_damping_curve.csv` and the `coupled DEM` \
-                 curves of `damping.png`.{}",
-                if short.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        " The decays of {} did not cover the whole amplitude range (first cycle \
-                         below the top: the bed's first impacts; last cycle above the bottom: \
-                         the bed damps less than the formulas predicted): outside the covered \
-                         amplitudes the grid takes the nearest cycle's ζ.",
-                        short.join(", ")
-                    )
-                }
-            );
-        }
-        if let Some(b) = best_by_dem(dem) {
-            let overlapping: Vec<String> = dem
-                .iter()
-                .filter(|d| {
-                    d.rank != b.rank
-                        && d.stat.ci95_low <= b.stat.ci95_high
-                        && d.stat.ci95_high >= b.stat.ci95_low
-                })
-                .map(|d| d.rank.to_string())
-                .collect();
-            let _ = writeln!(
-                r,
-                "\nUnder coupled DEM the best of these is design {} ({name} {:.4}{unit}){}.",
-                b.rank,
-                b.stat.mean * scale,
-                if overlapping.is_empty() {
-                    ", its 95 % interval clear of the others'".to_string()
-                } else {
-                    format!(
-                        "; the intervals of design(s) {} overlap it: more packings decide",
-                        overlapping.join(", ")
-                    )
-                }
-            );
-        }
+        r.push_str(&dem_section(f, dem));
         let _ = writeln!(r);
     }
     let _ = writeln!(r, "## Robustness of the best design\n");
