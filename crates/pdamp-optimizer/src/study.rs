@@ -302,8 +302,14 @@ impl DesignStudy {
     /// # Errors
     /// [`DesignError::Input`] naming the first bad key.
     pub fn validate(&self) -> Result<(), DesignError> {
+        self.validate_objective()?;
+        self.validate_damper()?;
+        self.validate_settings()
+    }
+
+    /// The objective against the scenario (free or steady state) and the structure's modes.
+    fn validate_objective(&self) -> Result<(), DesignError> {
         let f = &self.file;
-        let d = &f.damper;
         let forced = f.objective.is_forced();
         if forced != self.load.is_some() {
             return Err(self.input(
@@ -384,6 +390,13 @@ impl DesignStudy {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The damper space: locations, containers, dimensions, radii.
+    fn validate_damper(&self) -> Result<(), DesignError> {
+        let f = &self.file;
+        let d = &f.damper;
         if d.points.is_empty() && d.positions_m.is_empty() {
             return Err(self.input(
                 "damper.points",
@@ -483,6 +496,13 @@ impl DesignStudy {
         if d.particle_count_step == Some(0) {
             return Err(self.input("damper.particle_count_step", "must be ≥ 1"));
         }
+        Ok(())
+    }
+
+    /// Materials, constraints, verification and search settings.
+    fn validate_settings(&self) -> Result<(), DesignError> {
+        let f = &self.file;
+        let d = &f.damper;
         if f.materials.is_empty() {
             return Err(self.input("materials", "give at least one [[materials]] entry"));
         }
