@@ -249,6 +249,29 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
     s
 }
 
+/// Replaces a coupling scenario's dampers by the design's DEM bed (`damper.toml` beside it)
+/// at the design's point.
+fn set_dem_damper(space: &Space, d: &Design, table: &mut toml::Table) {
+    let mut damper = toml::Table::new();
+    damper.insert("model".into(), toml::Value::String("dem".into()));
+    damper.insert(
+        "point".into(),
+        toml::Value::String(space.location(d.choice).point.clone()),
+    );
+    damper.insert("scenario".into(), toml::Value::String("damper.toml".into()));
+    table.insert(
+        "dampers".into(),
+        toml::Value::Array(vec![toml::Value::Table(damper)]),
+    );
+}
+
+/// Sampling interval (DEM steps) for about 4000 samples of a decay of `duration_s`.
+fn sample_every(space: &Space, d: &Design, duration_s: f64) -> i64 {
+    ((duration_s / time_step_s(space, d)) / 4000.0)
+        .floor()
+        .max(1.0) as i64
+}
+
 /// The coupling scenario of a design's DEM run (TOML): the study's structure and free analysis
 /// (duration = the evaluation time) with the DEM damper at the design's point.
 pub fn couple_scenario(
@@ -257,21 +280,13 @@ pub fn couple_scenario(
     evaluate_at_s: f64,
 ) -> Result<String, DesignError> {
     let mut table = crate::report::scenario_table(space, d)?;
-    let point = &space.location(d.choice).point;
-    let damper: toml::Table = toml::from_str(&format!(
-        "model = \"dem\"\npoint = \"{point}\"\nscenario = \"damper.toml\"\n"
-    ))
-    .map_err(|e| DesignError::Solver(e.to_string()))?;
-    table.insert(
-        "dampers".into(),
-        toml::Value::Array(vec![toml::Value::Table(damper)]),
-    );
+    set_dem_damper(space, d, &mut table);
     if let Some(toml::Value::Table(a)) = table.get_mut("analysis") {
         a.insert("duration_s".into(), toml::Value::Float(evaluate_at_s));
-        let dt = time_step_s(space, d);
-        // about 4000 samples of the decay
-        let every = ((evaluate_at_s / dt) / 4000.0).floor().max(1.0) as i64;
-        a.insert("sample_every".into(), toml::Value::Integer(every));
+        a.insert(
+            "sample_every".into(),
+            toml::Value::Integer(sample_every(space, d, evaluate_at_s)),
+        );
     }
     toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
 }
@@ -316,18 +331,9 @@ pub fn decay_scenario(
     structure.insert("n_modes".into(), toml::Value::Integer(1));
     structure.insert("modal".into(), toml::Value::Table(modal));
     table.insert("structure".into(), toml::Value::Table(structure));
-    let point = &space.location(d.choice).point;
-    let damper: toml::Table = toml::from_str(&format!(
-        "model = \"dem\"\npoint = \"{point}\"\nscenario = \"damper.toml\"\n"
-    ))
-    .map_err(|e| DesignError::Solver(e.to_string()))?;
-    table.insert(
-        "dampers".into(),
-        toml::Value::Array(vec![toml::Value::Table(damper)]),
-    );
+    set_dem_damper(space, d, &mut table);
     let f = &plan.spec;
-    let dt = time_step_s(space, d);
-    let every = ((duration_s / dt) / 4000.0).floor().max(1.0) as i64;
+    let every = sample_every(space, d, duration_s);
     let analysis: toml::Table = toml::from_str(&format!(
         "kind = \"free\"\nduration_s = {duration_s:e}\ntime_step_s = {:e}\nmode = 1\n\
          initial_point = \"{}\"\ninitial_displacement_m = {:e}\noutput_point = \"{}\"\n\

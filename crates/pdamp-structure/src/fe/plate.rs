@@ -246,17 +246,13 @@ impl Plate {
 mod tests {
     use super::*;
 
+    /// The example plate on an n × n mesh, clamped or free.
     fn plate(n: usize, clamped: bool) -> Plate {
         Plate {
-            length_m: 0.25,
-            width_m: 0.25,
-            thickness_m: 0.003,
-            youngs_modulus_pa: 210e9,
-            poisson_ratio: 0.3,
-            density_kg_m3: 7850.0,
             elements_x: n,
             elements_y: n,
             clamped_at_x0: clamped,
+            ..Plate::EXAMPLE
         }
     }
 
