@@ -15,13 +15,20 @@ pub struct DesignArgs {
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
-    /// Replace the results of an earlier run in DIR (exactly the files it wrote).
+    /// Replace the results of an earlier run in DIR (exactly the files it wrote, the stored
+    /// effective fields in DIR/fields included).
     #[arg(long)]
     overwrite: bool,
+    /// Continue an earlier run in DIR: the search runs again (seconds) and every effective-field
+    /// point stored in DIR/fields is reused; the coupled-DEM runs are made again.
+    #[arg(long)]
+    resume: bool,
 }
 
 /// What `pdamp design` writes.
-const OUTPUTS: [&str; 15] = [
+const OUTPUTS: [&str; 17] = [
+    "fields",
+    "fields.csv",
     "dem",
     "dem.csv",
     "designs.csv",
@@ -45,16 +52,28 @@ pub fn run(args: DesignArgs) -> Result<()> {
         study,
         out,
         overwrite,
+        resume,
     } = args;
+    use pdamp_io::output_dir::{OutputDir, OutputMode};
+    let mode = match (resume, overwrite) {
+        (true, true) => anyhow::bail!("--resume and --overwrite exclude each other"),
+        (true, false) => OutputMode::Continue,
+        (false, true) => OutputMode::Overwrite,
+        (false, false) => OutputMode::Fresh,
+    };
     let traced = crate::Traced::start(Some(&study), 0);
-    let s = crate::structure::in_out_dir(&out, false, overwrite, &OUTPUTS, &study, || {
+    let mut dir = OutputDir::open(&out, mode, &OUTPUTS, &[study.as_path()])?;
+    let s: Result<serde_json::Value> = (|| {
         let s = pdamp_optimizer::run_design_study_file_with(&study, &out, &mut |m| {
             eprintln!("pdamp design: {m}")
         })
         .map_err(|e| anyhow!(e))?;
         traced.write(&out)?;
         Ok(s)
-    })?;
+    })();
+    dir.set_outcome(&s);
+    dir.close()?;
+    let s = s?;
     println!("{}", serde_json::to_string_pretty(&s["best"])?);
     eprintln!("wrote {}", out.join("report.md").display());
     Ok(())

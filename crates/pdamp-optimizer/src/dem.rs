@@ -86,7 +86,7 @@ pub struct DemModeDamping {
 
 /// Largest relative particle velocity expected in the study: twice the damper point's
 /// initial velocity amplitude X₀ω, plus a margin, m/s.
-fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
+pub fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
     let a = space.peak_acceleration_m_s2(d);
     let k = space.study.free.mode;
     let w = space.structure(d.choice).modes[k].omega_rad_s();
@@ -96,6 +96,11 @@ fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
 /// The DEM time step: `[verification] time_step_s` or 0.08 of the particle–particle Hertz
 /// contact time at the check velocity (D Eq. 4.8; pdamp refuses steps above 0.1).
 pub fn time_step_s(space: &Space, d: &Design) -> f64 {
+    time_step_at_s(space, d, check_velocity_m_s(space, d))
+}
+
+/// [`time_step_s`] for a largest relative impact velocity `velocity_m_s`.
+pub fn time_step_at_s(space: &Space, d: &Design, velocity_m_s: f64) -> f64 {
     let v = &space.study.file.verification;
     if let Some(dt) = v.time_step_s {
         return dt;
@@ -108,15 +113,22 @@ pub fn time_step_s(space: &Space, d: &Design) -> f64 {
         e_eff,
         0.5 * g.radius_m,
         0.5 * g.particle_mass_kg,
-        check_velocity_m_s(space, d),
+        velocity_m_s,
     );
     0.08 * tc
 }
 
-fn plane(s: &mut String, name: &str, point: [f64; 3], normal: [f64; 3], two_sided: bool) {
+fn plane(
+    s: &mut String,
+    name: &str,
+    material: &str,
+    point: [f64; 3],
+    normal: [f64; 3],
+    two_sided: bool,
+) {
     let _ = writeln!(
         s,
-        "[[bodies.walls]]\nname = \"{name}\"\nmaterial = \"container\"\ngeometry = {{ type = \
+        "[[bodies.walls]]\nname = \"{name}\"\nmaterial = \"{material}\"\ngeometry = {{ type = \
          \"plane\", point_m = [{:e}, {:e}, {:e}], normal = [{}, {}, {}], two_sided = {two_sided} \
          }}\n",
         point[0], point[1], point[2], normal[0], normal[1], normal[2]
@@ -124,14 +136,48 @@ fn plane(s: &mut String, name: &str, point: [f64; 3], normal: [f64; 3], two_side
 }
 
 /// The six walls of a box container, x ∈ [−a/2, a/2], y ∈ [−b/2, b/2], z ∈ [0, c], as one-sided
-/// planes facing inwards.
-fn box_walls(s: &mut String, a: f64, b: f64, c: f64) {
-    plane(s, "wall_x-", [-a / 2.0, 0.0, 0.0], [1.0, 0.0, 0.0], false);
-    plane(s, "wall_x+", [a / 2.0, 0.0, 0.0], [-1.0, 0.0, 0.0], false);
-    plane(s, "wall_y-", [0.0, -b / 2.0, 0.0], [0.0, 1.0, 0.0], false);
-    plane(s, "wall_y+", [0.0, b / 2.0, 0.0], [0.0, -1.0, 0.0], false);
-    plane(s, "floor", [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
-    plane(s, "lid", [0.0, 0.0, c], [0.0, 0.0, -1.0], false);
+/// planes facing inwards; the two walls normal to the excitation (x for a horizontal
+/// container, z for a vertical one) of material `impacted`, the others of the container's.
+fn box_walls(s: &mut String, a: f64, b: f64, c: f64, vertical: bool, impacted: &str) {
+    let (xm, zm) = if vertical {
+        ("container", impacted)
+    } else {
+        (impacted, "container")
+    };
+    plane(
+        s,
+        "wall_x-",
+        xm,
+        [-a / 2.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        false,
+    );
+    plane(
+        s,
+        "wall_x+",
+        xm,
+        [a / 2.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        false,
+    );
+    plane(
+        s,
+        "wall_y-",
+        "container",
+        [0.0, -b / 2.0, 0.0],
+        [0.0, 1.0, 0.0],
+        false,
+    );
+    plane(
+        s,
+        "wall_y+",
+        "container",
+        [0.0, b / 2.0, 0.0],
+        [0.0, -1.0, 0.0],
+        false,
+    );
+    plane(s, "floor", zm, [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
+    plane(s, "lid", zm, [0.0, 0.0, c], [0.0, 0.0, -1.0], false);
 }
 
 /// The damper scenario of a design (TOML), for packing seed `seed`.
@@ -176,6 +222,27 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
          friction_coefficient = {}, regularization_s_m = 1000.0 }}\n",
         m.restitution, m.friction, m.wall_restitution, m.friction
     );
+    let coating = st.coating(d.choice.coating);
+    let impacted = if let Some(c) = coating {
+        let _ = writeln!(
+            s,
+            "# end walls coated with {}: a half-space of its modulus (D Eq. 8.3–8.11)\n\
+             [[materials]]\nname = \"coating\"\ndensity_kg_m3 = {}\nyoungs_modulus_pa = {:e}\n\
+             poisson_ratio = {}\n\n[[contact.pairs]]\nmaterials = [\"particle\", \"coating\"]\n\
+             normal = {{ law = \"gonthier\", restitution = {}, min_impact_velocity_m_s = 0.05 }}\n\
+             friction = {{ law = \"regularized-sliding\", friction_coefficient = {}, \
+             regularization_s_m = 1000.0 }}\n",
+            c.name,
+            c.density_kg_m3,
+            c.youngs_modulus_pa,
+            c.poisson_ratio,
+            c.restitution,
+            m.friction
+        );
+        "coating"
+    } else {
+        "container"
+    };
     let _ = writeln!(s, "[[bodies]]\nname = \"container\"\n");
     let (l, w) = (g.length_m, f.damper.container_width_m);
     let direction;
@@ -185,11 +252,12 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
         Direction::Horizontal => {
             let h = v.layer_height_m.unwrap_or(2.2 * g.radius_m);
             let top = h * d.particles.len() as f64;
-            box_walls(&mut s, l, w, top);
+            box_walls(&mut s, l, w, top, false, impacted);
             for i in 1..d.particles.len() {
                 plane(
                     &mut s,
                     &format!("shelf_{i}"),
+                    "container",
                     [0.0, 0.0, i as f64 * h],
                     [0.0, 0.0, 1.0],
                     true,
@@ -209,7 +277,7 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
         }
         Direction::Vertical => {
             let depth = f.damper.container_depth_m.unwrap_or(w);
-            box_walls(&mut s, w, depth, l);
+            box_walls(&mut s, w, depth, l, true, impacted);
             groups.push((
                 d.particles[0],
                 [-w / 2.0, -depth / 2.0, 0.0],
@@ -493,7 +561,7 @@ fn announce(
     ps
 }
 
-fn seed(space: &Space, packing: usize) -> u64 {
+pub(crate) fn seed(space: &Space, packing: usize) -> u64 {
     pdamp_io::prepare::packing_seed(space.study.file.search.seed, packing)
 }
 

@@ -593,13 +593,27 @@ pub fn time_evaluation(
     structure: &ModalStructure,
     dampers: &[CoupledDamper],
 ) -> Result<(Evaluation, Option<TimeHistory>), DesignError> {
+    time_evaluation_by_mode(study, structure, &|_| dampers)
+}
+
+/// [`time_evaluation`] with the dampers of each mode's evaluation from `dampers_of(k)` (k the
+/// 0-based mode the decay, stroke or resonance belongs to): level 2 couples every mode to the
+/// effective field computed at that mode's frequency.
+///
+/// # Errors
+/// Solver errors.
+pub fn time_evaluation_by_mode<'a>(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers_of: &dyn Fn(usize) -> &'a [CoupledDamper],
+) -> Result<(Evaluation, Option<TimeHistory>), DesignError> {
     match &study.file.objective {
         ObjectiveSpec::MinStroke { evaluate_at_s } => {
             let mut fs = study.free.clone();
             fs.duration_s = *evaluate_at_s;
-            let hist =
-                free::run_free_vibration(structure, dampers, &fs).map_err(DesignError::Solver)?;
             let k = fs.mode;
+            let hist = free::run_free_vibration(structure, dampers_of(k), &fs)
+                .map_err(DesignError::Solver)?;
             let period = 1.0 / structure.modes[k].frequency_hz;
             // the layer study's window: one bare period + 10 % (the loaded structure is slower)
             let stroke = pdamp_structure::study::stroke_at(&hist, *evaluate_at_s, 1.1 * period);
@@ -624,7 +638,7 @@ pub fn time_evaluation(
                 let curve = simulated_damping_curve(
                     study,
                     structure,
-                    dampers,
+                    dampers_of(m - 1),
                     m - 1,
                     *amplitude_min_m,
                     *amplitude_max_m,
@@ -662,7 +676,7 @@ pub fn time_evaluation(
             let mut rel = 0.0;
             for &m in modes {
                 let k = m - 1;
-                let (p, q_max) = frf_peak(study, structure, dampers, k, *frequencies, *band)?;
+                let (p, q_max) = frf_peak(study, structure, dampers_of(k), k, *frequencies, *band)?;
                 rel += p / bare_peak_m(study, k)?;
                 peaks.push(p);
                 // D Eq. 3.47 with m = ω_k²/Ω_R² (Eq. 3.33): ζ = R/(2 Q_max ω_k²)

@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 pub mod dem;
+pub mod effective_fields;
 mod error;
 pub mod fidelity;
 pub mod report;

@@ -6,6 +6,7 @@
 //! Every file is written atomically.
 
 use crate::DesignError;
+use crate::effective_fields::FieldEvaluation;
 use crate::fidelity::{amplitude_grid, curve_at, simulated_damping_curve, time_evaluation};
 use crate::search::{Candidate, SearchOutcome, spearman};
 use crate::space::{Design, Space};
@@ -37,12 +38,18 @@ pub fn describe(space: &Space, d: &Design) -> String {
     } else {
         what
     };
+    let coating = &f.damper.coatings[d.choice.coating];
     format!(
-        "{what} × {} r = {:.3} mm (n_max = {}), L = {:.1} mm at {}",
+        "{what} × {} r = {:.3} mm (n_max = {}), L = {:.1} mm{} at {}",
         f.materials[d.choice.material].name,
         g.radius_m * 1e3,
         g.capacity,
         g.length_m * 1e3,
+        if coating == crate::spec::NO_COATING {
+            String::new()
+        } else {
+            format!(", end walls coated with {coating}")
+        },
         space.location(d.choice).label
     )
 }
@@ -97,6 +104,7 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
         "fidelity".into(),
         "point".into(),
         "material".into(),
+        "coating".into(),
         "particle_radius_m".into(),
         "container_length_m".into(),
         "particles_max_per_layer".into(),
@@ -124,6 +132,7 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
             },
             space.location(c.design.choice).label.replace(',', ";"),
             f.materials[c.design.choice.material].name.clone(),
+            f.damper.coatings[c.design.choice.coating].clone(),
             format!("{:e}", g.radius_m),
             format!("{:e}", g.length_m),
             g.capacity.to_string(),
@@ -231,13 +240,34 @@ pub fn write_outputs(
     write(out, "designs.csv", &designs_csv(space, cands))?;
     let verified: Vec<&Candidate> = cands.iter().filter(|c| c.time.is_some()).collect();
     let best = verified[0];
-    let top: Vec<&Candidate> = verified.iter().take(f.search.top).copied().collect();
+    // level 2: effective fields of the best time-simulated designs, with every coating
+    let fields_started = std::time::Instant::now();
+    let fields = if f.verification.field_designs > 0 {
+        let level1: Vec<(&Design, &crate::fidelity::Evaluation)> = verified
+            .iter()
+            .map(|c| (&c.design, c.time.as_ref().expect("verified")))
+            .collect();
+        crate::effective_fields::run_level(space, &level1, out, progress)?
+    } else {
+        Vec::new()
+    };
+    let fields_wall_s = fields_started.elapsed().as_secs_f64();
+    let listed = listed_candidates(space, &verified, &fields);
+    let top: Vec<&Candidate> = listed.iter().collect();
+    let field_of = |d: &Design| {
+        fields
+            .iter()
+            .find(|e| &e.design == d && e.failure.is_none())
+    };
     for (i, c) in top.iter().enumerate() {
-        write(
-            out,
-            &format!("scenarios/design_{}.toml", i + 1),
-            &scenario_toml(space, &c.design, i + 1)?,
-        )?;
+        let text = match field_of(&c.design) {
+            Some(e) => fields_scenario_toml(space, e, out, i + 1)?,
+            None => scenario_toml(space, &c.design, i + 1)?,
+        };
+        write(out, &format!("scenarios/design_{}.toml", i + 1), &text)?;
+    }
+    if !fields.is_empty() {
+        write(out, "fields.csv", &fields_csv(space, &fields))?;
     }
     // the bare structure on both levels
     let (bare_time, bare_hist) = time_evaluation(st, &st.structure, &[])?;
@@ -324,7 +354,15 @@ pub fn write_outputs(
                 format!("{obj}_time_simulation"): c.time.as_ref().map(|t| shown(space, t.cost)),
                 "damping_ratio_per_mode_time_simulation": c.time.as_ref().map(|t| t.damping_ratio_per_mode.clone()),
                 "peak_amplitude_per_mode_m_time_simulation": c.time.as_ref().map(|t| t.peak_amplitude_per_mode_m.clone()),
-                "confirmed_by": if dem.iter().any(|d| d.rank == i + 1) { "coupled_dem" } else { "formulas_time" },
+                "coating": f.damper.coatings[c.design.choice.coating],
+                "confirmed_by": if dem.iter().any(|d| d.rank == i + 1) {
+                    "coupled_dem"
+                } else if field_of(&c.design).is_some() {
+                    "effective_fields"
+                } else {
+                    "formulas_time"
+                },
+                "effective_fields": field_of(&c.design),
                 "coupled_dem": dem.iter().find(|d| d.rank == i + 1),
                 "scenario": format!("scenarios/design_{}.toml", i + 1),
             })
@@ -348,6 +386,9 @@ pub fn write_outputs(
             "screening_rank_of_best": screening_rank_of_best,
         },
         "robustness": {"detuning": d, "best_design_objective": detune},
+        "effective_fields": fields,
+        "effective_field_points": fields.iter().flat_map(|e| e.fields.iter().map(|m| m.points)).sum::<usize>(),
+        "effective_field_points_reused": fields.iter().flat_map(|e| e.fields.iter().map(|m| m.reused_points)).sum::<usize>(),
         "coupled_dem": dem,
         "coupled_dem_skipped_several_containers": dem_skipped,
         "coupled_dem_runs": dem.iter().map(|d| d.runs).sum::<usize>(),
@@ -356,6 +397,7 @@ pub fn write_outputs(
                 "ci95_half_width": d.stat.ci95_half_width})),
         "wall_time_s": {"screening": outcome.screening_wall_s,
             "verification": outcome.verification_wall_s,
+            "effective_fields": fields_wall_s,
             "coupled_dem": dem.iter().map(|d| d.wall_s).sum::<f64>(),
             "total": wall_s + started.elapsed().as_secs_f64()},
         "plots": plots,
@@ -363,7 +405,7 @@ pub fn write_outputs(
     write(
         out,
         "report.md",
-        &report_md(space, outcome, &summary, &top, &dem),
+        &report_md(space, outcome, &summary, &top, &fields, &dem),
     )?;
     write(
         out,
@@ -709,6 +751,7 @@ fn report_md(
     o: &SearchOutcome,
     s: &Value,
     top: &[&Candidate],
+    fields: &[FieldEvaluation],
     dem: &[crate::dem::DemVerification],
 ) -> String {
     let st = space.study;
@@ -754,13 +797,25 @@ fn report_md(
     let _ = writeln!(
         r,
         "**Search**: {:.0} designs in the space (before the constraints); {} envelope evaluations ({}), {} time \
-         simulations; wall time {:.2} s screening + {:.2} s verification{}.\n",
+         simulations; wall time {:.2} s screening + {:.2} s verification{}{}.\n",
         o.space_size,
         o.envelope_evaluations,
         o.screening,
         o.time_evaluations,
         o.screening_wall_s,
         o.verification_wall_s,
+        if fields.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " + {:.0} s effective fields ({} field points, {} reused from the store)",
+                s["wall_time_s"]["effective_fields"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                s["effective_field_points"].as_u64().unwrap_or(0),
+                s["effective_field_points_reused"].as_u64().unwrap_or(0)
+            )
+        },
         if dem.is_empty() {
             String::new()
         } else {
@@ -775,19 +830,34 @@ fn report_md(
     let _ = writeln!(r, "## Best designs\n");
     let _ = writeln!(
         r,
-        "| rank | design | bed mass (kg) | {obj} (envelope) | {obj} (time simulation) | scenario |"
+        "| rank | design | bed mass (kg) | {obj} (envelope) | {obj} (time simulation) | {obj} \
+         (effective fields, mean ± 95 % CI) | scenario |"
     );
-    let _ = writeln!(r, "|---|---|---|---|---|---|");
+    let _ = writeln!(r, "|---|---|---|---|---|---|---|");
     for (i, c) in top.iter().enumerate() {
         let _ = writeln!(
             r,
-            "| {} | {} | {:.4} | {:.4e} | {:.4e} | `scenarios/design_{}.toml` |",
+            "| {} | {} | {:.4} | {:.4e} | {:.4e} | {} | `scenarios/design_{}.toml` |",
             i + 1,
             describe(space, &c.design),
             space.bed_mass_kg(&c.design),
             shown(space, c.envelope.cost),
             shown(space, c.time.as_ref().map_or(f64::NAN, |t| t.cost)),
+            fields
+                .iter()
+                .find(|e| e.design == c.design)
+                .map_or("–".to_string(), |e| format!(
+                    "{:.4e} ± {:.1e}",
+                    e.stat.mean, e.stat.ci95_half_width
+                )),
             i + 1
+        );
+    }
+    if !fields.is_empty() {
+        let _ = writeln!(
+            r,
+            "\nThe designs with effective fields come first, in the fields' order; the others \
+             follow in the time simulation's order."
         );
     }
     let bare = &s["bare_structure"][format!("{obj}_time_simulation")];
@@ -812,10 +882,14 @@ fn report_md(
         r,
         "Both levels use the analytical motion-mode formulas (approach 3); they inherit their \
          assumptions (D Ch. 5–7: rigid spheres, fully plastic collect-and-collide impacts, one \
-         layer rolling as a block, a vertical bed as one block). Effective fields (approach 2) \
-         and coupled DEM (approach 1) are the next levels: run the scenario of a design with a \
-         `model = \"fields\"` or `model = \"dem\"` damper to confirm it.\n"
+         layer rolling as a block, a vertical bed as one block) and do not see a wall coating. \
+         Effective fields (approach 2, `[verification] field_designs`) and coupled DEM \
+         (approach 1, `dem_designs`) are the next levels.\n"
     );
+    if !fields.is_empty() {
+        r.push_str(&fields_section(space, fields));
+        let _ = writeln!(r);
+    }
     if let Some(skipped) = s["coupled_dem_skipped_several_containers"].as_array()
         && !skipped.is_empty()
     {
@@ -855,5 +929,340 @@ fn report_md(
             ""
         }
     );
+    r
+}
+
+/// The listed designs: with level 2, its designs in its order (every coating), then the other
+/// time-simulated designs in level-1 order, up to `search.top` in all (level 2's all listed);
+/// without level 2 the best `search.top` time-simulated designs.
+fn listed_candidates(
+    space: &Space,
+    verified: &[&Candidate],
+    fields: &[FieldEvaluation],
+) -> Vec<Candidate> {
+    let top = space.study.file.search.top;
+    let mut list: Vec<Candidate> = Vec::new();
+    for e in fields.iter().filter(|e| e.failure.is_none()) {
+        let mut plain = e.design.clone();
+        plain.choice.coating = 0;
+        if let Some(c) = verified.iter().find(|c| c.design == plain) {
+            let mut c = (*c).clone();
+            c.design = e.design.clone();
+            list.push(c);
+        }
+    }
+    for c in verified {
+        if list.len() >= top.max(fields.iter().filter(|e| e.failure.is_none()).count()) {
+            break;
+        }
+        if !list.iter().any(|l| l.design == c.design) {
+            list.push((*c).clone());
+        }
+    }
+    list
+}
+
+/// The scenario of a design confirmed by its effective fields: its damper at every container
+/// point as `model = "fields"` (approach 2) with the fields of every mode merged into
+/// `scenarios/design_N_fields.csv` (ensemble means, one frequency per mode).
+fn fields_scenario_toml(
+    space: &Space,
+    e: &FieldEvaluation,
+    out: &Path,
+    rank: usize,
+) -> Result<String, DesignError> {
+    let d = &e.design;
+    let mut header = String::new();
+    let mut rows: Vec<(f64, String)> = Vec::new();
+    for m in &e.fields {
+        let p = m.dir.join("fields.csv");
+        let text = std::fs::read_to_string(&p).map_err(|err| DesignError::output(&p, err))?;
+        let mut lines = text
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+        if let Some(h) = lines.next() {
+            header = h.to_string();
+        }
+        rows.extend(lines.map(|l| (m.frequency_hz, l.to_string())));
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let csv_name = format!("design_{rank}_fields.csv");
+    let mut csv = header + "\n";
+    for (_, r) in &rows {
+        csv += r;
+        csv.push('\n');
+    }
+    write(out, &format!("scenarios/{csv_name}"), &csv)?;
+    let bed = space.bed_mass_kg(d) / space.location(d.choice).points.len() as f64;
+    let dampers: Vec<pdamp_structure::scenario::DamperSpec> = space
+        .location(d.choice)
+        .points
+        .iter()
+        .map(|p| pdamp_structure::scenario::DamperSpec::Fields {
+            point: p.clone(),
+            path: csv_name.clone().into(),
+            bed_mass_kg: bed,
+        })
+        .collect();
+    let mut table = scenario_table(space, d)?;
+    table.insert(
+        "dampers".into(),
+        toml::Value::try_from(dampers)
+            .map_err(|err| DesignError::Solver(format!("serialising the dampers: {err}")))?,
+    );
+    let body = toml::to_string(&table)
+        .map_err(|err| DesignError::Solver(format!("serialising the scenario: {err}")))?;
+    Ok(format!(
+        "# Design {rank} of the design study {} (pdamp design):\n# {}\n# bed mass {:.4} kg; \
+         effective fields (approach 2) of the DEM bed, {} packing(s), in {csv_name} (the mean \
+         over the packings; each field at one mode's frequency).\n#\n#   pdamp couple \
+         scenarios/design_{rank}.toml --out out/design_{rank}\n{body}",
+        space.study.path.display(),
+        describe(space, d),
+        space.bed_mass_kg(d),
+        e.stat.count
+    ))
+}
+
+/// `fields.csv` of the design study: level 2's designs in its order.
+fn fields_csv(space: &Space, fields: &[FieldEvaluation]) -> String {
+    let obj = fields[0].objective;
+    let (per_mode, _) = objective_names(space);
+    let mut s = format!(
+        "rank,level1_rank,coating,design,{obj}_effective_fields_mean,\
+         {obj}_effective_fields_ci95_half_width,packings,{obj}_time_simulation"
+    );
+    for m in &per_mode {
+        let _ = write!(
+            s,
+            ",{m}_effective_fields_mean,{m}_effective_fields_ci95_half_width"
+        );
+    }
+    s += ",field_points,field_points_reused,time_step_s,wall_s\n";
+    for (i, e) in fields.iter().enumerate() {
+        let _ = write!(
+            s,
+            "{},{},{},{},{:e},{:e},{},{:e}",
+            i + 1,
+            e.level1_rank,
+            e.coating,
+            describe(space, &e.design).replace(',', ";"),
+            e.stat.mean,
+            e.stat.ci95_half_width,
+            e.stat.count,
+            e.time_simulation
+        );
+        for m in &e.per_mode {
+            let _ = write!(s, ",{:e},{:e}", m.mean, m.ci95_half_width);
+        }
+        let _ = writeln!(
+            s,
+            ",{},{},{:e},{:.1}",
+            e.fields.iter().map(|m| m.points).sum::<usize>(),
+            e.fields.iter().map(|m| m.reused_points).sum::<usize>(),
+            e.time_step_s,
+            e.wall_s
+        );
+    }
+    s
+}
+
+/// The effective-field section of `report.md`.
+fn fields_section(space: &Space, fields: &[FieldEvaluation]) -> String {
+    let f = &space.study.file;
+    let v = &f.verification;
+    let mut r = String::new();
+    let _ = writeln!(r, "## Effective fields (approach 2)\n");
+    let _ = writeln!(
+        r,
+        "The {} best time-simulated design(s), each with {} coating(s) ({}), as DEM beds in \
+         their containers: η̄ and m̄/m_bed (D Eq. 3.13–3.17) at every objective mode's frequency \
+         over {} log-spaced amplitudes of the damper point, {} cycles ({} dropped), on {} \
+         dropped bed(s); the structure then simulated with each mode coupled to its field \
+         (bilinear interpolation), once per bed's field.{} Fields stored in `{}` (reused on \
+         every rerun).\n",
+        v.field_designs,
+        f.damper.coatings.len(),
+        f.damper.coatings.join(", "),
+        v.field_amplitudes,
+        v.field_cycles,
+        v.field_transient_cycles,
+        v.packings,
+        if v.youngs_modulus_scale < 1.0 {
+            format!(
+                " **Softened**: particle Young's modulus × {} (not the reference fidelity).",
+                v.youngs_modulus_scale
+            )
+        } else {
+            String::new()
+        },
+        fields
+            .first()
+            .and_then(|e| e.fields.first())
+            .and_then(|m| m.dir.parent().and_then(|p| p.parent()))
+            .map_or(String::new(), |p| p.display().to_string())
+    );
+    let (unit, scale) = if matches!(f.objective, ObjectiveSpec::MinStroke { .. }) {
+        (" mm", 1e3)
+    } else {
+        ("", 1.0)
+    };
+    let _ = writeln!(
+        r,
+        "| rank | level-1 rank | coating | {obj} (formulas, time simulation) | {obj} (effective \
+         fields, mean ± 95 % CI) | fields − formulas | η̄ on the grid | field points (reused) \
+         | wall time |\n|---|---|---|---|---|---|---|---|---|",
+        obj = fields[0].objective
+    );
+    for (i, e) in fields.iter().enumerate() {
+        if let Some(why) = &e.failure {
+            let _ = writeln!(
+                r,
+                "| {} | {} | {} | {:.4}{unit} | **no field**: {} | – | – | – | {:.0} s |",
+                i + 1,
+                e.level1_rank,
+                e.coating,
+                e.time_simulation * scale,
+                why.replace('|', "/"),
+                e.wall_s
+            );
+            continue;
+        }
+        let eta = e.fields.iter().fold((f64::INFINITY, 0.0_f64), |a, m| {
+            (
+                a.0.min(m.loss_factor_range.0),
+                a.1.max(m.loss_factor_range.1),
+            )
+        });
+        let _ = writeln!(
+            r,
+            "| {} | {} | {} | {:.4}{unit} | {:.4} ± {:.4}{unit} | {:+.1} % | {:.3}–{:.3} | {} ({}) \
+             | {:.0} s |",
+            i + 1,
+            e.level1_rank,
+            e.coating,
+            e.time_simulation * scale,
+            e.stat.mean * scale,
+            e.stat.ci95_half_width * scale,
+            100.0 * (e.stat.mean / e.time_simulation - 1.0),
+            eta.0,
+            eta.1,
+            e.fields.iter().map(|m| m.points).sum::<usize>(),
+            e.fields.iter().map(|m| m.reused_points).sum::<usize>(),
+            e.wall_s
+        );
+    }
+    // level 1 against level 2 on the uncoated designs
+    let plain: Vec<&FieldEvaluation> = fields
+        .iter()
+        .filter(|e| e.design.choice.coating == 0 && e.failure.is_none())
+        .collect();
+    let a: Vec<f64> = plain.iter().map(|e| e.time_simulation).collect();
+    let b: Vec<f64> = plain.iter().map(|e| e.stat.mean).collect();
+    let best1 = plain
+        .iter()
+        .min_by_key(|e| e.level1_rank)
+        .map(|e| e.level1_rank);
+    let best2 = fields.iter().find(|e| e.failure.is_none());
+    let _ = writeln!(
+        r,
+        "\nFormulas against fields on the {} design(s) without coating: Spearman rank \
+         correlation {}; the time simulation's best (level-1 rank {}) is {} under the fields.",
+        plain.len(),
+        spearman(&a, &b).map_or("– (fewer than 3 designs)".to_string(), |x| format!(
+            "{x:.2}"
+        )),
+        best1.map_or("–".into(), |x| x.to_string()),
+        match (best1, best2) {
+            (Some(b1), Some(b2)) if b2.level1_rank == b1 && b2.design.choice.coating == 0 =>
+                "also the best".to_string(),
+            (_, Some(b2)) => format!(
+                "not the best: level 2 prefers level-1 rank {} with coating {}",
+                b2.level1_rank, b2.coating
+            ),
+            _ => "–".into(),
+        }
+    );
+    if let Some(b) = best2 {
+        let overlapping: Vec<String> = fields
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| {
+                !std::ptr::eq(*e, b)
+                    && e.failure.is_none()
+                    && e.stat.ci95_low <= b.stat.ci95_high
+                    && e.stat.ci95_high >= b.stat.ci95_low
+            })
+            .map(|(i, _)| (i + 1).to_string())
+            .collect();
+        if b.stat.count > 1 && !overlapping.is_empty() {
+            let _ = writeln!(
+                r,
+                "\nThe 95 % intervals of field rank(s) {} overlap the best's: more packings \
+                 decide.",
+                overlapping.join(", ")
+            );
+        }
+    }
+    if f.damper.coatings.len() > 1 || f.damper.coatings[0] != crate::spec::NO_COATING {
+        let _ = writeln!(r, "\n{}", coating_rule(space, fields));
+    }
+    let _ = writeln!(
+        r,
+        "\nEach field has one frequency, the mode's with the container on the structure; the \
+         bed's effective mass lowers the coupled frequency by a few per cent, which the field \
+         does not resolve, and outside the amplitude grid its edge values hold."
+    );
+    r
+}
+
+/// D's coated-wall design rule (Eq. 8.11 with Eq. 8.5, n_line = ⌊L/2r⌋, ν_w of the coating)
+/// at the field frequencies, beside the coatings of the study.
+fn coating_rule(space: &Space, fields: &[FieldEvaluation]) -> String {
+    let f = &space.study.file;
+    let mut r = String::from(
+        "D's coated-wall rule (Eq. 8.11 + 8.5: the wall modulus at which the bed's compression \
+         of the coating is the optimal stroke at Γ = 1, n_line particles in a row along the \
+         excitation):",
+    );
+    let mut seen = Vec::new();
+    for e in fields.iter().filter(|e| e.design.choice.coating == 0) {
+        let g = space.geometry(e.design.choice);
+        let m = &f.materials[e.design.choice.material];
+        let n_line = (g.length_m / (2.0 * g.radius_m)).floor().max(1.0);
+        let nu_w = f.coatings.first().map_or(0.49, |c| c.poisson_ratio);
+        for fld in &e.fields {
+            let key = (e.level1_rank, fld.mode);
+            if seen.contains(&key) {
+                continue;
+            }
+            seen.push(key);
+            let dsg = pdamp_structure::design::coated_wall_design(
+                &pdamp_structure::design::CoatedWallInput {
+                    design_frequency_hz: fld.frequency_hz,
+                    particle_radius_m: g.radius_m,
+                    particle_density_kg_m3: m.density_kg_m3,
+                    particle_youngs_modulus_pa: m.youngs_modulus_pa,
+                    particle_poisson_ratio: m.poisson_ratio,
+                    particles_per_line: n_line,
+                    wall_poisson_ratio: nu_w,
+                },
+            );
+            let _ = write!(
+                r,
+                " level-1 rank {} mode {} at {:.1} Hz: E_w ≈ {:.3} MPa (n_line = {n_line});",
+                e.level1_rank,
+                fld.mode,
+                fld.frequency_hz,
+                dsg.wall_modulus_pa * 1e-6
+            );
+        }
+    }
+    let table: Vec<String> = f
+        .coatings
+        .iter()
+        .map(|c| format!("{} {:.3} MPa", c.name, c.youngs_modulus_pa * 1e-6))
+        .collect();
+    let _ = write!(r, " the coatings of the study: {}.", table.join(", "));
     r
 }

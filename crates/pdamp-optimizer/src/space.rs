@@ -25,6 +25,9 @@ pub struct Choice {
     pub material: usize,
     /// Index into `damper.particle_radii_m`.
     pub radius: usize,
+    /// Index into `damper.coatings`. The formulas do not see it: the search (levels 0 and 1)
+    /// keeps 0, and the effective fields (level 2) expand a design over every coating.
+    pub coating: usize,
 }
 
 /// One damper design: a categorical choice and the particle number of every layer (ascending).
@@ -81,7 +84,7 @@ impl<'a> Space<'a> {
         &self.study.locations[c.point].structure
     }
 
-    /// Every categorical choice, in a fixed order.
+    /// Every categorical choice the formulas tell apart (coating 0), in a fixed order.
     pub fn choices(&self) -> Vec<Choice> {
         let d = &self.study.file.damper;
         let mut out = Vec::new();
@@ -94,6 +97,7 @@ impl<'a> Space<'a> {
                             length,
                             material,
                             radius,
+                            coating: 0,
                         });
                     }
                 }

@@ -142,6 +142,53 @@ pub struct DamperSpace {
     /// horizontal layers, one level of the cross-section for vertical beds).
     #[serde(default)]
     pub particle_count_step: Option<usize>,
+    /// Candidate wall coatings of the two walls the bed impacts (those normal to the
+    /// excitation), by name from `[[coatings]]`; `"none"` is the bare container wall (default
+    /// `["none"]`). The formulas do not see a coating (D gives only the design rule Eq. 8.11,
+    /// no motion-mode formula), so levels 0 and 1 rate the uncoated design and the effective
+    /// fields (level 2) and the coupled DEM (level 3) tell the coatings apart.
+    #[serde(default = "no_coating")]
+    pub coatings: Vec<String>,
+}
+
+/// Name of the uncoated wall in `[damper] coatings`.
+pub const NO_COATING: &str = "none";
+
+fn no_coating() -> Vec<String> {
+    vec![NO_COATING.into()]
+}
+
+/// A wall coating of the table (D Sect. 8.1.5): a soft layer on the walls the bed impacts,
+/// modelled in DEM as a half-space of its modulus (Hertz contact of a sphere with a flat
+/// coating, the idealisation of D's design formula Eq. 8.3–8.11; the finite thickness on the
+/// container wall is not represented). `container_lengths_m` are the inner lengths between
+/// the coatings' faces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoatingSpec {
+    /// Name (in `[damper] coatings`, designs.csv and the scenario files).
+    pub name: String,
+    /// Young's modulus E_w, Pa (D Tab. 8.4: 0.27 / 0.72 / 1.4 MPa for TFC Type 13 / 1 / 2).
+    pub youngs_modulus_pa: f64,
+    /// Poisson's ratio ν_w (rubber ≈ 0.5; < 0.5 for the contact law).
+    #[serde(default = "default_coating_poisson")]
+    pub poisson_ratio: f64,
+    /// Density, kg/m³.
+    #[serde(default = "default_coating_density")]
+    pub density_kg_m3: f64,
+    /// Coefficient of restitution particle–coating (default 0.77, T2 of D L1917).
+    #[serde(default = "default_coating_restitution")]
+    pub restitution: f64,
+}
+
+fn default_coating_poisson() -> f64 {
+    0.49
+}
+fn default_coating_density() -> f64 {
+    1190.0
+}
+fn default_coating_restitution() -> f64 {
+    0.77
 }
 
 fn one_container() -> Vec<usize> {
@@ -236,7 +283,8 @@ impl Default for WallMaterialSpec {
     }
 }
 
-/// `[verification]`: the coupled-DEM level (approach 1) on the best designs.
+/// `[verification]`: the effective fields (level 2, approach 2) and the coupled DEM (level 3,
+/// approach 1) of the best designs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VerificationSpec {
@@ -261,6 +309,35 @@ pub struct VerificationSpec {
     /// Container wall material.
     #[serde(default)]
     pub container: WallMaterialSpec,
+    /// Best designs (by the time simulation) whose effective fields are computed (level 2,
+    /// approach 2), each with every coating of `[damper] coatings`; 0: none.
+    #[serde(default)]
+    pub field_designs: usize,
+    /// Amplitudes of a field (log-spaced over the amplitudes the damper point sees).
+    #[serde(default = "default_field_amplitudes")]
+    pub field_amplitudes: usize,
+    /// Excitation cycles of a field point (the first `field_transient_cycles` dropped).
+    #[serde(default = "default_field_cycles")]
+    pub field_cycles: u32,
+    /// Transient cycles of a field point.
+    #[serde(default = "default_field_transient_cycles")]
+    pub field_transient_cycles: u32,
+    /// Where the fields are stored (relative to the study file; default `OUT/fields`): one
+    /// folder per damper, named by the digest of its scenario, with the finished points of
+    /// every packing (`pdamp fields`' store). A study run again, or another study with the
+    /// same dampers, reuses every stored point.
+    #[serde(default)]
+    pub fields_store: Option<PathBuf>,
+}
+
+fn default_field_amplitudes() -> usize {
+    5
+}
+fn default_field_cycles() -> u32 {
+    10
+}
+fn default_field_transient_cycles() -> u32 {
+    3
 }
 
 fn default_packings() -> usize {
@@ -279,6 +356,11 @@ impl Default for VerificationSpec {
             layer_height_m: None,
             time_step_s: None,
             container: WallMaterialSpec::default(),
+            field_designs: 0,
+            field_amplitudes: default_field_amplitudes(),
+            field_cycles: default_field_cycles(),
+            field_transient_cycles: default_field_transient_cycles(),
+            fields_store: None,
         }
     }
 }
@@ -388,6 +470,9 @@ pub struct DesignStudyFile {
     /// Particle materials (default: steel, 7900 kg/m³).
     #[serde(default = "default_materials")]
     pub materials: Vec<MaterialSpec>,
+    /// Wall coatings (`[damper] coatings` picks from them).
+    #[serde(default)]
+    pub coatings: Vec<CoatingSpec>,
     /// Constraints.
     #[serde(default)]
     pub constraints: Constraints,

@@ -304,7 +304,120 @@ impl DesignStudy {
     pub fn validate(&self) -> Result<(), DesignError> {
         self.validate_objective()?;
         self.validate_damper()?;
-        self.validate_settings()
+        self.validate_settings()?;
+        self.validate_coatings_and_fields()
+    }
+
+    /// The coating of `[damper] coatings[index]` from `[[coatings]]` (`None` for the bare
+    /// wall, `"none"`).
+    pub fn coating(&self, index: usize) -> Option<&crate::spec::CoatingSpec> {
+        let name = &self.file.damper.coatings[index];
+        self.file.coatings.iter().find(|c| &c.name == name)
+    }
+
+    /// The coating table, `[damper] coatings` and the effective-field settings.
+    fn validate_coatings_and_fields(&self) -> Result<(), DesignError> {
+        let f = &self.file;
+        for (i, c) in f.coatings.iter().enumerate() {
+            let key = |k: &str| format!("coatings[{i}].{k}");
+            if c.name.trim().is_empty() || c.name == crate::spec::NO_COATING {
+                return Err(self.input(
+                    key("name"),
+                    format!(
+                        "must be a non-empty name other than '{}' (the bare wall)",
+                        crate::spec::NO_COATING
+                    ),
+                ));
+            }
+            if f.coatings[..i].iter().any(|o| o.name == c.name) {
+                return Err(self.input(key("name"), format!("'{}' is listed twice", c.name)));
+            }
+            self.positive(&key("youngs_modulus_pa"), c.youngs_modulus_pa, 1e13)?;
+            self.positive(&key("density_kg_m3"), c.density_kg_m3, 1e5)?;
+            if !(c.poisson_ratio > 0.0 && c.poisson_ratio < 0.5) {
+                return Err(self.input(
+                    key("poisson_ratio"),
+                    format!(
+                        "must lie in (0, 0.5) (the contact law needs ν < 0.5; rubber: 0.49), \
+                         got {}",
+                        c.poisson_ratio
+                    ),
+                ));
+            }
+            if !(c.restitution > 0.0 && c.restitution <= 1.0) {
+                return Err(self.input(
+                    key("restitution"),
+                    format!("must lie in (0, 1], got {}", c.restitution),
+                ));
+            }
+        }
+        let d = &f.damper;
+        if d.coatings.is_empty() {
+            return Err(self.input(
+                "damper.coatings",
+                format!("give at least one, e.g. [\"{}\"]", crate::spec::NO_COATING),
+            ));
+        }
+        for (i, name) in d.coatings.iter().enumerate() {
+            let key = format!("damper.coatings[{i}]");
+            if name != crate::spec::NO_COATING && !f.coatings.iter().any(|c| &c.name == name) {
+                let known: Vec<&str> = f.coatings.iter().map(|c| c.name.as_str()).collect();
+                return Err(self.input(
+                    key,
+                    format!(
+                        "'{name}' is neither '{}' nor a [[coatings]] name ({})",
+                        crate::spec::NO_COATING,
+                        if known.is_empty() {
+                            "the table is empty".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ));
+            }
+            if d.coatings[..i].contains(name) {
+                return Err(self.input(key, format!("'{name}' is listed twice")));
+            }
+        }
+        let v = &f.verification;
+        if d.coatings.len() > 1 && v.field_designs == 0 {
+            return Err(self.input(
+                "verification.field_designs",
+                format!(
+                    "{} coatings are candidates, but the formulas do not see a coating: only \
+                     the effective fields tell them apart; set field_designs ≥ 1",
+                    d.coatings.len()
+                ),
+            ));
+        }
+        if v.field_designs > 20 {
+            return Err(self.input(
+                "verification.field_designs",
+                format!("must be in [0, 20], got {}", v.field_designs),
+            ));
+        }
+        if !(2..=50).contains(&v.field_amplitudes) {
+            return Err(self.input(
+                "verification.field_amplitudes",
+                format!("must be in [2, 50], got {}", v.field_amplitudes),
+            ));
+        }
+        if v.field_cycles == 0 || v.field_cycles > 10_000 {
+            return Err(self.input(
+                "verification.field_cycles",
+                format!("must be in [1, 10000], got {}", v.field_cycles),
+            ));
+        }
+        if v.field_transient_cycles >= v.field_cycles {
+            return Err(self.input(
+                "verification.field_transient_cycles",
+                format!(
+                    "must be below field_cycles = {} (at least one cycle is evaluated), got {}",
+                    v.field_cycles, v.field_transient_cycles
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The objective against the scenario (free or steady state) and the structure's modes.

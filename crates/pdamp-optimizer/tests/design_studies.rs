@@ -434,6 +434,118 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// Level 2 on the Ch. 7 vertical beam posed as max_damping (mode 1, ζ̄ over 10–50 mm): the best
+/// time-simulated design's effective field (DEM bed softened × 0.01, two dropped beds, one
+/// frequency × 5 amplitudes, 6 cycles) with three end-wall coatings: none, a 55 MPa polymer
+/// (SAA-like) and a 1.4 MPa rubber. Measured with 10 cycles: formulas ζ̄ 0.068, fields
+/// 0.063 ± 0.003 (−7.5 %), coupled DEM 0.076 ± 0.013; tolerance 20 % (η̄ runs from 0.01 to 0.8
+/// over the grid: 3 amplitudes gave −24 %, the grid matters). The 1.4 MPa coating is
+/// pressed in beyond the health check's limit by the 0.46 kg column: that design is reported
+/// without a field, and the others go on. A second run in the same folder takes every point
+/// from the store and gives the same bits; the written scenario of the best design couples the
+/// merged fields (`model = "fields"`) and runs.
+#[test]
+fn effective_fields_rank_the_best_design_with_every_coating() {
+    let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
+        .unwrap()
+        .replace(
+            "kind = \"min_stroke\"\nevaluate_at_s = 0.8",
+            "kind = \"max_damping\"\nmodes = [1]\namplitude_min_m = 0.01\n\
+             amplitude_max_m = 0.05\namplitudes = 6",
+        )
+        .replace(
+            "particle_radii_m = [0.005]",
+            "particle_radii_m = [0.005]\ncoatings = [\"none\", \"polymer\", \"rubber\"]",
+        );
+    assert!(text.contains("max_damping") && text.contains("coatings"));
+    let p = examples().join(format!("_test_fields_{}.toml", std::process::id()));
+    std::fs::write(
+        &p,
+        format!(
+            "{text}\n[[coatings]]\nname = \"polymer\"\nyoungs_modulus_pa = 55e6\n\n\
+             [[coatings]]\nname = \"rubber\"\nyoungs_modulus_pa = 1.4e6\n\n[verification]\n\
+             field_designs = 1\npackings = 2\nyoungs_modulus_scale = 0.01\nfield_amplitudes = 5\n\
+             field_cycles = 6\nfield_transient_cycles = 2\n"
+        ),
+    )
+    .unwrap();
+    let out = temp_dir("fields");
+    let first = run_design_study_file(&p, &out);
+    let again = run_design_study_file(&p, &out);
+    std::fs::remove_file(&p).unwrap();
+    let (s, again) = (first.unwrap(), again.unwrap());
+    let fields = s["effective_fields"].as_array().unwrap();
+    assert_eq!(fields.len(), 3);
+    let by = |c: &str| fields.iter().find(|e| e["coating"] == c).unwrap();
+    let level1 = s["top"][0]["mean_damping_ratio_time_simulation"]
+        .as_f64()
+        .unwrap_or_else(|| by("none")["time_simulation"].as_f64().unwrap());
+    for c in ["none", "polymer"] {
+        let e = by(c);
+        assert!(e["failure"].is_null(), "{c}: {}", e["failure"]);
+        let z: Vec<f64> = e["values"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(z.len(), 2);
+        assert!(z[0] != z[1], "{c}: {z:?}");
+        let mean = e["stat"]["mean"].as_f64().unwrap();
+        assert!((mean / level1 - 1.0).abs() < 0.2, "{c}: {mean} vs {level1}");
+        assert!(e["stat"]["ci95_half_width"].as_f64().unwrap().is_finite());
+        assert_eq!(e["fields"][0]["points"], 10);
+    }
+    assert!(by("none")["stat"]["mean"] != by("polymer")["stat"]["mean"]);
+    let rubber = by("rubber");
+    let why = rubber["failure"].as_str().unwrap();
+    assert!(
+        why.contains("penetrates") && why.contains("field points failed"),
+        "{why}"
+    );
+    // the listed designs: the two with fields first, the failed one not listed
+    assert_eq!(s["best"]["confirmed_by"], "effective_fields");
+    assert!(
+        s["top"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|t| t["coating"] != "rubber")
+    );
+    // the rerun: every point from the store, the same bits
+    let a2 = again["effective_fields"].as_array().unwrap();
+    for (a, b) in fields.iter().zip(a2) {
+        assert_eq!(a["values"], b["values"]);
+        if a["failure"].is_null() {
+            assert_eq!(b["fields"][0]["reused_points"], 10, "{}", b["coating"]);
+        }
+    }
+    assert_eq!(s["effective_field_points_reused"], 0);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Effective fields") && report.contains("**no field**"));
+    assert!(report.contains("Eq. 8.11"), "{report}");
+    let csv = std::fs::read_to_string(out.join("fields.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 3);
+    // the best design's scenario couples its fields and runs
+    let scn = out.join("scenarios/design_1.toml");
+    let text = std::fs::read_to_string(&scn).unwrap();
+    assert!(text.contains("model = \"fields\""), "{text}");
+    assert!(out.join("scenarios/design_1_fields.csv").is_file());
+    let run = out.join("couple_design_1");
+    pdamp_structure::report::run_couple(
+        &scn,
+        &run,
+        pdamp_io::run::RunOptions {
+            checkpoint_interval_s: 0.0,
+            resume: false,
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(run.join("decay.csv").is_file());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
 /// A user-style structure from another FE program (the cantilever plate of
 /// structure_plate.toml, Matrix Market K and M): the optimiser puts the damper at the free-edge
 /// corner, where both the bending and the torsion mode move most; at the free edge's middle
