@@ -1111,9 +1111,33 @@ fn check_design_study(path: &std::path::Path) -> Option<Result<()>> {
                 }
             )
         };
+        let fields = if v.field_designs == 0 {
+            String::new()
+        } else {
+            let modes = match &study.file.objective {
+                pdamp_optimizer::study::ObjectiveSpec::MinStroke { .. } => 1,
+                pdamp_optimizer::study::ObjectiveSpec::MaxDamping { modes, .. }
+                | pdamp_optimizer::study::ObjectiveSpec::MinFrfPeak { modes, .. }
+                | pdamp_optimizer::study::ObjectiveSpec::MaxResonanceDamping { modes, .. } => {
+                    modes.len()
+                }
+            };
+            let designs = v.field_designs * study.file.damper.coatings.len();
+            format!(
+                "; effective fields: {designs} designs ({} × {} coating(s)) × {modes} mode(s) × \
+                 {} amplitudes × {} packings = {} DEM field points of {} cycles (stored points \
+                 are reused)",
+                v.field_designs,
+                study.file.damper.coatings.len(),
+                v.field_amplitudes,
+                v.packings,
+                designs * modes * v.field_amplitudes * v.packings,
+                v.field_cycles
+            )
+        };
         println!(
-            "{}: a design study, OK — {screened}; time simulations: {verify}{dem}; run it with \
-             `pdamp design FILE --out DIR` (docs/design.md)",
+            "{}: a design study, OK — {screened}; time simulations: {verify}{fields}{dem}; run \
+             it with `pdamp design FILE --out DIR` (docs/design.md)",
             path.display()
         );
         Ok(())

@@ -11,9 +11,12 @@
 //! space, the modal time simulation with the formula dampers verifies a budget of designs with
 //! a local search, and the report ([`report`]) compares the levels on every verified design,
 //! checks the best design's robustness to detuning and writes a ready-to-run scenario for each
-//! listed design. With `[verification] dem_designs = N` the best N designs are run with coupled
-//! DEM ([`dem`], approach 1) on an ensemble of dropped beds, and the report gives the stroke's
-//! mean and 95 % confidence interval beside the formulas' value.
+//! listed design. With `[verification] field_designs = N` the best N designs, each with every
+//! wall coating of the study, get the effective fields of their DEM beds ([`effective_fields`],
+//! approach 2, stored and reused) and are ranked by the structure's response with those fields;
+//! with `dem_designs = N` the best N listed designs are run with coupled DEM ([`dem`],
+//! approach 1). Both on an ensemble of dropped beds: the report gives the objective's mean and
+//! 95 % confidence interval beside the formulas' value.
 //!
 //! \[D\] is the dissertation on the particle damper design toolchain.
 

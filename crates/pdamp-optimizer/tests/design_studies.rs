@@ -177,6 +177,23 @@ fn bad_study_keys_are_named() {
         ),
         ("[search]\ntop = 0", "search.top"),
         ("[search]\ndetuning = 0.7", "search.detuning"),
+        // coatings: a bad modulus, a ν the contact law refuses, fields without amplitudes
+        (
+            "[[coatings]]\nname = \"T1\"\nyoungs_modulus_pa = -1.0",
+            "coatings[0].youngs_modulus_pa",
+        ),
+        (
+            "[[coatings]]\nname = \"T1\"\nyoungs_modulus_pa = 0.72e6\npoisson_ratio = 0.5",
+            "coatings[0].poisson_ratio",
+        ),
+        (
+            "[verification]\nfield_designs = 1\nfield_amplitudes = 1",
+            "verification.field_amplitudes",
+        ),
+        (
+            "[verification]\nfield_cycles = 4\nfield_transient_cycles = 4",
+            "verification.field_transient_cycles",
+        ),
     ] {
         let p = variant("design_ch7_vertical.toml", "bad", extra);
         let e = DesignStudy::load(&p).unwrap_err();
@@ -215,9 +232,25 @@ fn bad_study_keys_are_named() {
             "points = [\"damper\"]\ncontainers = [5]",
             "damper.containers[0]",
         ),
+        // a coating not in the table; coatings the formulas cannot tell apart without fields
+        (
+            "points = [\"damper\"]",
+            "points = [\"damper\"]\ncoatings = [\"T1\"]",
+            "damper.coatings[0]",
+        ),
+        (
+            "points = [\"damper\"]",
+            "points = [\"damper\"]\ncoatings = [\"none\", \"T1\"]",
+            "verification.field_designs",
+        ),
     ] {
         let p = examples().join(format!("_test_badkey_{}.toml", std::process::id()));
-        std::fs::write(&p, text.replace(from, to)).unwrap();
+        let table = if key == "verification.field_designs" {
+            "\n[[coatings]]\nname = \"T1\"\nyoungs_modulus_pa = 0.72e6\n"
+        } else {
+            ""
+        };
+        std::fs::write(&p, text.replace(from, to) + table).unwrap();
         let e = DesignStudy::load(&p).unwrap_err();
         std::fs::remove_file(&p).unwrap();
         match e {
