@@ -93,8 +93,9 @@ pub fn check_velocity_m_s(space: &Space, d: &Design) -> f64 {
     2.0 * a / w + 0.2
 }
 
-/// The DEM time step: `[verification] time_step_s` or 0.08 of the particle–particle Hertz
-/// contact time at the check velocity (D Eq. 4.8; pdamp refuses steps above 0.1).
+/// The DEM time step: `[verification] time_step_s` or 0.08 of the shorter Hertz contact time,
+/// particle–particle or particle–container wall, at the check velocity (D Eq. 4.8; pdamp refuses
+/// steps above 0.1 of the shortest contact).
 pub fn time_step_s(space: &Space, d: &Design) -> f64 {
     time_step_at_s(space, d, check_velocity_m_s(space, d))
 }
@@ -108,14 +109,24 @@ pub fn time_step_at_s(space: &Space, d: &Design, velocity_m_s: f64) -> f64 {
     let g = space.geometry(d.choice);
     let m = &space.study.file.materials[d.choice.material];
     let e = m.youngs_modulus_pa * v.youngs_modulus_scale;
-    let e_eff = e / (2.0 * (1.0 - m.poisson_ratio * m.poisson_ratio));
-    let tc = hertz_contact_time(
-        e_eff,
+    let compliance = (1.0 - m.poisson_ratio * m.poisson_ratio) / e;
+    // two particles: E* = 1/(2(1−ν²)/E), R* = r/2, m* = m/2
+    let pair = hertz_contact_time(
+        1.0 / (2.0 * compliance),
         0.5 * g.radius_m,
         0.5 * g.particle_mass_kg,
         velocity_m_s,
     );
-    0.08 * tc
+    // a particle on the container wall (flat, at rest): R* = r, m* = m — shorter than the pair's
+    // where the wall is much stiffer than softened particles
+    let c = &v.container;
+    let wall = hertz_contact_time(
+        1.0 / (compliance + (1.0 - c.poisson_ratio * c.poisson_ratio) / c.youngs_modulus_pa),
+        g.radius_m,
+        g.particle_mass_kg,
+        velocity_m_s,
+    );
+    0.08 * pair.min(wall)
 }
 
 fn plane(
@@ -250,7 +261,10 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
     let settle_gravity;
     match f.damper.direction {
         Direction::Horizontal => {
-            let h = v.layer_height_m.unwrap_or(2.2 * g.radius_m);
+            let h = match f.damper.container_height_m {
+                Some(height) => height / d.particles.len() as f64,
+                None => v.layer_height_m.unwrap_or(2.2 * g.radius_m),
+            };
             let top = h * d.particles.len() as f64;
             box_walls(&mut s, l, w, top, false, impacted);
             for i in 1..d.particles.len() {

@@ -897,7 +897,8 @@ fn report_md(
         let _ = writeln!(
             r,
             "Design(s) {} have several containers: coupled DEM couples one DEM bed per run, so \
-             they are confirmed by the formulas only.\n",
+             they are not run with coupled DEM (level 2, `field_designs`, couples every \
+             container to its DEM field).\n",
             ranks.join(", ")
         );
     }

@@ -106,8 +106,9 @@ impl<'a> Space<'a> {
         out
     }
 
-    /// Geometry of a choice: capacity ⌊L/2r⌋·⌊W/2r⌋ per horizontal layer, ⌊L/2r⌋·⌊W/2r⌋·⌊D/2r⌋
-    /// for a vertical bed; default step one row across (horizontal) or one level (vertical).
+    /// Geometry of a choice: capacity ⌊L/2r⌋·⌊W/2r⌋ per horizontal layer (× ⌊H/(layers·2r)⌋ with
+    /// a container height H), ⌊L/2r⌋·⌊W/2r⌋·⌊D/2r⌋ for a vertical bed; default step one row
+    /// (one cross-section) across (horizontal) or one level (vertical).
     pub fn geometry(&self, c: Choice) -> Geometry {
         let d = &self.study.file.damper;
         let l = d.container_lengths_m[c.length];
@@ -115,7 +116,11 @@ impl<'a> Space<'a> {
         let dia = 2.0 * r;
         let fit = |x: f64| ((x / dia) * (1.0 + 1e-12)).floor().max(0.0) as usize;
         let across = match d.direction {
-            Direction::Horizontal => fit(d.container_width_m),
+            Direction::Horizontal => {
+                fit(d.container_width_m)
+                    * d.container_height_m
+                        .map_or(1, |h| fit(h / d.layers as f64).max(1))
+            }
             Direction::Vertical => {
                 fit(d.container_width_m) * fit(d.container_depth_m.unwrap_or(d.container_width_m))
             }

@@ -133,6 +133,13 @@ pub struct DamperSpace {
     /// Vertical containers: the second horizontal dimension, m (default: the width).
     #[serde(default)]
     pub container_depth_m: Option<f64>,
+    /// Horizontal containers: inner height, m, shared by the layers. Each layer is then
+    /// ⌊H/(layers·2r)⌋ particles high — with `layers = 1` a three-dimensional bed that fills the
+    /// cross-section, as the cylinders and cubes of D Ch. 8, its clearance by D Eq. 8.1 and its
+    /// optimal stroke X_opt = h/π (D Eq. 8.2, the bouncing of D Eq. 6.12). Default: one particle
+    /// row per layer (the rolling layers of D Ch. 5/6).
+    #[serde(default)]
+    pub container_height_m: Option<f64>,
     /// Horizontal containers: number of separate layers (shelves), each filled independently.
     #[serde(default = "one")]
     pub layers: usize,

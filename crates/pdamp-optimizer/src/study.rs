@@ -606,6 +606,33 @@ impl DesignStudy {
                 ));
             }
         }
+        if let Some(h) = d.container_height_m {
+            self.positive("damper.container_height_m", h, 100.0)?;
+            if d.direction == crate::study::Direction::Vertical {
+                return Err(self.input(
+                    "damper.container_height_m",
+                    "a vertical container's height is its length along the excitation: use \
+                     container_lengths_m (and container_depth_m for the second horizontal side)",
+                ));
+            }
+            let rmax = d.particle_radii_m.iter().cloned().fold(0.0, f64::max);
+            if h < 2.0 * rmax * d.layers as f64 {
+                return Err(self.input(
+                    "damper.container_height_m",
+                    format!(
+                        "{h} m holds no row of the largest spheres (r = {rmax} m) in each of the \
+                         {} layer(s)",
+                        d.layers
+                    ),
+                ));
+            }
+            if f.verification.layer_height_m.is_some() {
+                return Err(self.input(
+                    "verification.layer_height_m",
+                    "the layers share damper.container_height_m: give one of the two",
+                ));
+            }
+        }
         if d.particle_count_step == Some(0) {
             return Err(self.input("damper.particle_count_step", "must be ≥ 1"));
         }
@@ -652,8 +679,8 @@ impl DesignStudy {
                 "verification.dem_designs",
                 "the coupled-DEM verification is built for free decays (min_stroke, \
                  max_damping); a forced objective's DEM frequency response is not built yet: \
-                 set 0 and run the scenario of a design with a `model = \"dem\"` damper \
-                 through a sweep analysis",
+                 set 0 and use field_designs (the effective fields of the DEM beds, level 2, \
+                 which forced objectives take)",
             ));
         }
         if v.dem_designs > f.search.top {

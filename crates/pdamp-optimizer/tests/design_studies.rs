@@ -793,3 +793,70 @@ fn every_design_couple_and_structure_example_loads() {
     assert!(designs >= 5 && couples >= 19 && structures >= 8);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// D's coated-wall question posed as a study (examples/design_ch8_coated.toml): a
+/// three-dimensional horizontal bed (container_height_m) holds ⌊L/2r⌋·⌊W/2r⌋·⌊H/2r⌋ = 21·8·8
+/// spheres, its clearance is D Eq. 8.1 (1264 spheres: 52.6 · (1 − 1264/1344) = 3.131 mm), one
+/// filling step is one cross-section slice unless given, and the DEM damper of a coated design
+/// puts the coating (its modulus, ν and restitution) on the two walls normal to the excitation
+/// and the container's material on the others.
+#[test]
+fn coated_study_builds_a_three_dimensional_bed_with_coated_end_walls() {
+    let study = DesignStudy::load(&examples().join("design_ch8_coated.toml")).unwrap();
+    let space = Space::new(&study);
+    let c = space.choices()[0];
+    assert_eq!(c.coating, 0);
+    let g = space.geometry(c);
+    assert_eq!(g.capacity, 21 * 8 * 8);
+    assert_eq!(g.step, 16);
+    assert!((g.clearance_m(1264) - 0.0526 * (1.0 - 1264.0 / 1344.0)).abs() < 1e-15);
+    assert!((g.clearance_m(1264) - 3.131e-3).abs() < 1e-6);
+    let mut d = pdamp_optimizer::Design {
+        choice: c,
+        particles: vec![1264],
+    };
+    d.choice.coating = 2; // TFC1, 0.72 MPa
+    let text = pdamp_optimizer::dem::damper_scenario(&space, &d, 7);
+    let sc: toml::Table = text.parse().unwrap();
+    let walls = sc["bodies"][0]["walls"].as_array().unwrap();
+    let material = |name: &str| {
+        walls
+            .iter()
+            .find(|w| w["name"].as_str() == Some(name))
+            .unwrap()["material"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(material("wall_x-"), "coating");
+    assert_eq!(material("wall_x+"), "coating");
+    for w in ["wall_y-", "wall_y+", "floor", "lid"] {
+        assert_eq!(material(w), "container", "{w}");
+    }
+    let lid = walls
+        .iter()
+        .find(|w| w["name"].as_str() == Some("lid"))
+        .unwrap();
+    assert!((lid["geometry"]["point_m"][2].as_float().unwrap() - 0.02).abs() < 1e-15);
+    let coating = sc["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"].as_str() == Some("coating"))
+        .unwrap();
+    assert_eq!(coating["youngs_modulus_pa"].as_float(), Some(0.72e6));
+    let pair = sc["contact"]["pairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["materials"][1].as_str() == Some("coating"))
+        .unwrap();
+    assert_eq!(pair["normal"]["restitution"].as_float(), Some(0.77));
+    // the scenario is a valid DEM damper scenario
+    let p = std::env::temp_dir().join(format!("pdamp_coated_{}.toml", std::process::id()));
+    std::fs::write(&p, &text).unwrap();
+    let loaded = pdamp_io::scenario::Scenario::load(&p);
+    std::fs::remove_file(&p).unwrap();
+    let loaded = loaded.unwrap();
+    assert_eq!(loaded.particles[0].count, Some(1264));
+}
