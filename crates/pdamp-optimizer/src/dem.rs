@@ -259,7 +259,7 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
     let direction;
     let mut groups: Vec<(usize, [f64; 3], [f64; 3])> = Vec::new();
     let settle_gravity;
-    match f.damper.direction {
+    match space.location(d.choice).direction {
         Direction::Horizontal => {
             let h = match f.damper.container_height_m {
                 Some(height) => height / d.particles.len() as f64,

@@ -28,7 +28,12 @@ pub fn describe(space: &Space, d: &Design) -> String {
     let f = &space.study.file;
     let g = space.geometry(d.choice);
     let counts: Vec<String> = d.particles.iter().map(|n| n.to_string()).collect();
-    let what = match f.damper.direction {
+    let what = match space.location(d.choice).direction {
+        Direction::Horizontal
+            if f.damper.container_height_m.is_some() && d.particles.len() == 1 =>
+        {
+            format!("horizontal bed of {}", counts[0])
+        }
         Direction::Horizontal => format!("{} layer(s) {}", d.particles.len(), counts.join("/")),
         Direction::Vertical => format!("vertical bed of {}", counts.join("/")),
     };

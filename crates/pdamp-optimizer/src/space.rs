@@ -115,7 +115,7 @@ impl<'a> Space<'a> {
         let r = d.particle_radii_m[c.radius];
         let dia = 2.0 * r;
         let fit = |x: f64| ((x / dia) * (1.0 + 1e-12)).floor().max(0.0) as usize;
-        let across = match d.direction {
+        let across = match self.location(c).direction {
             Direction::Horizontal => {
                 fit(d.container_width_m)
                     * d.container_height_m
@@ -378,7 +378,7 @@ impl<'a> Space<'a> {
         let g = self.geometry(d.choice);
         let point = point.to_string();
         let filled: Vec<usize> = d.particles.iter().copied().filter(|&n| n > 0).collect();
-        match self.study.file.damper.direction {
+        match self.location(d.choice).direction {
             Direction::Vertical => filled
                 .iter()
                 .map(|&n| DamperSpec::Vertical {

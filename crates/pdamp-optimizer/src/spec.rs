@@ -108,6 +108,14 @@ pub struct DamperSpace {
     /// Candidate structure points (names of `[[structure.points]]` or the single-mode point).
     #[serde(default)]
     pub points: Vec<String>,
+    /// The damper's orientation at particular points, overriding `direction`: the container's
+    /// length L always lies along the point's dof, and gravity lies along it (`vertical`, a dof
+    /// along the vertical) or across it (`horizontal`). A structure whose point moves in several
+    /// dofs is offered as several points (e.g. `tip_ux`, `tip_uz`), each with its orientation:
+    /// the optimiser then chooses the orientation with the point. The containers of one
+    /// multi-container set share an orientation (sets that mix are left out).
+    #[serde(default)]
+    pub point_directions: std::collections::BTreeMap<String, Direction>,
     /// Candidate positions along a `[structure.beam]`, m: a damper point placed there (the FE
     /// snaps it to the nearest node), in the dof of `position_dof`.
     #[serde(default)]

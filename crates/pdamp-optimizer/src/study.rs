@@ -48,6 +48,8 @@ pub struct Location {
     /// The structure spec when it differs from the scenario's (positions along a beam): the
     /// scenario files of a design carry it inline.
     pub spec: Option<StructureSpec>,
+    /// The damper's orientation there (`damper.direction` or `damper.point_directions`).
+    pub direction: Direction,
 }
 
 /// Name of the damper point placed at `damper.positions_m`.
@@ -169,12 +171,30 @@ impl DesignStudy {
         Ok(study)
     }
 
+    /// The damper's orientation at a named point (`damper.point_directions`, else
+    /// `damper.direction`).
+    pub fn direction_at(&self, point: &str) -> Direction {
+        let d = &self.file.damper;
+        d.point_directions
+            .get(point)
+            .copied()
+            .unwrap_or(d.direction)
+    }
+
+    /// Whether some candidate location has orientation `dir`.
+    pub fn offers(&self, dir: Direction) -> bool {
+        let d = &self.file.damper;
+        (d.direction == dir
+            && (!d.positions_m.is_empty() || d.points.len() > d.point_directions.len()))
+            || d.point_directions.values().any(|&x| x == dir)
+    }
+
     /// The candidate locations: the named points on the scenario's structure, and for every
     /// position along the beam the structure rebuilt with the damper point there (and the
     /// container mass moved, `damper.move_mass_at_m`).
     fn locations(&self, spec: &StructureSpec) -> Result<Vec<Location>, DesignError> {
         let d = &self.file.damper;
-        let named = |set: &[usize]| Location {
+        let named = |set: &[usize], direction: Direction| Location {
             label: set
                 .iter()
                 .map(|&i| format!("'{}'", d.points[i]))
@@ -184,13 +204,21 @@ impl DesignStudy {
             points: set.iter().map(|&i| d.points[i].clone()).collect(),
             structure: self.structure.clone(),
             spec: None,
+            direction,
         };
         let mut out: Vec<Location> = Vec::new();
         let mut counts = d.containers.clone();
         counts.sort_unstable();
         for &n in &counts {
             for set in combinations(d.points.len(), n) {
-                out.push(named(&set));
+                let first = self.direction_at(&d.points[set[0]]);
+                // the containers of a set share their orientation
+                if set
+                    .iter()
+                    .all(|&i| self.direction_at(&d.points[i]) == first)
+                {
+                    out.push(named(&set, first));
+                }
             }
         }
         if d.positions_m.is_empty() {
@@ -255,6 +283,7 @@ impl DesignStudy {
                 points: vec![POSITION_POINT.into()],
                 structure,
                 spec: Some(st),
+                direction: d.direction,
             });
         }
         Ok(out)
@@ -579,7 +608,15 @@ impl DesignStudy {
                 format!("must be in [1, 12], got {}", d.layers),
             ));
         }
-        if d.direction == crate::study::Direction::Vertical && d.layers != 1 {
+        for (name, _) in d.point_directions.iter() {
+            if !d.points.contains(name) {
+                return Err(self.input(
+                    format!("damper.point_directions.{name}"),
+                    format!("'{name}' is not one of damper.points {:?}", d.points),
+                ));
+            }
+        }
+        if self.offers(Direction::Vertical) && d.layers != 1 {
             return Err(self.input(
                 "damper.layers",
                 "a vertical bed is one block (D Sect. 7.1.1): use layers = 1",
@@ -608,7 +645,7 @@ impl DesignStudy {
         }
         if let Some(h) = d.container_height_m {
             self.positive("damper.container_height_m", h, 100.0)?;
-            if d.direction == crate::study::Direction::Vertical {
+            if !self.offers(Direction::Horizontal) {
                 return Err(self.input(
                     "damper.container_height_m",
                     "a vertical container's height is its length along the excitation: use \

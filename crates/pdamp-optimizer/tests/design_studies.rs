@@ -860,3 +860,91 @@ fn coated_study_builds_a_three_dimensional_bed_with_coated_end_walls() {
     let loaded = loaded.unwrap();
     assert_eq!(loaded.particles[0].count, Some(1264));
 }
+
+/// Orientation as a design variable: one structure point offered in two dofs, `tip_uz` (the
+/// container's axis vertical: a vertical bed, D Eq. 7.1–7.19) and `tip_ux` (horizontal: rolling
+/// and bouncing layers, D Eq. 5.1–5.14 / 6.12). Each location carries its orientation into the
+/// capacity (⌊L/2r⌋·⌊W/2r⌋·⌊D/2r⌋ against ⌊L/2r⌋·⌊W/2r⌋), the formula model and the DEM
+/// container (gravity along or across the excitation); the search ranks both, and a
+/// `point_directions` key that is not a point is named.
+#[test]
+fn orientation_is_chosen_with_the_point() {
+    let dir = temp_dir("orientation");
+    std::fs::write(
+        dir.join("couple.toml"),
+        "[structure]\nn_modes = 1\n\n[structure.modal]\nfrequencies_hz = [8.0]\n\
+         damping_ratios = [0.002]\npoints = [{ name = \"tip_uz\", shape = [1.0] }, \
+         { name = \"tip_ux\", shape = [1.0] }]\n\n[analysis]\nkind = \"free\"\nduration_s = 2.0\n\
+         time_step_s = 1e-3\ninitial_point = \"tip_uz\"\ninitial_displacement_m = 0.03\n\
+         output_point = \"tip_uz\"\n",
+    )
+    .unwrap();
+    let study_text = "scenario = \"couple.toml\"\n\n[objective]\nkind = \"max_damping\"\n\
+         modes = [1]\namplitude_min_m = 0.005\namplitude_max_m = 0.03\namplitudes = 6\n\n\
+         [damper]\ndirection = \"vertical\"\npoints = [\"tip_uz\", \"tip_ux\"]\n\
+         point_directions = { tip_ux = \"horizontal\" }\ncontainer_lengths_m = [0.08]\n\
+         container_width_m = 0.04\nparticle_radii_m = [0.005]\n\n[search]\nverifications = 8\n";
+    std::fs::write(dir.join("study.toml"), study_text).unwrap();
+    let study = DesignStudy::load(&dir.join("study.toml")).unwrap();
+    let space = Space::new(&study);
+    let by_point = |p: &str| {
+        space
+            .choices()
+            .into_iter()
+            .find(|c| space.location(*c).point == p)
+            .unwrap()
+    };
+    let (cz, cx) = (by_point("tip_uz"), by_point("tip_ux"));
+    assert_eq!(
+        space.location(cz).direction,
+        pdamp_optimizer::spec::Direction::Vertical
+    );
+    assert_eq!(
+        space.location(cx).direction,
+        pdamp_optimizer::spec::Direction::Horizontal
+    );
+    assert_eq!(space.geometry(cz).capacity, 8 * 4 * 4);
+    assert_eq!(space.geometry(cx).capacity, 8 * 4);
+    let dz = pdamp_optimizer::Design {
+        choice: cz,
+        particles: vec![32],
+    };
+    let dx = pdamp_optimizer::Design {
+        choice: cx,
+        particles: vec![16],
+    };
+    assert!(matches!(
+        space.damper_specs(&dz)[0],
+        pdamp_structure::scenario::DamperSpec::Vertical { .. }
+    ));
+    assert!(matches!(
+        space.damper_specs(&dx)[0],
+        pdamp_structure::scenario::DamperSpec::Horizontal { .. }
+            | pdamp_structure::scenario::DamperSpec::Rolling { .. }
+    ));
+    let excitation_x = |d: &pdamp_optimizer::Design| {
+        let t: toml::Table = pdamp_optimizer::dem::damper_scenario(&space, d, 1)
+            .parse()
+            .unwrap();
+        let x = &t["damper"]["direction"].as_array().unwrap()[0];
+        x.as_float()
+            .or_else(|| x.as_integer().map(|i| i as f64))
+            .unwrap()
+    };
+    assert_eq!(excitation_x(&dz), 0.0); // excitation along z, gravity along it
+    assert_eq!(excitation_x(&dx), 1.0); // excitation along x, gravity across it
+    let o = run_search(&space).unwrap();
+    let verified: Vec<_> = o.candidates.iter().filter(|c| c.time.is_some()).collect();
+    assert!(verified.iter().any(|c| c.design.choice.point == cz.point));
+    assert!(verified.iter().any(|c| c.design.choice.point == cx.point));
+    std::fs::write(
+        dir.join("bad.toml"),
+        study_text.replace("{ tip_ux = ", "{ tip_uy = "),
+    )
+    .unwrap();
+    match DesignStudy::load(&dir.join("bad.toml")).unwrap_err() {
+        DesignError::Input { key, .. } => assert_eq!(key, "damper.point_directions.tip_uy"),
+        other => panic!("{other}"),
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
