@@ -605,7 +605,11 @@ fn best_by_dem(dem: &[crate::dem::DemVerification]) -> Option<&crate::dem::DemVe
 
 /// The coupled-DEM section of `report.md`: the ensembles against the formulas, the energy
 /// closure, ζ per mode (max_damping) and the DEM best.
-fn dem_section(f: &crate::study::DesignStudyFile, dem: &[crate::dem::DemVerification]) -> String {
+fn dem_section(
+    f: &crate::study::DesignStudyFile,
+    dem: &[crate::dem::DemVerification],
+    level2: &[Option<&FieldEvaluation>],
+) -> String {
     let mut r = String::new();
     let _ = writeln!(r, "## Coupled DEM (approach 1)\n");
     let _ = writeln!(
@@ -651,6 +655,34 @@ fn dem_section(f: &crate::study::DesignStudyFile, dem: &[crate::dem::DemVerifica
             d.energy_closure,
             d.wall_s
         );
+    }
+    if level2.iter().any(|e| e.is_some()) {
+        let _ = writeln!(
+            r,
+            "\nAgainst the effective fields (level 2, the same bed type, the structure simulated \
+             with the fields):\n\n| rank | {name} (effective fields, mean ± 95 % CI) | {name} \
+             (coupled DEM, mean ± 95 % CI) | DEM − fields | intervals overlap |\n|---|---|---|---|---|"
+        );
+        for (d, e) in dem.iter().zip(level2) {
+            if let Some(e) = e {
+                let _ = writeln!(
+                    r,
+                    "| {} | {:.4} ± {:.4}{unit} | {:.4} ± {:.4}{unit} | {:+.1} % | {} |",
+                    d.rank,
+                    e.stat.mean * scale,
+                    e.stat.ci95_half_width * scale,
+                    d.stat.mean * scale,
+                    d.stat.ci95_half_width * scale,
+                    100.0 * (d.stat.mean / e.stat.mean - 1.0),
+                    if d.stat.ci95_low <= e.stat.ci95_high && d.stat.ci95_high >= e.stat.ci95_low
+                    {
+                        "yes"
+                    } else {
+                        "no"
+                    }
+                );
+            }
+        }
     }
     let open: Vec<String> = dem
         .iter()
@@ -908,7 +940,17 @@ fn report_md(
         );
     }
     if !dem.is_empty() {
-        r.push_str(&dem_section(f, dem));
+        let level2: Vec<Option<&FieldEvaluation>> = dem
+            .iter()
+            .map(|d| {
+                top.get(d.rank - 1).and_then(|c| {
+                    fields
+                        .iter()
+                        .find(|e| e.design == c.design && e.failure.is_none())
+                })
+            })
+            .collect();
+        r.push_str(&dem_section(f, dem, &level2));
         let _ = writeln!(r);
     }
     let _ = writeln!(r, "## Robustness of the best design\n");

@@ -401,7 +401,8 @@ fn coupled_dem_verifies_the_best_design_on_an_ensemble() {
 /// structure gives ζ(X) by the log decrement per cycle (the same procedure as level 1);
 /// measured: formulas ζ̄ 0.068, DEM 0.076 ± 0.013 (+11 %), tolerance 30 %. The decays cover
 /// part of the range, the runs' energy ledgers close to 1e-3, and the per-amplitude ensemble
-/// curve is written.
+/// curve is written. Level 2 runs on the same design first (6-cycle fields) and the report
+/// sets it against level 3.
 #[test]
 fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
@@ -416,7 +417,8 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     std::fs::write(
         &p,
         format!(
-            "{text}\n[verification]\ndem_designs = 1\npackings = 2\nyoungs_modulus_scale = 0.01\n"
+            "{text}\n[verification]\ndem_designs = 1\npackings = 2\nyoungs_modulus_scale = 0.01\n\
+             field_designs = 1\nfield_cycles = 6\nfield_transient_cycles = 2\n"
         ),
     )
     .unwrap();
@@ -464,6 +466,11 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     assert_eq!(csv.lines().count(), 1 + 6);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("Per mode") && report.contains("**Softened**"));
+    // level 2 on the same design, set against level 3
+    assert!(report.contains("Against the effective fields"), "{report}");
+    assert_eq!(s["best"]["confirmed_by"], "coupled_dem");
+    let e = s["best"]["effective_fields"]["stat"]["mean"].as_f64().unwrap();
+    assert!((e / formulas - 1.0).abs() < 0.2, "fields {e} vs formulas {formulas}");
     std::fs::remove_dir_all(&out).unwrap();
 }
 
