@@ -101,7 +101,15 @@ fn shown(space: &Space, cost: f64) -> f64 {
 }
 
 /// `designs.csv`: verified designs by level-1 objective, then the screened ones by level 0.
-fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
+/// With levels 2 and 3: the listed designs first (their order), each with the highest level
+/// that ran on it and the ensembles' means and 95 % half-widths, then the other designs.
+fn designs_csv(
+    space: &Space,
+    cands: &[Candidate],
+    listed: &[Candidate],
+    fields: &[FieldEvaluation],
+    dem: &[crate::dem::DemVerification],
+) -> String {
     let layers = space.study.file.damper.layers;
     let (per_mode, obj) = objective_names(space);
     let mut h = vec![
@@ -124,13 +132,35 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
         h.push(format!("{m}_time_simulation"));
     }
     h.push("verified_as".into());
+    for level in ["effective_fields", "coupled_dem"] {
+        h.push(format!("{obj}_{level}_mean"));
+        h.push(format!("{obj}_{level}_ci95_half_width"));
+    }
     let mut s = h.join(",") + "\n";
     let f = &space.study.file;
-    for (i, c) in cands.iter().enumerate() {
+    let rows = listed
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c, Some(i + 1)))
+        .chain(
+            cands
+                .iter()
+                .filter(|c| !listed.iter().any(|l| l.design == c.design))
+                .map(|c| (c, None)),
+        );
+    for (i, (c, listed_rank)) in rows.enumerate() {
         let g = space.geometry(c.design.choice);
+        let field = fields
+            .iter()
+            .find(|e| e.design == c.design && e.failure.is_none());
+        let coupled = listed_rank.and_then(|r| dem.iter().find(|d| d.rank == r));
         let mut row = vec![
             (i + 1).to_string(),
-            if c.time.is_some() {
+            if coupled.is_some() {
+                "coupled_dem".into()
+            } else if field.is_some() {
+                "effective_fields".into()
+            } else if c.time.is_some() {
                 "formulas_time".into()
             } else {
                 "envelope".into()
@@ -163,6 +193,15 @@ fn designs_csv(space: &Space, cands: &[Candidate]) -> String {
             }));
         }
         row.push(c.verified_as.map_or(String::new(), |v| (v + 1).to_string()));
+        for st in [field.map(|e| e.stat), coupled.map(|d| d.stat)] {
+            match st {
+                Some(st) => {
+                    row.push(format!("{:e}", st.mean));
+                    row.push(format!("{:e}", st.ci95_half_width));
+                }
+                None => row.extend([String::new(), String::new()]),
+            }
+        }
         s += &(row.join(",") + "\n");
     }
     s
@@ -242,7 +281,6 @@ pub fn write_outputs(
     let f = &st.file;
     std::fs::create_dir_all(out.join("scenarios")).map_err(|e| DesignError::output(out, e))?;
     let cands = &outcome.candidates;
-    write(out, "designs.csv", &designs_csv(space, cands))?;
     let verified: Vec<&Candidate> = cands.iter().filter(|c| c.time.is_some()).collect();
     let best = verified[0];
     // level 2: effective fields of the best time-simulated designs, with every coating
@@ -341,6 +379,11 @@ pub fn write_outputs(
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
     let (dem, dem_skipped) = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
+    write(
+        out,
+        "designs.csv",
+        &designs_csv(space, cands, &listed, &fields, &dem),
+    )?;
     let (_, obj) = objective_names(space);
     let list: Vec<Value> = top
         .iter()
@@ -674,8 +717,7 @@ fn dem_section(
                     d.stat.mean * scale,
                     d.stat.ci95_half_width * scale,
                     100.0 * (d.stat.mean / e.stat.mean - 1.0),
-                    if d.stat.ci95_low <= e.stat.ci95_high && d.stat.ci95_high >= e.stat.ci95_low
-                    {
+                    if d.stat.ci95_low <= e.stat.ci95_high && d.stat.ci95_high >= e.stat.ci95_low {
                         "yes"
                     } else {
                         "no"

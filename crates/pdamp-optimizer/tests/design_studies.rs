@@ -469,8 +469,13 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
     // level 2 on the same design, set against level 3
     assert!(report.contains("Against the effective fields"), "{report}");
     assert_eq!(s["best"]["confirmed_by"], "coupled_dem");
-    let e = s["best"]["effective_fields"]["stat"]["mean"].as_f64().unwrap();
-    assert!((e / formulas - 1.0).abs() < 0.2, "fields {e} vs formulas {formulas}");
+    let e = s["best"]["effective_fields"]["stat"]["mean"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (e / formulas - 1.0).abs() < 0.2,
+        "fields {e} vs formulas {formulas}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 
@@ -566,6 +571,28 @@ fn effective_fields_rank_the_best_design_with_every_coating() {
     assert!(report.contains("Eq. 8.11"), "{report}");
     let csv = std::fs::read_to_string(out.join("fields.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3);
+    // designs.csv: the two designs with fields first, with their ensemble columns
+    let designs = std::fs::read_to_string(out.join("designs.csv")).unwrap();
+    let header: Vec<&str> = designs.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = designs
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    for row in &rows[..2] {
+        assert_eq!(row[col("fidelity")], "effective_fields");
+        let m: f64 = row[col("mean_damping_ratio_effective_fields_mean")]
+            .parse()
+            .unwrap();
+        assert!(m > 0.0);
+    }
+    assert!(rows[..2].iter().any(|r| r[col("coating")] == "polymer"));
+    assert!(
+        rows[2..]
+            .iter()
+            .all(|r| r[col("fidelity")] != "effective_fields")
+    );
     // the best design's scenario couples its fields and runs
     let scn = out.join("scenarios/design_1.toml");
     let text = std::fs::read_to_string(&scn).unwrap();
