@@ -10,6 +10,30 @@ use crate::world::World;
 /// 25 % means particles are passing through each other.
 pub const MAX_RELATIVE_OVERLAP: f64 = 0.25;
 
+/// A wall whose Young's modulus is below this fraction of the particle's is a soft layer — a
+/// rubber or polymer coating (D Sect. 8.1.5, moduli of 0.27–55 MPa against 208 GPa steel) —
+/// for the overlap check.
+pub const SOFT_WALL_MODULUS_RATIO: f64 = 1e-2;
+
+/// Largest particle–wall overlap, relative to the radius, on a soft wall: a bed pressed into a
+/// coating by its own impact (D's compression collect-and-collide, Sect. 8.1.5) legitimately
+/// indents it by tens of per cent of a sphere's radius. A plane's Hertz force grows with the
+/// indentation, so a particle passing through it shows as an overlap approaching the radius,
+/// which this still catches. Beyond ≈ 10 % Hertz is outside its small-strain range, as D notes
+/// for its coating design formula (Eq. 8.3–8.11).
+pub const SOFT_WALL_MAX_RELATIVE_OVERLAP: f64 = 0.75;
+
+/// The particle–wall overlap limit of a particle material against a wall material:
+/// [`SOFT_WALL_MAX_RELATIVE_OVERLAP`] for a soft wall ([`SOFT_WALL_MODULUS_RATIO`]),
+/// [`MAX_RELATIVE_OVERLAP`] otherwise.
+pub fn wall_overlap_limit(particle: &crate::Material, wall: &crate::Material) -> f64 {
+    if wall.youngs_modulus_pa < SOFT_WALL_MODULUS_RATIO * particle.youngs_modulus_pa {
+        SOFT_WALL_MAX_RELATIVE_OVERLAP
+    } else {
+        MAX_RELATIVE_OVERLAP
+    }
+}
+
 /// Relative energy-balance residual |W − ΔE − D| / scale beyond which the run has blown up
 /// (healthy runs close to 1e-4 or better; Gear runs to their error tolerance).
 pub const MAX_CLOSURE_ERROR: f64 = 0.5;
@@ -150,18 +174,26 @@ impl World {
                 out.clear();
                 wall.geometry
                     .sphere_contacts(&x, p.radius[i], 0.0, &mut out);
-                if let Some(c) = out
-                    .iter()
-                    .find(|c| c.overlap_m > MAX_RELATIVE_OVERLAP * p.radius[i])
-                {
+                let limit = wall_overlap_limit(
+                    &self.materials[p.material[i] as usize],
+                    &self.materials[wall.material as usize],
+                );
+                if let Some(c) = out.iter().find(|c| c.overlap_m > limit * p.radius[i]) {
                     return Err(err(
                         Some(i),
                         format!(
                             "particle {i} penetrates wall '{}' of body '{}' by {:.0} % of its \
-                             radius (runaway overlap; a particle may have left the container); {}",
+                             radius (runaway overlap, limit {:.0} %{}; a particle may have left \
+                             the container); {}",
                             wall.name,
                             b.name,
                             100.0 * c.overlap_m / p.radius[i],
+                            100.0 * limit,
+                            if limit > MAX_RELATIVE_OVERLAP {
+                                " for a soft wall"
+                            } else {
+                                ""
+                            },
                             cause(self)
                         ),
                     ));
@@ -402,6 +434,45 @@ mod tests {
             !w.check_health()
                 .is_err_and(|e| e.to_string().contains("left its container"))
         );
+    }
+
+    /// A sphere pressed into a wall by 40 % of its radius: a runaway on a steel wall, a
+    /// legitimate indentation of a rubber coating (E_w < 1 % of the particle's), where only an
+    /// overlap beyond 75 % is refused.
+    #[test]
+    fn soft_walls_may_be_indented_deeper() {
+        use crate::body::{BodyState, Motion, RigidBody};
+        use crate::walls::{Geometry, Plane};
+        let indented = |wall_modulus_pa: f64, depth: f64| {
+            let steel = Material::new("steel", 7850.0, 2.1e11, 0.3);
+            let coating = Material::new("coating", 1190.0, wall_modulus_pa, 0.49);
+            let model = ContactModel {
+                normal: NormalLaw::Hertz,
+                friction: FrictionLaw::Frictionless,
+                rolling: None,
+                adhesion: None,
+            };
+            let mut w = World::new(vec![steel, coating], model, 1e-7);
+            w.gravity_m_s2 = Vec3::zeros();
+            w.add_particle(Vec3::new(0.0, 0.0, (1.0 - depth) * 1e-3), 1e-3, 0);
+            w.add_body(
+                RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+                    "floor",
+                    Geometry::Plane(Plane::new(Vec3::zeros(), Vec3::new(0.0, 0.0, 1.0), false)),
+                    1,
+                ),
+            );
+            w.initialize();
+            w.check_health()
+        };
+        let e = indented(2.1e11, 0.4).unwrap_err().to_string();
+        assert!(
+            e.contains("penetrates wall 'floor'") && e.contains("limit 25 %"),
+            "{e}"
+        );
+        indented(0.72e6, 0.4).unwrap();
+        let e = indented(0.72e6, 0.8).unwrap_err().to_string();
+        assert!(e.contains("limit 75 % for a soft wall"), "{e}");
     }
 
     #[test]
