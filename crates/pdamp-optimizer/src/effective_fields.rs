@@ -12,9 +12,9 @@
 //!
 //! The fields lie in a store (`[verification] fields_store`, default `OUT/fields`): one folder
 //! per damper named by the digest of its scenario, one subfolder per frequency holding
-//! `pdamp fields`' output (finished points in `points/`, packings in `packings/`). A run that is
-//! stopped, a study run again or another study with the same damper reuses every stored
-//! point; only the missing ones run.
+//! `pdamp fields`' output (finished points in `points/`, packings in `packings/`, the dropped
+//! beds in `beds/`). A run that is stopped, a study run again or another study with the same
+//! damper reuses every stored point and bed; only the missing points run.
 //!
 //! Limits, reported with the results: each field has one frequency (the mode's, with the
 //! container on the structure); the effective mass of the bed lowers the coupled frequency by
@@ -357,11 +357,14 @@ pub fn evaluate_design(
             .map_err(|e| DesignError::output(&path, e))?;
         let sc = pdamp_io::scenario::Scenario::load(&path)
             .map_err(|e| DesignError::Solver(format!("{}: {e}", path.display())))?;
-        let outcome = pdamp_design::report::run_fields_scenario_on(
+        // the beds are saved beside the points (`beds/packing_KKK.pdprep`): a rerun reads them
+        // instead of dropping them again
+        let outcome = pdamp_design::report::run_fields_scenario_from(
             &sc,
             &dir,
             &dir,
             pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
+            pdamp_design::report::BedSource::Saved(&dir),
             |_| {},
             |_, _| {},
         )
