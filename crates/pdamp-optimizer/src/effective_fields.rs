@@ -260,16 +260,23 @@ fn field_scenario(
     ))
 }
 
-/// Folder of a damper's fields in the store: the digest of its scenario without comments
-/// (the same damper in another study or rank lands in the same folder).
-fn damper_dir(store: &Path, scenario: &str) -> PathBuf {
-    let physics: String = scenario
-        .lines()
-        .filter(|l| !l.trim_start().starts_with('#'))
-        .collect::<Vec<_>>()
-        .join("\n");
+/// Folder of a damper's fields in the store: the digest of its scenario without the grid, the
+/// single-point excitation and the comments — what `pdamp fields` itself compares before it
+/// reuses a point — so that the same damper (same bed, contact laws and time step) in another
+/// study, rank or amplitude range lands in the same folder; points are then reused where their
+/// frequency and amplitude match.
+fn damper_dir(store: &Path, scenario: &str) -> Result<PathBuf, DesignError> {
+    let mut table: toml::Table = toml::from_str(scenario)
+        .map_err(|e| DesignError::Solver(format!("field scenario: {e}")))?;
+    table.remove("fields");
+    if let Some(toml::Value::Table(d)) = table.get_mut("damper") {
+        d.remove("frequency_hz");
+        d.remove("amplitude_m");
+    }
+    let physics =
+        toml::to_string(&table).map_err(|e| DesignError::Solver(format!("field scenario: {e}")))?;
     let digest = pdamp_io::checkpoint::digest(physics.as_bytes());
-    store.join(format!("damper_{}", &digest[..digest.len().min(16)]))
+    Ok(store.join(format!("damper_{}", &digest[..digest.len().min(16)])))
 }
 
 /// The field tables of a finished field folder: the ensemble's packings (or the single field).
@@ -326,7 +333,7 @@ pub fn evaluate_design(
         let f = structure.modes[k].frequency_hz;
         let range = damper_range_m(space, d, level1, k)?;
         let (scenario, dt) = field_scenario(space, d, f, range)?;
-        let dir = damper_dir(&store, &scenario).join(format!("field_{f:.4}Hz"));
+        let dir = damper_dir(&store, &scenario)?.join(format!("field_{f:.4}Hz"));
         let pending = (0..v.packings)
             .map(|p| packing_dir(&dir, v.packings, p))
             .flat_map(|pd| {
