@@ -1934,17 +1934,18 @@ impl Scenario {
         }
         // A dropped bed or one from a file is at rest with its contacts: it overlaps its
         // neighbours and the walls by its contact deformation (a few 1e-4 of the radius,
-        // refused beyond 5 %). A bed dropped here was simulated under the health check, which
-        // allows a soft wall (a coating) to be pressed in up to MAX_RELATIVE_OVERLAP of the
-        // radius: its wall contacts are accepted to that limit.
+        // refused beyond 5 %). A bed dropped here was simulated under the health check: its
+        // wall contacts are accepted to the health check's limit of that wall (a soft wall, a
+        // coating, may be pressed in deeper: pdamp_dem::health::wall_overlap_limit).
         let tolerance = if settled_bed { 0.05 } else { 1e-9 };
-        let wall_tolerance = if settled_bed && !bed_from_file {
-            pdamp_dem::health::MAX_RELATIVE_OVERLAP
-        } else {
-            tolerance
-        };
         check_initial_overlaps(&world, &group_of, tolerance)?;
-        check_inside_walls(&world, &group_of, self, wall_tolerance)?;
+        check_inside_walls(
+            &world,
+            &group_of,
+            self,
+            tolerance,
+            settled_bed && !bed_from_file,
+        )?;
         // Check mode: the drop-down groups' particles far away in a row (for counts, masses
         // and the time-step check below), not dropped.
         let far = world
@@ -2190,11 +2191,15 @@ fn check_initial_overlaps(world: &World, group_of: &[usize], tolerance: f64) -> 
 
 /// Fails if a particle starts overlapping a wall or outside a closed container (boxes and
 /// cylinders report a particle outside as a deep overlap; open meshes cannot tell).
+/// Particles overlapping a wall by more than `tolerance` of their radius are refused; with
+/// `health_limits` (a bed dropped under the health check) each wall's health-check limit
+/// applies instead.
 fn check_inside_walls(
     world: &World,
     group_of: &[usize],
     sc: &Scenario,
     tolerance: f64,
+    health_limits: bool,
 ) -> Result<(), String> {
     let p = &world.particles;
     let mut contacts = Vec::new();
@@ -2206,10 +2211,15 @@ fn check_inside_walls(
                 let x = pose.to_body(&p.position[i]);
                 w.geometry
                     .sphere_contacts(&x, p.radius[i], 0.0, &mut contacts);
-                if let Some(c) = contacts
-                    .iter()
-                    .find(|c| c.overlap_m > tolerance * p.radius[i])
-                {
+                let limit = if health_limits {
+                    pdamp_dem::health::wall_overlap_limit(
+                        &world.materials[p.material[i] as usize],
+                        &world.materials[w.material as usize],
+                    )
+                } else {
+                    tolerance
+                };
+                if let Some(c) = contacts.iter().find(|c| c.overlap_m > limit * p.radius[i]) {
                     let outside = c.overlap_m > p.radius[i];
                     return Err(format!(
                         "particles[{g}].placement.region: particle {i} at {:?} m {} wall '{}' of body '{}' (bodies[{bi}].walls[{wi}]) by {:.3e} m; \

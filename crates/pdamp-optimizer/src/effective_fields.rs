@@ -362,30 +362,37 @@ pub fn evaluate_design(
         let path = dir.join("damper.toml");
         pdamp_io::atomic::write_atomic(&path, scenario.as_bytes())
             .map_err(|e| DesignError::output(&path, e))?;
-        let sc = pdamp_io::scenario::Scenario::load(&path)
-            .map_err(|e| DesignError::Solver(format!("{}: {e}", path.display())))?;
         // the beds are saved beside the points (`beds/packing_KKK.pdprep`): a rerun reads them
         // instead of dropping them again
-        let outcome = pdamp_design::report::run_fields_scenario_from(
-            &sc,
-            &dir,
-            &dir,
-            pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
-            pdamp_design::report::BedSource::Saved(&dir),
-            |_| {},
-            |_, _| {},
-        )
-        .map_err(|e| DesignError::Solver(format!("{}: {e}", dir.display())))?;
-        if !outcome.failed.is_empty() {
-            // the design has no field: reported as such, the others go on
-            let first = &outcome.failed[0].2;
-            let failure = format!(
+        let run = pdamp_io::scenario::Scenario::load(&path)
+            .map_err(|e| format!("{}: {e}", path.display()))
+            .and_then(|sc| {
+                pdamp_design::report::run_fields_scenario_from(
+                    &sc,
+                    &dir,
+                    &dir,
+                    pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
+                    pdamp_design::report::BedSource::Saved(&dir),
+                    |_| {},
+                    |_, _| {},
+                )
+                .map_err(|e| format!("{}: {e}", dir.display()))
+            });
+        // a damper that cannot be built, dropped or run has no field: reported as such (the
+        // cause named), and the other designs go on
+        let failure = match &run {
+            Err(e) => Some(format!("the damper's field could not be computed: {e}")),
+            Ok(o) if !o.failed.is_empty() => Some(format!(
                 "{} of {} field points failed (a rerun retries them; errors in {}/points), \
-                 the first: {first}",
-                outcome.failed.len(),
-                outcome.points.len(),
-                dir.display()
-            );
+                 the first: {}",
+                o.failed.len(),
+                o.points.len(),
+                dir.display(),
+                o.failed[0].2
+            )),
+            Ok(_) => None,
+        };
+        if let Some(failure) = failure {
             progress(&format!(
                 "level 2, design {level1_rank} ({coating}): {failure}"
             ));
@@ -406,6 +413,7 @@ pub fn evaluate_design(
                 failure: Some(failure),
             });
         }
+        let outcome = run.expect("checked above");
         let eta: Vec<f64> = outcome
             .points
             .iter()

@@ -1275,6 +1275,10 @@ fn fields_section(space: &Space, fields: &[FieldEvaluation]) -> String {
         match (best1, best2) {
             (Some(b1), Some(b2)) if b2.level1_rank == b1 && b2.design.choice.coating == 0 =>
                 "also the best".to_string(),
+            (Some(b1), Some(b2)) if b2.level1_rank == b1 => format!(
+                "also the best filling, and best with coating {}",
+                b2.coating
+            ),
             (_, Some(b2)) => format!(
                 "not the best: level 2 prefers level-1 rank {} with coating {}",
                 b2.level1_rank, b2.coating
