@@ -355,7 +355,22 @@ pub fn evaluate_design(
         v.packings,
         steps / 5e6 / 60.0
     ));
-    let mut fields = Vec::new();
+    let mut result = FieldEvaluation {
+        design: d.clone(),
+        level1_rank,
+        coating: coating.clone(),
+        objective: objective_name(space),
+        values: Vec::new(),
+        stat: EnsembleStat::of(&[]),
+        per_mode: Vec::new(),
+        time_simulation: shown(space, level1.cost),
+        fields: Vec::new(),
+        particles,
+        time_step_s: dt_max,
+        estimated_particle_steps: steps,
+        wall_s: 0.0,
+        failure: None,
+    };
     let mut tables: Vec<(usize, Vec<FieldTable>)> = Vec::new();
     for (k, f, range, scenario, dir) in plans {
         std::fs::create_dir_all(&dir).map_err(|e| DesignError::output(&dir, e))?;
@@ -396,22 +411,9 @@ pub fn evaluate_design(
             progress(&format!(
                 "level 2, design {level1_rank} ({coating}): {failure}"
             ));
-            return Ok(FieldEvaluation {
-                design: d.clone(),
-                level1_rank,
-                coating,
-                objective: objective_name(space),
-                values: Vec::new(),
-                stat: EnsembleStat::of(&[]),
-                per_mode: Vec::new(),
-                time_simulation: shown(space, level1.cost),
-                fields,
-                particles,
-                time_step_s: dt_max,
-                estimated_particle_steps: steps,
-                wall_s: started.elapsed().as_secs_f64(),
-                failure: Some(failure),
-            });
+            result.failure = Some(failure);
+            result.wall_s = started.elapsed().as_secs_f64();
+            return Ok(result);
         }
         let outcome = run.expect("checked above");
         let eta: Vec<f64> = outcome
@@ -421,7 +423,7 @@ pub fn evaluate_design(
             .collect();
         let t = packing_tables(&dir, v.packings, bed_mass)?;
         let ci = ci95_max(&t);
-        fields.push(ModeField {
+        result.fields.push(ModeField {
             mode: k + 1,
             frequency_hz: f,
             amplitude_range_m: range,
@@ -471,24 +473,13 @@ pub fn evaluate_design(
         per_mode.push(pm);
     }
     let n_modes = per_mode.first().map_or(0, |v| v.len());
-    Ok(FieldEvaluation {
-        design: d.clone(),
-        level1_rank,
-        coating,
-        objective: objective_name(space),
-        stat: EnsembleStat::of(&values),
-        values,
-        per_mode: (0..n_modes)
-            .map(|i| EnsembleStat::of(&per_mode.iter().map(|v| v[i]).collect::<Vec<_>>()))
-            .collect(),
-        time_simulation: shown(space, level1.cost),
-        fields,
-        particles,
-        time_step_s: dt_max,
-        estimated_particle_steps: steps,
-        wall_s: started.elapsed().as_secs_f64(),
-        failure: None,
-    })
+    result.stat = EnsembleStat::of(&values);
+    result.values = values;
+    result.per_mode = (0..n_modes)
+        .map(|k| EnsembleStat::of(&per_mode.iter().map(|v| v[k]).collect::<Vec<_>>()))
+        .collect();
+    result.wall_s = started.elapsed().as_secs_f64();
+    Ok(result)
 }
 
 /// Largest 95 % half-width of η̄ over the grid points of the packings' tables.

@@ -38,6 +38,19 @@ fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// The Ch. 7 vertical-beam study posed as max_damping: mode 1, ζ̄ over 10–50 mm, 6 amplitudes.
+fn ch7_as_max_damping() -> String {
+    let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
+        .unwrap()
+        .replace(
+            "kind = \"min_stroke\"\nevaluate_at_s = 0.8",
+            "kind = \"max_damping\"\nmodes = [1]\namplitude_min_m = 0.01\n\
+             amplitude_max_m = 0.05\namplitudes = 6",
+        );
+    assert!(text.contains("max_damping"));
+    text
+}
+
 /// A copy of an example study with extra TOML appended (written beside the examples so that
 /// the relative scenario path resolves; removed by the caller).
 fn variant(example: &str, name: &str, extra: &str) -> PathBuf {
@@ -405,14 +418,7 @@ fn coupled_dem_verifies_the_best_design_on_an_ensemble() {
 /// sets it against level 3.
 #[test]
 fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
-    let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
-        .unwrap()
-        .replace(
-            "kind = \"min_stroke\"\nevaluate_at_s = 0.8",
-            "kind = \"max_damping\"\nmodes = [1]\namplitude_min_m = 0.01\n\
-             amplitude_max_m = 0.05\namplitudes = 6",
-        );
-    assert!(text.contains("max_damping"));
+    let text = ch7_as_max_damping();
     let p = examples().join(format!("_test_dem_damping_{}.toml", std::process::id()));
     std::fs::write(
         &p,
@@ -491,17 +497,10 @@ fn coupled_dem_verifies_the_damping_over_an_amplitude_range() {
 /// merged fields (`model = "fields"`) and runs.
 #[test]
 fn effective_fields_rank_the_best_design_with_every_coating() {
-    let text = std::fs::read_to_string(examples().join("design_ch7_vertical.toml"))
-        .unwrap()
-        .replace(
-            "kind = \"min_stroke\"\nevaluate_at_s = 0.8",
-            "kind = \"max_damping\"\nmodes = [1]\namplitude_min_m = 0.01\n\
-             amplitude_max_m = 0.05\namplitudes = 6",
-        )
-        .replace(
-            "particle_radii_m = [0.005]",
-            "particle_radii_m = [0.005]\ncoatings = [\"none\", \"polymer\", \"gel\"]",
-        );
+    let text = ch7_as_max_damping().replace(
+        "particle_radii_m = [0.005]",
+        "particle_radii_m = [0.005]\ncoatings = [\"none\", \"polymer\", \"gel\"]",
+    );
     assert!(text.contains("max_damping") && text.contains("coatings"));
     let p = examples().join(format!("_test_fields_{}.toml", std::process::id()));
     std::fs::write(
