@@ -15,10 +15,12 @@
 
 use crate::DesignError;
 use crate::fidelity::DecayPlan;
+use crate::resonance_sweep::{SweepPlan, SweepTarget};
 use crate::space::{Design, Space};
 use crate::study::{Direction, ObjectiveSpec};
 use pdamp_dem::contact::hertz::hertz_contact_time;
 use pdamp_design::ensemble::EnsembleStat;
+use pdamp_structure::forced;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -40,6 +42,8 @@ pub struct DemVerification {
     pub time_simulation: f64,
     /// max_damping: each mode's ζ̄ over the packings and ζ(X) on the amplitude grid.
     pub modes: Vec<DemModeDamping>,
+    /// min_frf_peak, max_resonance_damping: each mode's resonance from the DEM sweeps.
+    pub resonances: Vec<DemResonance>,
     /// DEM time step used, s.
     pub time_step_s: f64,
     /// Factor applied to the particles' Young's modulus.
@@ -60,10 +64,46 @@ pub struct DemVerification {
 }
 
 impl DemVerification {
-    /// Whether a larger objective is better (damping) or a smaller one (stroke).
+    /// Whether a larger objective is better (damping) or a smaller one (stroke, peak).
     pub fn larger_is_better(&self) -> bool {
-        self.objective == "mean_damping_ratio"
+        matches!(
+            self.objective,
+            "mean_damping_ratio" | "mean_resonance_damping_ratio"
+        )
     }
+}
+
+impl DemResonance {
+    /// Level 1's peak relative to the bare peak on the same sweep as the DEM (the formula
+    /// dampers run through the plan's sweep).
+    pub fn formula_sweep_relative_peak(&self) -> f64 {
+        self.time_simulation.0 * (1.0 + self.sweep.formula_sweep_bias())
+    }
+}
+
+/// One mode's resonance from the coupled-DEM sweeps of a design (forced objectives,
+/// [`crate::resonance_sweep`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct DemResonance {
+    /// Mode number (1-based).
+    pub mode: usize,
+    /// Peak at the output point relative to the bare structure's, per packing.
+    pub relative_peak: Vec<f64>,
+    /// Its ensemble statistics.
+    pub relative_peak_stat: EnsembleStat,
+    /// ζ at resonance (D Eq. 3.47) per packing.
+    pub damping_ratio: Vec<f64>,
+    /// Its ensemble statistics.
+    pub damping_ratio_stat: EnsembleStat,
+    /// Frequency of the peak per packing, Hz.
+    pub resonance_frequency_hz: Vec<f64>,
+    /// Level 1 (steady-state FRF of the formula dampers, D Eq. 3.44): relative peak, ζ,
+    /// frequency of the peak (Hz).
+    pub time_simulation: (f64, f64, f64),
+    /// The sweep the packings ran.
+    pub sweep: crate::resonance_sweep::SweepSummary,
+    /// Why the sweep was planned again after the first packing, if it was.
+    pub replanned: Option<String>,
 }
 
 /// One mode's damping from the coupled-DEM decays of a design (max_damping).
@@ -373,18 +413,16 @@ pub fn couple_scenario(
     toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
 }
 
-/// The coupling scenario of a design's damping decay in one mode (max_damping, TOML): the
-/// [`DecayPlan`]'s single-mode structure written inline as `[structure.modal]`, its free
-/// analysis over `duration_s`, and the DEM damper at the design's point.
-pub fn decay_scenario(
+/// The study's coupling scenario with the structure replaced by `s` written inline as
+/// `[structure.modal]` (a structure reduced to one mode) and the DEM damper at the design's
+/// point; the caller sets `[analysis]`.
+fn single_mode_table(
     space: &Space,
     d: &Design,
-    plan: &DecayPlan,
-    duration_s: f64,
-) -> Result<String, DesignError> {
+    s: &pdamp_structure::modal::ModalStructure,
+) -> Result<toml::Table, DesignError> {
     let mut table = crate::report::scenario_table(space, d)?;
     table.remove("structure_file");
-    let s = &plan.structure;
     let points: Vec<toml::Value> = s
         .points
         .iter()
@@ -414,6 +452,19 @@ pub fn decay_scenario(
     structure.insert("modal".into(), toml::Value::Table(modal));
     table.insert("structure".into(), toml::Value::Table(structure));
     set_dem_damper(space, d, &mut table);
+    Ok(table)
+}
+
+/// The coupling scenario of a design's damping decay in one mode (max_damping, TOML): the
+/// [`DecayPlan`]'s single-mode structure written inline as `[structure.modal]`, its free
+/// analysis over `duration_s`, and the DEM damper at the design's point.
+pub fn decay_scenario(
+    space: &Space,
+    d: &Design,
+    plan: &DecayPlan,
+    duration_s: f64,
+) -> Result<String, DesignError> {
+    let mut table = single_mode_table(space, d, &plan.structure)?;
     let f = &plan.spec;
     let every = sample_every(space, d, duration_s);
     let analysis: toml::Table = toml::from_str(&format!(
@@ -427,19 +478,49 @@ pub fn decay_scenario(
     toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
 }
 
+/// The coupling scenario of a design's resonance sweep in one mode (forced objectives, TOML):
+/// the [`SweepPlan`]'s single-mode structure inline, its sweep (`kind = "sweep"`, sampled
+/// [`crate::resonance_sweep::SAMPLES_PER_PERIOD`] times per period of the highest frequency
+/// at the DEM step) and the DEM damper at the design's point.
+pub fn sweep_scenario(space: &Space, d: &Design, plan: &SweepPlan) -> Result<String, DesignError> {
+    let mut table = single_mode_table(space, d, &plan.structure)?;
+    let s = &plan.spec;
+    let top = s.sweep.start_hz.max(s.sweep.end_hz);
+    let every = ((1.0 / (crate::resonance_sweep::SAMPLES_PER_PERIOD * top)) / time_step_s(space, d))
+        .floor()
+        .max(1.0) as i64;
+    let analysis: toml::Table = toml::from_str(&format!(
+        "kind = \"sweep\"\nstart_hz = {:e}\nend_hz = {:e}\nduration_s = {:e}\n\
+         law = \"linear\"\nforce_amplitude_n = {:e}\nexcitation_point = \"{}\"\n\
+         output_point = \"{}\"\ntime_step_s = {:e}\nsample_every = {every}\nmode = 1\n",
+        s.sweep.start_hz,
+        s.sweep.end_hz,
+        s.sweep.duration_s,
+        s.force_amplitude_n,
+        s.excitation_point,
+        s.output_point,
+        s.time_step_s
+    ))
+    .map_err(|e| DesignError::Solver(e.to_string()))?;
+    table.insert("analysis".into(), toml::Value::Table(analysis));
+    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
+}
+
 /// How much longer than the formulas' decay a DEM decay runs: a DEM bed that damps less than
 /// the formulas predict still reaches (most of) the bottom of the amplitude range.
 pub const DEM_DECAY_MARGIN: f64 = 1.25;
 
 /// One coupled DEM run of a packing: writes the damper and coupling scenarios to `dir`, runs
-/// `pdamp couple` into `dir/out` and returns the decay at the output point and the run's
-/// energy closure (the larger of the bed ledger's and the coupling's, from `summary.json`).
+/// `pdamp couple` into `dir/out` and returns the history at the output point (`history`:
+/// `decay.csv` of a free analysis, `response.csv` of a sweep) and the run's energy closure
+/// (the larger of the bed ledger's and the coupling's, from `summary.json`).
 fn run_one(
     space: &Space,
     d: &Design,
     dir: &Path,
     seed: u64,
     couple: &str,
+    history: &str,
 ) -> Result<(pdamp_structure::free::TimeHistory, f64), DesignError> {
     std::fs::create_dir_all(dir).map_err(|e| DesignError::output(dir, e))?;
     let dscn = dir.join("damper.toml");
@@ -469,19 +550,19 @@ fn run_one(
         .iter()
         .map(|k| e[*k].as_f64().unwrap_or(f64::NAN))
         .fold(0.0_f64, |a, b| if b.is_nan() { f64::NAN } else { a.max(b) });
-    Ok((read_decay(&run_out.join("decay.csv"))?, closure))
+    Ok((read_decay(&run_out.join(history))?, closure))
 }
 
 /// Runs the coupled DEM of `d` on `[verification] packings` beds in `out/dem/design_RANK` and
 /// returns the objective of each: the stroke at the evaluation time (min_stroke), or ζ(X) of
 /// every mode from a free decay over the amplitude range (max_damping, one run per mode and
-/// packing, [`DecayPlan`] × [`DEM_DECAY_MARGIN`]). `level1` is the design's time-simulation
+/// packing, [`DecayPlan`] × [`DEM_DECAY_MARGIN`]), or each mode's resonance from a sine sweep
+/// (min_frf_peak, max_resonance_damping, [`crate::resonance_sweep`]). `level1` is the design's time-simulation
 /// evaluation (compared in the result). The cost (particles × steps) is reported through
 /// `progress` before the first run.
 ///
 /// # Errors
-/// Input, DEM and output errors (the message names the packing's directory); forced
-/// objectives (no coupled-DEM verification for them yet).
+/// Input, DEM and output errors (the message names the packing's directory).
 pub fn verify_design(
     space: &Space,
     d: &Design,
@@ -503,6 +584,7 @@ pub fn verify_design(
         stat: EnsembleStat::of(&[]),
         time_simulation: level1.stroke_m.unwrap_or(f64::NAN),
         modes: Vec::new(),
+        resonances: Vec::new(),
         time_step_s: dt,
         youngs_modulus_scale: v.youngs_modulus_scale,
         particles,
@@ -530,7 +612,8 @@ pub fn verify_design(
                     v.packings
                 ));
                 let dir = out.join(&rel).join(format!("packing_{}", p + 1));
-                let (hist, closure) = run_one(space, d, &dir, seed(space, p), &couple)?;
+                let (hist, closure) =
+                    run_one(space, d, &dir, seed(space, p), &couple, "decay.csv")?;
                 result.runs += 1;
                 result.energy_closure = result.energy_closure.max(closure);
                 result.values.push(pdamp_structure::study::stroke_at(
@@ -544,9 +627,7 @@ pub fn verify_design(
             damping_decays(space, d, level1, out, &mut result, progress)?;
         }
         ObjectiveSpec::MinFrfPeak { .. } | ObjectiveSpec::MaxResonanceDamping { .. } => {
-            return Err(DesignError::Solver(
-                "coupled-DEM verification of forced objectives is not available".into(),
-            ));
+            resonance_sweeps(space, d, level1, out, &mut result, progress)?;
         }
     }
     result.stat = EnsembleStat::of(&result.values);
@@ -646,7 +727,7 @@ fn damping_decays(
                 .join(format!("mode_{m}"));
             let duration = DEM_DECAY_MARGIN * plan.spec.duration_s;
             let couple = decay_scenario(space, d, plan, duration)?;
-            let (hist, closure) = run_one(space, d, &dir, seed(space, p), &couple)?;
+            let (hist, closure) = run_one(space, d, &dir, seed(space, p), &couple, "decay.csv")?;
             result.runs += 1;
             result.energy_closure = result.energy_closure.max(closure);
             per_mode[i].push(crate::fidelity::damping_curve_of(&hist, plan.period_s)?);
@@ -698,7 +779,174 @@ fn damping_decays(
     Ok(())
 }
 
-/// Reads `decay.csv` (time_s, displacement_m, …) of a coupled run.
+/// min_frf_peak, max_resonance_damping: per mode a [`SweepPlan`] at level 1's resonance
+/// (frequency and ζ of the steady-state FRF); one coupled-DEM sweep per packing and mode. After
+/// the first packing a mode's sweep is planned again once, around the DEM's peak and for the
+/// smaller ζ, if [`crate::resonance_sweep::replan_reason`] says so, and that packing runs
+/// again. Fills `result`'s values (mean relative peak or mean ζ over the modes) and resonances.
+fn resonance_sweeps(
+    space: &Space,
+    d: &Design,
+    level1: &crate::fidelity::Evaluation,
+    out: &Path,
+    result: &mut DemVerification,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(), DesignError> {
+    let st = space.study;
+    let v = &st.file.verification;
+    let rank = result.rank;
+    let rel = PathBuf::from(&result.dir);
+    let (ObjectiveSpec::MinFrfPeak {
+        modes,
+        frequencies,
+        band,
+    }
+    | ObjectiveSpec::MaxResonanceDamping {
+        modes,
+        frequencies,
+        band,
+    }) = &st.file.objective
+    else {
+        return Err(DesignError::Solver(
+            "resonance sweeps: a forced objective".into(),
+        ));
+    };
+    let peak_objective = matches!(st.file.objective, ObjectiveSpec::MinFrfPeak { .. });
+    result.objective = if peak_objective {
+        "relative_peak"
+    } else {
+        "mean_resonance_damping_ratio"
+    };
+    result.time_simulation = if peak_objective {
+        level1.cost
+    } else {
+        -level1.cost
+    };
+    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let structure = space.structure(d.choice);
+    let mut plans = Vec::new();
+    let mut level1_modes = Vec::new();
+    for &m in modes {
+        let k = m - 1;
+        let steady =
+            crate::fidelity::frf_resonance(st, structure, &dampers, k, *frequencies, *band)?;
+        let zeta = crate::fidelity::resonance_damping_ratio(st, structure, k, steady.modal_peak)?;
+        let bare = crate::fidelity::bare_peak_m(st, k)?;
+        level1_modes.push((steady, zeta, bare));
+        plans.push(crate::resonance_sweep::sweep_plan(
+            st,
+            structure,
+            &dampers,
+            k,
+            &steady,
+            SweepTarget {
+                centre_hz: steady.frequency_hz,
+                band_damping_ratio: zeta,
+                rate_damping_ratio: zeta,
+            },
+        )?);
+    }
+    let simulated: f64 = plans.iter().map(|p| p.summary.duration_s).sum();
+    result.estimated_particle_steps = announce(
+        progress,
+        result,
+        v.packings * plans.len(),
+        v.packings as f64 * simulated,
+    );
+    let mut peaks: Vec<Vec<forced::PeakDamping>> = vec![Vec::new(); plans.len()];
+    let mut replanned: Vec<Option<String>> = vec![None; plans.len()];
+    for p in 0..v.packings {
+        for (i, &m) in modes.iter().enumerate() {
+            let dir = out
+                .join(&rel)
+                .join(format!("packing_{}", p + 1))
+                .join(format!("mode_{m}"));
+            loop {
+                let plan = &plans[i];
+                progress(&format!(
+                    "design {rank}, packing {}/{}, mode {m}: coupled DEM sweep {:.3}–{:.3} Hz \
+                     in {:.1} s",
+                    p + 1,
+                    v.packings,
+                    plan.summary.start_hz,
+                    plan.summary.end_hz,
+                    plan.summary.duration_s
+                ));
+                let couple = sweep_scenario(space, d, plan)?;
+                let (hist, closure) =
+                    run_one(space, d, &dir, seed(space, p), &couple, "response.csv")?;
+                let pk = plan.peak_of(&hist).ok_or_else(|| {
+                    DesignError::Solver(format!(
+                        "{}: the sweep's response has no peak",
+                        dir.display()
+                    ))
+                })?;
+                let why = crate::resonance_sweep::replan_reason(&plan.summary, &pk);
+                if let Some(why) = why.filter(|_| p == 0 && replanned[i].is_none()) {
+                    progress(&format!(
+                        "design {rank}, mode {m}: sweep planned again: {why}"
+                    ));
+                    let (steady, zeta, _) = level1_modes[i];
+                    let k = m - 1;
+                    plans[i] = crate::resonance_sweep::sweep_plan(
+                        st,
+                        structure,
+                        &dampers,
+                        k,
+                        &steady,
+                        SweepTarget {
+                            centre_hz: pk.resonance_frequency_hz,
+                            band_damping_ratio: zeta.max(pk.damping_ratio),
+                            rate_damping_ratio: zeta.min(pk.damping_ratio),
+                        },
+                    )?;
+                    replanned[i] = Some(why);
+                    continue;
+                }
+                result.runs += 1;
+                result.energy_closure = result.energy_closure.max(closure);
+                peaks[i].push(pk);
+                break;
+            }
+        }
+    }
+    for (i, &m) in modes.iter().enumerate() {
+        let (steady, zeta, bare) = level1_modes[i];
+        let rel_peak: Vec<f64> = peaks[i].iter().map(|p| p.max_amplitude_m / bare).collect();
+        let zetas: Vec<f64> = peaks[i].iter().map(|p| p.damping_ratio).collect();
+        result.resonances.push(DemResonance {
+            mode: m,
+            relative_peak_stat: EnsembleStat::of(&rel_peak),
+            relative_peak: rel_peak,
+            damping_ratio_stat: EnsembleStat::of(&zetas),
+            damping_ratio: zetas,
+            resonance_frequency_hz: peaks[i].iter().map(|p| p.resonance_frequency_hz).collect(),
+            time_simulation: (steady.peak_m / bare, zeta, steady.frequency_hz),
+            sweep: plans[i].summary,
+            replanned: replanned[i].take(),
+        });
+    }
+    let n = modes.len() as f64;
+    result.values = (0..v.packings)
+        .map(|p| {
+            result
+                .resonances
+                .iter()
+                .map(|r| {
+                    if peak_objective {
+                        r.relative_peak[p]
+                    } else {
+                        r.damping_ratio[p]
+                    }
+                })
+                .sum::<f64>()
+                / n
+        })
+        .collect();
+    Ok(())
+}
+
+/// Reads `decay.csv` or `response.csv` (time_s, displacement_m, …) of a coupled run.
 fn read_decay(path: &Path) -> Result<pdamp_structure::free::TimeHistory, DesignError> {
     let text = std::fs::read_to_string(path).map_err(|e| DesignError::output(path, e))?;
     let mut h = pdamp_structure::free::TimeHistory::default();

@@ -272,17 +272,31 @@ fn equilibrium_peak(
     Ok(((phi_out * q).abs(), e.damping_ratio))
 }
 
+/// A resonance of the steady-state FRF (D Eq. 3.44, level 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrfResonance {
+    /// Peak amplitude at the output point, m.
+    pub peak_m: f64,
+    /// Peak of the modal coordinate Q_max.
+    pub modal_peak: f64,
+    /// Frequency of the peak, Hz.
+    pub frequency_hz: f64,
+}
+
 /// Resonance peak of mode `k` from the steady-state FRF (D Eq. 3.44, level 1) over ±`band`
-/// around the equilibrium frequency, `n` frequencies: (peak at the output point (m), peak of
-/// the modal coordinate Q_max).
-fn frf_peak(
+/// around the equilibrium frequency, `n` frequencies, then three zooms around the highest
+/// point.
+///
+/// # Errors
+/// Unknown points, a study without a harmonic load.
+pub fn frf_resonance(
     study: &DesignStudy,
     structure: &ModalStructure,
     dampers: &[CoupledDamper],
     k: usize,
     n: usize,
     band: f64,
-) -> Result<(f64, f64), DesignError> {
+) -> Result<FrfResonance, DesignError> {
     let c = mode_coupling(study, structure, dampers, k)?;
     let phi_out = structure
         .point(&study.free.output_point)
@@ -297,7 +311,7 @@ fn frf_peak(
     // the band, then three zooms around its highest point (a lightly damped peak is far
     // narrower than the band's spacing)
     let (mut lo, mut hi) = (f0 * (1.0 - band), f0 * (1.0 + band));
-    let mut q_max: f64 = 0.0;
+    let (mut q_max, mut f_max) = (0.0_f64, f0);
     for _ in 0..4 {
         let freqs: Vec<f64> = (0..n)
             .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
@@ -308,11 +322,38 @@ fn frf_peak(
             .map(|p| p.modal_amplitude.abs())
             .enumerate()
             .fold((0, 0.0), |a, (i, p)| if p > a.1 { (i, p) } else { a });
-        q_max = q_max.max(q);
+        if q > q_max {
+            (q_max, f_max) = (q, freqs[i_max]);
+        }
         let df = (hi - lo) / (n - 1) as f64;
         (lo, hi) = (freqs[i_max] - 2.0 * df, freqs[i_max] + 2.0 * df);
     }
-    Ok(((phi_out * q_max).abs(), q_max))
+    Ok(FrfResonance {
+        peak_m: (phi_out * q_max).abs(),
+        modal_peak: q_max,
+        frequency_hz: f_max,
+    })
+}
+
+/// D Eq. 3.47 with m = ω_k²/Ω_R² (Eq. 3.33): ζ = R/(2 Q_max ω_k²), R = φ_ex F.
+///
+/// # Errors
+/// Unknown excitation point, no harmonic load.
+pub fn resonance_damping_ratio(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    k: usize,
+    modal_peak: f64,
+) -> Result<f64, DesignError> {
+    let load = study
+        .load
+        .as_ref()
+        .ok_or_else(|| DesignError::Solver("a forced objective without a harmonic load".into()))?;
+    let phi_ex = structure
+        .point(&load.excitation_point)
+        .map_err(DesignError::Solver)?[k];
+    let wk = structure.modes[k].omega_rad_s();
+    Ok((phi_ex * load.force_n).abs() / (2.0 * modal_peak.max(1e-300) * wk * wk))
 }
 
 /// Cost of a forced objective: the mean relative peak (min_frf_peak) or −(mean ζ)
@@ -668,23 +709,15 @@ pub fn time_evaluation_by_mode<'a>(
             frequencies,
             band,
         } => {
-            let load = study.load.as_ref().ok_or_else(|| {
-                DesignError::Solver("a forced objective without a harmonic load".into())
-            })?;
             let mut peaks = Vec::new();
             let mut zetas = Vec::new();
             let mut rel = 0.0;
             for &m in modes {
                 let k = m - 1;
-                let (p, q_max) = frf_peak(study, structure, dampers_of(k), k, *frequencies, *band)?;
-                rel += p / bare_peak_m(study, k)?;
-                peaks.push(p);
-                // D Eq. 3.47 with m = ω_k²/Ω_R² (Eq. 3.33): ζ = R/(2 Q_max ω_k²)
-                let phi_ex = structure
-                    .point(&load.excitation_point)
-                    .map_err(DesignError::Solver)?[k];
-                let wk = structure.modes[k].omega_rad_s();
-                zetas.push((phi_ex * load.force_n).abs() / (2.0 * q_max.max(1e-300) * wk * wk));
+                let r = frf_resonance(study, structure, dampers_of(k), k, *frequencies, *band)?;
+                rel += r.peak_m / bare_peak_m(study, k)?;
+                peaks.push(r.peak_m);
+                zetas.push(resonance_damping_ratio(study, structure, k, r.modal_peak)?);
             }
             let cost = forced_cost(study, rel, &zetas);
             Ok((

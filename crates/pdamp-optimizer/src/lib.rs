@@ -15,7 +15,8 @@
 //! wall coating of the study, get the effective fields of their DEM beds ([`effective_fields`],
 //! approach 2, stored and reused) and are ranked by the structure's response with those fields;
 //! with `dem_designs = N` the best N listed designs are run with coupled DEM ([`dem`],
-//! approach 1). Both on an ensemble of dropped beds: the report gives the objective's mean and
+//! approach 1: free decays, or for the forced objectives a slow sine sweep through each
+//! resonance, [`resonance_sweep`]). Both on an ensemble of dropped beds: the report gives the objective's mean and
 //! 95 % confidence interval beside the formulas' value.
 //!
 //! \[D\] is the dissertation on the particle damper design toolchain.
@@ -27,6 +28,7 @@ pub mod effective_fields;
 mod error;
 pub mod fidelity;
 pub mod report;
+pub mod resonance_sweep;
 pub mod search;
 pub mod space;
 pub mod spec;

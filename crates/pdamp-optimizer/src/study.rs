@@ -711,15 +711,6 @@ impl DesignStudy {
                 format!("must be in [0, 20], got {}", v.dem_designs),
             ));
         }
-        if v.dem_designs > 0 && f.objective.is_forced() {
-            return Err(self.input(
-                "verification.dem_designs",
-                "the coupled-DEM verification is built for free decays (min_stroke, \
-                 max_damping); a forced objective's DEM frequency response is not built yet: \
-                 set 0 and use field_designs (the effective fields of the DEM beds, level 2, \
-                 which forced objectives take)",
-            ));
-        }
         if v.dem_designs > f.search.top {
             return Err(self.input(
                 "verification.dem_designs",

@@ -982,3 +982,86 @@ fn orientation_is_chosen_with_the_point() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Level 3 for a forced objective (min_frf_peak): a 22 Hz single-mode structure (1.514 kg,
+/// ζ = 0.01) under 30 N at the damper, a vertical 60 mm container of steel spheres r = 5 mm
+/// (≤ 32 by the mass limit), the best design as a dropped DEM bed softened × 0.01 on two
+/// packings. Each packing sweeps the resonance of the mode at the rate the formula dampers
+/// need; the DEM's peak and ζ (D Eq. 3.47) come from the largest response. Measured: formulas
+/// 0.458 of the bare peak in steady state but 0.259 on the same sweep (their steady-state FRF
+/// has an upper branch the sweep does not reach: the plan stops slowing down when the rate no
+/// longer moves the peak), DEM 0.224 ± 0.024 (−14 % against the same sweep), ζ 0.045; tolerance
+/// 30 % against the formulas' sweep. Energy ledgers close to 1e-3.
+#[test]
+fn coupled_dem_sweeps_the_resonance_of_a_forced_study() {
+    let dir = temp_dir("dem_forced");
+    std::fs::write(
+        dir.join("couple.toml"),
+        "[structure.single_mode]\nmass_kg = 1.514\nstiffness_n_m = 29568.0\n\
+         damping_n_s_m = 4.23\n\n[analysis]\nkind = \"steady_state\"\nstart_hz = 16.0\n\
+         end_hz = 28.0\npoints = 300\nforce_amplitude_n = 30.0\nexcitation_point = \"damper\"\n\
+         output_point = \"damper\"\nmode = 1\n",
+    )
+    .unwrap();
+    let p = dir.join("study.toml");
+    std::fs::write(
+        &p,
+        "scenario = \"couple.toml\"\n[objective]\nkind = \"min_frf_peak\"\nmodes = [1]\n\
+         [damper]\ndirection = \"vertical\"\npoints = [\"damper\"]\ncontainer_lengths_m = [0.06]\n\
+         container_width_m = 0.04\nparticle_radii_m = [0.005]\n[[materials]]\nname = \"steel\"\n\
+         density_kg_m3 = 7900.0\n[constraints]\nmax_bed_mass_kg = 0.14\n[verification]\n\
+         dem_designs = 1\npackings = 2\nyoungs_modulus_scale = 0.01\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let s = run_design_study_file(&p, &out).unwrap();
+    let d = &s["coupled_dem"][0];
+    assert_eq!(d["objective"], "relative_peak");
+    let v: Vec<f64> = d["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(v.len(), 2);
+    assert!(v[0] != v[1], "{v:?}");
+    let r = &d["resonances"][0];
+    assert_eq!(r["mode"], 1);
+    let steady = r["time_simulation"][0].as_f64().unwrap();
+    let bias = r["sweep"]["formula_sweep_peak_m"].as_f64().unwrap()
+        / r["sweep"]["steady_peak_m"].as_f64().unwrap();
+    let same_sweep = steady * bias;
+    let mean = d["stat"]["mean"].as_f64().unwrap();
+    assert!(
+        (mean / same_sweep - 1.0).abs() < 0.3,
+        "DEM {mean} vs formulas on the same sweep {same_sweep} (steady state {steady})"
+    );
+    assert!(mean > 0.0 && mean < 1.0, "{mean}");
+    let zeta = r["damping_ratio_stat"]["mean"].as_f64().unwrap();
+    assert!(zeta > 0.01 && zeta < 0.2, "{zeta}");
+    let f: Vec<f64> = r["resonance_frequency_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let (lo, hi) = (
+        r["sweep"]["start_hz"].as_f64().unwrap(),
+        r["sweep"]["end_hz"].as_f64().unwrap(),
+    );
+    assert!(f.iter().all(|&x| x > lo && x < hi), "{f:?} in {lo}–{hi}");
+    let closure = d["energy_closure"].as_f64().unwrap();
+    assert!(closure <= 1e-3, "energy closure {closure}");
+    for k in 1..=2 {
+        let run = out.join(format!("dem/design_1/packing_{k}/mode_1"));
+        let cscn = std::fs::read_to_string(run.join("couple.toml")).unwrap();
+        assert!(cscn.contains("kind = \"sweep\""), "{cscn}");
+        assert!(run.join("out/response.csv").is_file());
+    }
+    let csv = std::fs::read_to_string(out.join("dem_resonance.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Per mode at resonance") && report.contains("same sweep"));
+    assert_eq!(s["best"]["confirmed_by"], "coupled_dem");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -669,6 +669,33 @@ pub fn run_dem_sweep(
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
+    run_dem_sweep_with_energy(
+        structure,
+        damper,
+        damper_point,
+        spec,
+        opts,
+        progress,
+        checkpoint,
+    )
+    .map(|(h, _)| h)
+}
+
+/// [`run_dem_sweep`] that also returns the energy exchange [`DemEnergy`] (the shaker's work
+/// enters the structure's side: the coupling closure compares the structure's work on the bed
+/// with the walls' work on the particles, which the load does not touch).
+///
+/// # Errors
+/// See [`run_dem_sweep`].
+pub fn run_dem_sweep_with_energy(
+    structure: &ModalStructure,
+    damper: &Damper,
+    damper_point: &str,
+    spec: &SweepSpec,
+    opts: &DemCoupling,
+    progress: &mut dyn FnMut(f64),
+    checkpoint: Option<&CouplingCheckpoint>,
+) -> Result<(TimeHistory, DemEnergy), String> {
     spec.sweep.validate()?;
     let ex = structure.point(&spec.excitation_point)?.to_vec();
     let n = structure.modes.len();
@@ -686,5 +713,5 @@ pub fn run_dem_sweep(
         progress,
         checkpoint,
     )
-    .map(|r| r.history)
+    .map(|r| (r.history, r.energy))
 }

@@ -1,6 +1,6 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
-use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep};
+use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep, run_dem_sweep_with_energy};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
@@ -250,21 +250,34 @@ pub fn run_couple(
                 sample_every: *sample_every,
             };
             if *segments <= 1 {
-                let hist = match &dem {
+                let (hist, energy) = match &dem {
                     Some((p, d, o)) => {
-                        run_dem_sweep(&structure, d, p, &spec, o, progress, Some(&ck))?
+                        let (h, e) = run_dem_sweep_with_energy(
+                            &structure,
+                            d,
+                            p,
+                            &spec,
+                            o,
+                            progress,
+                            Some(&ck),
+                        )?;
+                        (h, Some(e))
                     }
-                    None => forced::run_sweep(&structure, &dampers, &spec)?,
+                    None => (forced::run_sweep(&structure, &dampers, &spec)?, None),
                 };
                 let frf = forced::sweep_frf(&hist, &spec.sweep, *window_cycles);
-                sweep_outputs(
+                let mut v = sweep_outputs(
                     &structure,
                     &spec,
                     &[(hist, sweep)],
                     frf,
                     mode.saturating_sub(1),
                     out,
-                )?
+                )?;
+                if let Some(e) = energy {
+                    v["energy_exchange"] = energy_exchange_json(&e);
+                }
+                v
             } else {
                 // Frequency-domain approach [D Sect. 3.3.2]: overlapping segments from rest,
                 // start-up transients cut off, FRFs combined by peak hold.
