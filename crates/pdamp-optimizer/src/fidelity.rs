@@ -335,6 +335,32 @@ pub fn frf_resonance(
     })
 }
 
+/// The steady-state FRF of mode `k` (D Eq. 3.44) at the output point under the study's force
+/// with the formula `dampers` (none: the bare structure): |φ_out Q| at every frequency, m.
+///
+/// # Errors
+/// Unknown points, a study without a harmonic load.
+pub fn steady_frf_at_output(
+    study: &DesignStudy,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    k: usize,
+    frequencies_hz: &[f64],
+) -> Result<Vec<f64>, DesignError> {
+    let c = mode_coupling(study, structure, dampers, k)?;
+    let phi_out = structure
+        .point(&study.free.output_point)
+        .map_err(DesignError::Solver)?[k];
+    let none: [CoupledDamper; 0] = [];
+    let model = Combined(if c.phi_pd == 0.0 { &none } else { dampers });
+    Ok(
+        pdamp_structure::forced::steady_state_frf(&c, &model, frequencies_hz)
+            .iter()
+            .map(|p| (phi_out * p.modal_amplitude).abs())
+            .collect(),
+    )
+}
+
 /// D Eq. 3.47 with m = ω_k²/Ω_R² (Eq. 3.33): ζ = R/(2 Q_max ω_k²), R = φ_ex F.
 ///
 /// # Errors

@@ -378,6 +378,9 @@ pub fn write_outputs(
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
     let (dem, dem_skipped) = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
+    if f.objective.is_forced() && frf_plots(space, &verified, &dem, out)? {
+        plots.push("frf.png");
+    }
     write(
         out,
         "designs.csv",
@@ -460,6 +463,114 @@ pub fn write_outputs(
         &serde_json::to_string_pretty(&summary).map_err(|e| DesignError::output(out, e))?,
     )?;
     Ok(summary)
+}
+
+/// Forced objectives: the steady-state FRF at the output point (D Eq. 3.44) of the bare
+/// structure and of the three best verified designs around every objective mode
+/// (`frf.csv`: `mode,frequency_hz,bare_m,design_1_m,…`), and in `frf.png` also the coupled-DEM
+/// sweeps of the first packing of every verified design (its `frf.csv` × the force). Returns
+/// whether the plot was written.
+fn frf_plots(
+    space: &Space,
+    verified: &[&Candidate],
+    dem: &[crate::dem::DemVerification],
+    out: &Path,
+) -> Result<bool, DesignError> {
+    let st = space.study;
+    let (ObjectiveSpec::MinFrfPeak { modes, band, .. }
+    | ObjectiveSpec::MaxResonanceDamping { modes, band, .. }) = &st.file.objective
+    else {
+        return Ok(false);
+    };
+    let force = st.load.as_ref().map_or(0.0, |l| l.force_n);
+    let top: Vec<&&Candidate> = verified.iter().take(3).collect();
+    let mut csv = String::from("mode,frequency_hz,bare_m");
+    for i in 0..top.len() {
+        let _ = write!(csv, ",design_{}_m", i + 1);
+    }
+    csv.push('\n');
+    let mut plot = LinePlot::new(
+        Axis::linear("frequency f (Hz)"),
+        Axis::log("amplitude at the output point x (m)"),
+    );
+    for &m in modes {
+        let k = m - 1;
+        let fk = st.structure.modes[k].frequency_hz;
+        // the bed's mass lowers the resonance: the band reaches further down than up
+        let (lo, hi) = (fk * (1.0 - 2.0 * band).max(0.05), fk * (1.0 + band));
+        let freqs: Vec<f64> = (0..400)
+            .map(|i| lo + (hi - lo) * i as f64 / 399.0)
+            .collect();
+        let mut columns = vec![crate::fidelity::steady_frf_at_output(
+            st,
+            &st.structure,
+            &[],
+            k,
+            &freqs,
+        )?];
+        for c in &top {
+            let dm = space
+                .coupled_dampers(&c.design)
+                .map_err(DesignError::Solver)?;
+            columns.push(crate::fidelity::steady_frf_at_output(
+                st,
+                space.structure(c.design.choice),
+                &dm,
+                k,
+                &freqs,
+            )?);
+        }
+        for (i, f) in freqs.iter().enumerate() {
+            let _ = write!(csv, "{m},{f:e}");
+            for col in &columns {
+                let _ = write!(csv, ",{:e}", col[i]);
+            }
+            csv.push('\n');
+        }
+        for (j, col) in columns.into_iter().enumerate() {
+            let label = if j == 0 {
+                format!("mode {m}, bare structure")
+            } else {
+                format!("mode {m}, design {j} (formulas)")
+            };
+            plot.series.push(Series::new(label, freqs.clone(), col));
+        }
+        for d in dem {
+            let path = out
+                .join(&d.dir)
+                .join("packing_1")
+                .join(format!("mode_{m}"))
+                .join("out")
+                .join("frf.csv");
+            if let Ok(text) = std::fs::read_to_string(&path) {
+                let (fs, xs): (Vec<f64>, Vec<f64>) = text
+                    .lines()
+                    .skip(1)
+                    .filter_map(|l| {
+                        let mut it = l.split(',');
+                        let f = it.next()?.parse::<f64>().ok()?;
+                        let h = it.next()?.parse::<f64>().ok()?;
+                        Some((f, h * force))
+                    })
+                    .unzip();
+                if !fs.is_empty() {
+                    plot.series.push(Series::new(
+                        format!("mode {m}, design {}, coupled DEM sweep (packing 1)", d.rank),
+                        fs,
+                        xs,
+                    ));
+                }
+            }
+        }
+    }
+    write(out, "frf.csv", &csv)?;
+    match line_plot(out.join("frf"), &plot) {
+        Ok(_) => Ok(true),
+        Err(e) => {
+            eprintln!("note: no frf.png: {e}");
+            Ok(false)
+        }
+    }
 }
 
 /// ζ(X) of the three best verified designs from level 1 (`damping_curve.csv` for the best,
@@ -1102,15 +1213,23 @@ fn report_md(
             );
         }
     }
-    let _ = writeln!(
-        r,
-        "\nζ over the amplitude range: `damping_curve.csv`, `damping.png`{}.",
-        if matches!(f.objective, ObjectiveSpec::MinStroke { .. }) {
-            "; the decays against the bare structure: `decay.png`"
-        } else {
-            ""
-        }
-    );
+    if f.objective.is_forced() {
+        let _ = writeln!(
+            r,
+            "\nThe steady-state FRFs of the best designs against the bare structure (and the \
+             coupled-DEM sweeps of level 3): `frf.csv`, `frf.png`."
+        );
+    } else {
+        let _ = writeln!(
+            r,
+            "\nζ over the amplitude range: `damping_curve.csv`, `damping.png`{}.",
+            if matches!(f.objective, ObjectiveSpec::MinStroke { .. }) {
+                "; the decays against the bare structure: `decay.png`"
+            } else {
+                ""
+            }
+        );
+    }
     r
 }
 
