@@ -48,7 +48,7 @@ pub struct DemVerification {
     pub time_step_s: f64,
     /// Factor applied to the particles' Young's modulus.
     pub youngs_modulus_scale: f64,
-    /// Particles of the bed.
+    /// Particles of the beds (all containers).
     pub particles: usize,
     /// Coupled runs made (packings, × modes for max_damping).
     pub runs: usize,
@@ -371,20 +371,43 @@ pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
     s
 }
 
-/// Replaces a coupling scenario's dampers by the design's DEM bed (`damper.toml` beside it)
-/// at the design's point.
+/// The damper scenario file of container `j` (0-based) of a design's run: `damper.toml`, then
+/// `damper_2.toml`, … beside the coupling scenario.
+fn damper_file(j: usize) -> String {
+    if j == 0 {
+        "damper.toml".into()
+    } else {
+        format!("damper_{}.toml", j + 1)
+    }
+}
+
+/// The drop seed of container `j` of the packing with seed `seed`: the packing's own for the
+/// first container, independent ones for the others (never another packing's).
+fn container_seed(seed: u64, j: usize) -> u64 {
+    if j == 0 {
+        seed
+    } else {
+        seed ^ (j as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    }
+}
+
+/// Replaces a coupling scenario's dampers by the design's DEM beds, one per container at its
+/// point ([`damper_file`] beside it).
 fn set_dem_damper(space: &Space, d: &Design, table: &mut toml::Table) {
-    let mut damper = toml::Table::new();
-    damper.insert("model".into(), toml::Value::String("dem".into()));
-    damper.insert(
-        "point".into(),
-        toml::Value::String(space.location(d.choice).point.clone()),
-    );
-    damper.insert("scenario".into(), toml::Value::String("damper.toml".into()));
-    table.insert(
-        "dampers".into(),
-        toml::Value::Array(vec![toml::Value::Table(damper)]),
-    );
+    let dampers = space
+        .location(d.choice)
+        .points
+        .iter()
+        .enumerate()
+        .map(|(j, point)| {
+            let mut damper = toml::Table::new();
+            damper.insert("model".into(), toml::Value::String("dem".into()));
+            damper.insert("point".into(), toml::Value::String(point.clone()));
+            damper.insert("scenario".into(), toml::Value::String(damper_file(j)));
+            toml::Value::Table(damper)
+        })
+        .collect();
+    table.insert("dampers".into(), toml::Value::Array(dampers));
 }
 
 /// Sampling interval (DEM steps) for about 4000 samples of a decay of `duration_s`.
@@ -510,7 +533,8 @@ pub fn sweep_scenario(space: &Space, d: &Design, plan: &SweepPlan) -> Result<Str
 /// the formulas predict still reaches (most of) the bottom of the amplitude range.
 pub const DEM_DECAY_MARGIN: f64 = 1.25;
 
-/// One coupled DEM run of a packing: writes the damper and coupling scenarios to `dir`, runs
+/// One coupled DEM run of a packing: writes the damper scenario of every container (each its
+/// own drop) and the coupling scenario to `dir`, runs
 /// `pdamp couple` into `dir/out` and returns the history at the output point (`history`:
 /// `decay.csv` of a free analysis, `response.csv` of a sweep) and the run's energy closure
 /// (the larger of the bed ledger's and the coupling's, from `summary.json`).
@@ -523,9 +547,12 @@ fn run_one(
     history: &str,
 ) -> Result<(pdamp_structure::free::TimeHistory, f64), DesignError> {
     std::fs::create_dir_all(dir).map_err(|e| DesignError::output(dir, e))?;
-    let dscn = dir.join("damper.toml");
-    pdamp_io::atomic::write_atomic(&dscn, damper_scenario(space, d, seed).as_bytes())
-        .map_err(|e| DesignError::output(&dscn, e))?;
+    for j in 0..space.location(d.choice).points.len() {
+        let dscn = dir.join(damper_file(j));
+        let text = damper_scenario(space, d, container_seed(seed, j));
+        pdamp_io::atomic::write_atomic(&dscn, text.as_bytes())
+            .map_err(|e| DesignError::output(&dscn, e))?;
+    }
     let cscn = dir.join("couple.toml");
     pdamp_io::atomic::write_atomic(&cscn, couple.as_bytes())
         .map_err(|e| DesignError::output(&cscn, e))?;
@@ -576,7 +603,9 @@ pub fn verify_design(
     let rel = PathBuf::from(format!("dem/design_{rank}"));
     let started = std::time::Instant::now();
     let dt = time_step_s(space, d);
-    let particles: usize = d.particles.iter().sum();
+    // every container carries the design's bed
+    let particles: usize =
+        d.particles.iter().sum::<usize>() * space.location(d.choice).points.len();
     let mut result = DemVerification {
         rank,
         objective: "stroke_m",

@@ -377,7 +377,7 @@ pub fn write_outputs(
         }
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
-    let (dem, dem_skipped) = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
+    let dem = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
     if f.objective.is_forced() && frf_plots(space, &verified, &dem, out)? {
         plots.push("frf.png");
     }
@@ -440,7 +440,6 @@ pub fn write_outputs(
         "effective_field_points": fields.iter().flat_map(|e| e.fields.iter().map(|m| m.points)).sum::<usize>(),
         "effective_field_points_reused": fields.iter().flat_map(|e| e.fields.iter().map(|m| m.reused_points)).sum::<usize>(),
         "coupled_dem": dem,
-        "coupled_dem_skipped_several_containers": dem_skipped,
         "coupled_dem_runs": dem.iter().map(|d| d.runs).sum::<usize>(),
         "best_by_coupled_dem": best_by_dem(&dem)
             .map(|d| json!({"rank": d.rank, "objective": d.objective, "mean": d.stat.mean,
@@ -653,10 +652,9 @@ fn level1_damping_curves(
     Ok((plot, plots))
 }
 
-/// Level 3 of [`write_outputs`]: coupled DEM of the best single-container designs,
-/// `dem.csv`, for max_damping `dem_damping_curve.csv` and the DEM curves in `damping.png`, for
-/// the forced objectives `dem_resonance.csv`.
-/// Returns the verifications and the ranks skipped for having several containers.
+/// Level 3 of [`write_outputs`]: coupled DEM of the best designs (every container its own
+/// dropped bed in one run), `dem.csv`, for max_damping `dem_damping_curve.csv` and the DEM
+/// curves in `damping.png`, for the forced objectives `dem_resonance.csv`.
 fn dem_level(
     space: &Space,
     top: &[&Candidate],
@@ -664,16 +662,10 @@ fn dem_level(
     plot: &mut LinePlot,
     plots: &mut Vec<&'static str>,
     progress: &mut dyn FnMut(&str),
-) -> Result<(Vec<crate::dem::DemVerification>, Vec<usize>), DesignError> {
+) -> Result<Vec<crate::dem::DemVerification>, DesignError> {
     let f = &space.study.file;
     let mut dem = Vec::new();
-    let mut dem_skipped = Vec::new();
     for (i, c) in top.iter().take(f.verification.dem_designs).enumerate() {
-        if space.location(c.design.choice).points.len() > 1 {
-            // `pdamp couple` couples one DEM bed per run
-            dem_skipped.push(i + 1);
-            continue;
-        }
         let level1 = c.time.as_ref().expect("verified");
         dem.push(crate::dem::verify_design(
             space,
@@ -742,7 +734,7 @@ fn dem_level(
             Err(e) => eprintln!("note: no damping.png: {e}"),
         }
     }
-    Ok((dem, dem_skipped))
+    Ok(dem)
 }
 
 /// `dem.csv`: one row per design and packing.
@@ -1161,18 +1153,6 @@ fn report_md(
     if !fields.is_empty() {
         r.push_str(&fields_section(space, fields));
         let _ = writeln!(r);
-    }
-    if let Some(skipped) = s["coupled_dem_skipped_several_containers"].as_array()
-        && !skipped.is_empty()
-    {
-        let ranks: Vec<String> = skipped.iter().map(|v| v.to_string()).collect();
-        let _ = writeln!(
-            r,
-            "Design(s) {} have several containers: coupled DEM couples one DEM bed per run, so \
-             they are not run with coupled DEM (level 2, `field_designs`, couples every \
-             container to its DEM field).\n",
-            ranks.join(", ")
-        );
     }
     if !dem.is_empty() {
         let level2: Vec<Option<&FieldEvaluation>> = dem

@@ -100,6 +100,12 @@ struct CoupledState {
     energy: DemEnergy,
     #[serde(default)]
     q_load: Option<DVector<f64>>,
+    /// The worlds of the beds after the first (several DEM dampers).
+    #[serde(default)]
+    more_worlds: Vec<WorldState>,
+    /// Their last raw loads.
+    #[serde(default)]
+    more_q_load: Vec<DVector<f64>>,
 }
 
 /// Container motion over one step: the structure's state at `t1` extrapolated quadratically.
@@ -311,106 +317,124 @@ struct CoupledResult {
     energy: DemEnergy,
 }
 
-#[allow(clippy::too_many_arguments)] // private driver shared by the two public entry points
-fn coupled_run(
-    structure: &ModalStructure,
-    damper: &Damper,
-    damper_point: &str,
-    output_point: &str,
-    opts: &DemCoupling,
-    q0: DVector<f64>,
-    v0: DVector<f64>,
-    duration_s: f64,
-    sample_every: usize,
-    load: Load,
-    progress: &mut dyn FnMut(f64),
-    ck: Option<&CouplingCheckpoint>,
-) -> Result<CoupledResult, String> {
-    use pdamp_io::checkpoint as cp;
-    structure.validate()?;
-    let kin = resolve_kinematics(structure, damper, damper_point, &opts.kinematics)?;
-    let out = structure.point(output_point)?.to_vec();
-    let dt = damper.time_step_s;
-    crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
-        .map_err(|e| format!("{e} (the time step is the damper scenario's)"))?;
-    let mut it = ModalIntegrator::new(structure, dt);
-    it.q = q0;
-    it.v = v0;
-    let mut w = damper.settled.clone();
-    let c = damper.container;
-    w.dt_s = dt;
-    match &kin {
-        Resolved::OneD { pd, e } => {
-            let x0 = it.displacement(pd);
-            let vx0 = it.velocity(pd);
-            // Move the settled bed with the container's initial displacement and velocity.
-            for (p, v) in w
-                .particles
-                .position
-                .iter_mut()
-                .zip(w.particles.velocity.iter_mut())
-            {
-                *p += e * x0;
-                *v += e * vx0;
-            }
-            w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
-                direction: *e,
-                t1: 0.0,
-                x1: x0,
-                v1: vx0,
-                a1: 0.0,
-            }));
-        }
-        Resolved::Rigid(r) => {
-            let (u0, du0) = (RigidRows::vec(&r.tr, &it.q), RigidRows::vec(&r.tr, &it.v));
-            let (th0, dth0) = (r.rot_vec(&it.q), r.rot_vec(&it.v));
-            let rot = Rotation::from_scaled_axis(th0);
-            for (p, v) in w
-                .particles
-                .position
-                .iter_mut()
-                .zip(w.particles.velocity.iter_mut())
-            {
-                let rel = rot.transform_vector(&(*p - r.attach));
-                *p = r.attach + u0 + rel;
-                *v = rot.transform_vector(v) + du0 + dth0.cross(&rel);
-            }
-            for wv in w.particles.angular_velocity.iter_mut() {
-                *wv = rot.transform_vector(wv) + dth0;
-            }
-            w.bodies[c].motion = Motion::Prescribed(Arc::new(RigidTrack {
-                t1: 0.0,
-                u1: u0,
-                v1: du0,
-                a1: Vec3::zeros(),
-                th1: th0,
-                w1: dth0,
-                al1: Vec3::zeros(),
-                arm: r.arm,
-                rotate: r.rot.is_some(),
-            }));
-        }
-    }
-    w.restart_clock();
-    let weight1d = match (&kin, opts.compensate_static_weight) {
-        (Resolved::OneD { e, .. }, true) => damper.bed_mass_kg * w.gravity_m_s2.dot(e),
-        _ => 0.0,
-    };
-    let weight = if opts.compensate_static_weight {
-        w.gravity_m_s2 * damper.bed_mass_kg
-    } else {
-        Vec3::zeros()
-    };
-    // Generalized loads of the particles on the container at the modal state q: the one
-    // entering the modal equations (static weight compensated if asked) and the raw one (for
-    // the work the structure does on the bed).
-    let bed_load = |w: &pdamp_dem::World, q: &DVector<f64>| -> (DVector<f64>, DVector<f64>) {
-        let b = &w.bodies[c];
+/// One DEM bed of a coupled run: a settled damper, the structure point its container
+/// follows and the coupling options.
+#[derive(Debug, Clone, Copy)]
+pub struct DemBed<'a> {
+    /// The settled bed in its container.
+    pub damper: &'a Damper,
+    /// The structure point of the container (1D kinematics; the rigid kinematics name their
+    /// own points).
+    pub point: &'a str,
+    /// Kinematics and static-weight compensation.
+    pub coupling: &'a DemCoupling,
+}
+
+/// One bed during a coupled run: its world, kinematics and the last raw load.
+struct BedRun {
+    w: pdamp_dem::World,
+    c: usize,
+    kin: Resolved,
+    weight1d: f64,
+    weight: Vec3,
+    compensate: bool,
+    q_raw: DVector<f64>,
+}
+
+impl BedRun {
+    /// The bed of `b` moved to the structure's initial state (`it`).
+    fn start(structure: &ModalStructure, b: &DemBed, it: &ModalIntegrator) -> Result<Self, String> {
+        let damper = b.damper;
+        let kin = resolve_kinematics(structure, damper, b.point, &b.coupling.kinematics)?;
+        let mut w = damper.settled.clone();
+        let c = damper.container;
+        w.dt_s = damper.time_step_s;
         match &kin {
+            Resolved::OneD { pd, e } => {
+                let x0 = it.displacement(pd);
+                let vx0 = it.velocity(pd);
+                // Move the settled bed with the container's initial displacement and velocity.
+                for (p, v) in w
+                    .particles
+                    .position
+                    .iter_mut()
+                    .zip(w.particles.velocity.iter_mut())
+                {
+                    *p += e * x0;
+                    *v += e * vx0;
+                }
+                w.bodies[c].motion = Motion::Prescribed(Arc::new(Track {
+                    direction: *e,
+                    t1: 0.0,
+                    x1: x0,
+                    v1: vx0,
+                    a1: 0.0,
+                }));
+            }
+            Resolved::Rigid(r) => {
+                let (u0, du0) = (RigidRows::vec(&r.tr, &it.q), RigidRows::vec(&r.tr, &it.v));
+                let (th0, dth0) = (r.rot_vec(&it.q), r.rot_vec(&it.v));
+                let rot = Rotation::from_scaled_axis(th0);
+                for (p, v) in w
+                    .particles
+                    .position
+                    .iter_mut()
+                    .zip(w.particles.velocity.iter_mut())
+                {
+                    let rel = rot.transform_vector(&(*p - r.attach));
+                    *p = r.attach + u0 + rel;
+                    *v = rot.transform_vector(v) + du0 + dth0.cross(&rel);
+                }
+                for wv in w.particles.angular_velocity.iter_mut() {
+                    *wv = rot.transform_vector(wv) + dth0;
+                }
+                w.bodies[c].motion = Motion::Prescribed(Arc::new(RigidTrack {
+                    t1: 0.0,
+                    u1: u0,
+                    v1: du0,
+                    a1: Vec3::zeros(),
+                    th1: th0,
+                    w1: dth0,
+                    al1: Vec3::zeros(),
+                    arm: r.arm,
+                    rotate: r.rot.is_some(),
+                }));
+            }
+        }
+        w.restart_clock();
+        let compensate = b.coupling.compensate_static_weight;
+        let weight1d = match (&kin, compensate) {
+            (Resolved::OneD { e, .. }, true) => damper.bed_mass_kg * w.gravity_m_s2.dot(e),
+            _ => 0.0,
+        };
+        let weight = if compensate {
+            w.gravity_m_s2 * damper.bed_mass_kg
+        } else {
+            Vec3::zeros()
+        };
+        let mut bed = BedRun {
+            w,
+            c,
+            kin,
+            weight1d,
+            weight,
+            compensate,
+            q_raw: DVector::zeros(structure.modes.len()),
+        };
+        bed.q_raw = bed.load(&it.q).1;
+        Ok(bed)
+    }
+
+    /// Generalized loads of the particles on the container at the modal state q: the one
+    /// entering the modal equations (static weight compensated if asked) and the raw one (for
+    /// the work the structure does on the bed).
+    fn load(&self, q: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+        let b = &self.w.bodies[self.c];
+        match &self.kin {
             Resolved::OneD { pd, e } => {
                 let f = b.contact_force_n.dot(e);
                 (
-                    generalized_force(pd, f - weight1d),
+                    generalized_force(pd, f - self.weight1d),
                     generalized_force(pd, f),
                 )
             }
@@ -423,78 +447,18 @@ fn coupled_run(
                     t += lever.cross(&f);
                 }
                 let raw = r.project(&f, &t);
-                if opts.compensate_static_weight {
-                    (r.project(&(f - weight), &(t - r.static_torque)), raw)
+                if self.compensate {
+                    (r.project(&(f - self.weight), &(t - r.static_torque)), raw)
                 } else {
                     (raw.clone(), raw)
                 }
             }
         }
-    };
-    let f_ex = |t: f64| match &load {
-        Load::Free => DVector::zeros(structure.modes.len()),
-        Load::Sweep(s, ex) => {
-            generalized_force(ex, s.force_amplitude_n * s.sweep.phase_rad(t).cos())
-        }
-    };
-    let f_ex_scalar = |t: f64| match &load {
-        Load::Free => 0.0,
-        Load::Sweep(s, _) => s.force_amplitude_n * s.sweep.phase_rad(t).cos(),
-    };
-    let (q_pd, mut q_raw) = bed_load(&w, &it.q);
-    it.make_consistent(&(f_ex(0.0) + q_pd));
-    let e_structure0 = it.energy_j();
-    let mut energy = DemEnergy::default();
-    let mut hist = TimeHistory::default();
-    let push = |it: &ModalIntegrator, h: &mut TimeHistory| {
-        h.time_s.push(it.time_s);
-        h.displacement_m.push(it.displacement(&out));
-        h.velocity_m_s.push(it.velocity(&out));
-        h.force_n.push(f_ex_scalar(it.time_s));
-    };
-    push(&it, &mut hist);
-    let mut first = 1;
-    let header = ck.map(|c| cp::CheckpointHeader::new(COUPLE_KIND, &c.inputs_digest));
-    if let Some(c) = ck.filter(|c| c.resume)
-        && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)?
-    {
-        w.restore_state(st.world)?;
-        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
-        hist.time_s = st.time;
-        hist.displacement_m = st.displacement;
-        hist.velocity_m_s = st.velocity;
-        hist.force_n = st.force;
-        energy = st.energy;
-        if let Some(ql) = st.q_load {
-            q_raw = ql;
-        }
-        first = st.step + 1;
     }
-    let _stoppable = ck.map(|_| cp::StoppableSection::enter());
-    let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
-    let n_steps = (duration_s / dt).round() as usize;
-    // The bed in ParaView: a frame every `interval_s` (frames of a resumed run's earlier steps
-    // are the interrupted run's).
-    let mut snapshots = match ck.and_then(|c| c.bed_vtk.as_ref()) {
-        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
-            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
-        }),
-        None => None,
-    };
-    if let Some(s) = snapshots.as_mut() {
-        if first > 1 {
-            s.resume_after((first - 1) as u64, dt, &w)?;
-        } else {
-            s.on_step(0, 0.0, &w)?;
-        }
-    }
-    let every = sample_every.max(1);
-    let report = (n_steps / 200).max(1);
-    for step in first..=n_steps {
-        let t1 = step as f64 * dt;
-        let q_prev = it.q.clone();
-        it.verlet_drift();
-        w.bodies[c].motion = match &kin {
+
+    /// The container's motion over the step to `t1`: the structure's state at `t1`.
+    fn follow(&mut self, it: &ModalIntegrator, t1: f64, dt: f64) {
+        self.w.bodies[self.c].motion = match &self.kin {
             Resolved::OneD { pd, e } => Motion::Prescribed(Arc::new(Track {
                 direction: *e,
                 t1,
@@ -517,26 +481,164 @@ fn coupled_run(
                 }))
             }
         };
-        w.dt_s = t1 - w.time_s;
-        w.step();
-        let (q_pd, q_new) = bed_load(&w, &it.q);
-        energy.structure_work_on_bed_j -= 0.5 * (&q_raw + &q_new).dot(&(&it.q - &q_prev));
-        q_raw = q_new;
-        it.verlet_kick(&(f_ex(t1) + &q_pd));
-        if !q_pd.iter().all(|x| x.is_finite()) || !w.ledger.kinetic_j.is_finite() {
+    }
+}
+
+#[allow(clippy::too_many_arguments)] // private driver shared by the public entry points
+fn coupled_run(
+    structure: &ModalStructure,
+    beds: &[DemBed],
+    output_point: &str,
+    q0: DVector<f64>,
+    v0: DVector<f64>,
+    duration_s: f64,
+    sample_every: usize,
+    load: Load,
+    progress: &mut dyn FnMut(f64),
+    ck: Option<&CouplingCheckpoint>,
+) -> Result<CoupledResult, String> {
+    use pdamp_io::checkpoint as cp;
+    structure.validate()?;
+    let first_bed = beds.first().ok_or("a coupled DEM run needs a DEM bed")?;
+    let out = structure.point(output_point)?.to_vec();
+    let dt = first_bed.damper.time_step_s;
+    for (i, b) in beds.iter().enumerate() {
+        if b.damper.time_step_s != dt {
             return Err(format!(
-                "numerical failure at t = {t1:e} s: the DEM bed's load on the structure became \
-                 non-finite (bed kinetic energy {:e} J); likely cause: the damper scenario's \
-                 time step {dt:e} s against its contact stiffness (check it with `pdamp check`)",
-                w.ledger.kinetic_j
+                "DEM bed {} at '{}': time step {:e} s, but bed 1's is {dt:e} s; the beds of one \
+                 coupled run step together: give their damper scenarios the same time_step_s",
+                i + 1,
+                b.point,
+                b.damper.time_step_s
             ));
         }
+    }
+    crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
+        .map_err(|e| format!("{e} (the time step is the damper scenario's)"))?;
+    let mut it = ModalIntegrator::new(structure, dt);
+    it.q = q0;
+    it.v = v0;
+    let mut runs = beds
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            BedRun::start(structure, b, &it)
+                .map_err(|e| format!("DEM bed {} at '{}': {e}", i + 1, b.point))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let total_load = |runs: &[BedRun], q: &DVector<f64>| -> (DVector<f64>, Vec<DVector<f64>>) {
+        let mut sum = DVector::zeros(q.len());
+        let mut raw = Vec::with_capacity(runs.len());
+        for r in runs {
+            let (l, rw) = r.load(q);
+            sum += l;
+            raw.push(rw);
+        }
+        (sum, raw)
+    };
+    let f_ex = |t: f64| match &load {
+        Load::Free => DVector::zeros(structure.modes.len()),
+        Load::Sweep(s, ex) => {
+            generalized_force(ex, s.force_amplitude_n * s.sweep.phase_rad(t).cos())
+        }
+    };
+    let f_ex_scalar = |t: f64| match &load {
+        Load::Free => 0.0,
+        Load::Sweep(s, _) => s.force_amplitude_n * s.sweep.phase_rad(t).cos(),
+    };
+    let (q_pd, _) = total_load(&runs, &it.q);
+    it.make_consistent(&(f_ex(0.0) + q_pd));
+    let e_structure0 = it.energy_j();
+    let mut energy = DemEnergy::default();
+    let mut hist = TimeHistory::default();
+    let push = |it: &ModalIntegrator, h: &mut TimeHistory| {
+        h.time_s.push(it.time_s);
+        h.displacement_m.push(it.displacement(&out));
+        h.velocity_m_s.push(it.velocity(&out));
+        h.force_n.push(f_ex_scalar(it.time_s));
+    };
+    push(&it, &mut hist);
+    let mut first = 1;
+    let header = ck.map(|c| cp::CheckpointHeader::new(COUPLE_KIND, &c.inputs_digest));
+    if let Some(c) = ck.filter(|c| c.resume)
+        && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)?
+    {
+        if st.more_worlds.len() + 1 != runs.len() {
+            return Err(format!(
+                "{}: a checkpoint of {} DEM bed(s), the scenario has {}",
+                c.path.display(),
+                st.more_worlds.len() + 1,
+                runs.len()
+            ));
+        }
+        let worlds = std::iter::once(st.world).chain(st.more_worlds);
+        for (r, ws) in runs.iter_mut().zip(worlds) {
+            r.w.restore_state(ws)?;
+        }
+        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
+        hist.time_s = st.time;
+        hist.displacement_m = st.displacement;
+        hist.velocity_m_s = st.velocity;
+        hist.force_n = st.force;
+        energy = st.energy;
+        let loads = st.q_load.into_iter().chain(st.more_q_load);
+        for (r, ql) in runs.iter_mut().zip(loads) {
+            r.q_raw = ql;
+        }
+        first = st.step + 1;
+    }
+    let _stoppable = ck.map(|_| cp::StoppableSection::enter());
+    let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
+    let n_steps = (duration_s / dt).round() as usize;
+    // The first bed in ParaView: a frame every `interval_s` (frames of a resumed run's earlier
+    // steps are the interrupted run's).
+    let mut snapshots = match ck.and_then(|c| c.bed_vtk.as_ref()) {
+        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
+            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
+        }),
+        None => None,
+    };
+    if let Some(s) = snapshots.as_mut() {
+        if first > 1 {
+            s.resume_after((first - 1) as u64, dt, &runs[0].w)?;
+        } else {
+            s.on_step(0, 0.0, &runs[0].w)?;
+        }
+    }
+    let every = sample_every.max(1);
+    let report = (n_steps / 200).max(1);
+    for step in first..=n_steps {
+        let t1 = step as f64 * dt;
+        let q_prev = it.q.clone();
+        it.verlet_drift();
+        let mut q_pd = f_ex(t1);
+        for (i, r) in runs.iter_mut().enumerate() {
+            r.follow(&it, t1, dt);
+            r.w.dt_s = t1 - r.w.time_s;
+            r.w.step();
+            let (l, q_new) = r.load(&it.q);
+            energy.structure_work_on_bed_j -= 0.5 * (&r.q_raw + &q_new).dot(&(&it.q - &q_prev));
+            r.q_raw = q_new;
+            if !l.iter().all(|x| x.is_finite()) || !r.w.ledger.kinetic_j.is_finite() {
+                return Err(format!(
+                    "numerical failure at t = {t1:e} s: the load of DEM bed {} ('{}') on the \
+                     structure became non-finite (bed kinetic energy {:e} J); likely cause: \
+                     the damper scenario's time step {dt:e} s against its contact stiffness \
+                     (check it with `pdamp check`)",
+                    i + 1,
+                    beds[i].point,
+                    r.w.ledger.kinetic_j
+                ));
+            }
+            q_pd += l;
+        }
+        it.verlet_kick(&q_pd);
         it.check_health(structure, step == n_steps)?;
         if step % every == 0 {
             push(&it, &mut hist);
         }
         if let Some(s) = snapshots.as_mut() {
-            s.on_step(step as u64, t1, &w)?;
+            s.on_step(step as u64, t1, &runs[0].w)?;
         }
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);
@@ -550,13 +652,15 @@ fn coupled_run(
                     q: it.q.clone(),
                     v: it.v.clone(),
                     a: it.a.clone(),
-                    world: w.save_state(),
+                    world: runs[0].w.save_state(),
                     time: hist.time_s.clone(),
                     displacement: hist.displacement_m.clone(),
                     velocity: hist.velocity_m_s.clone(),
                     force: hist.force_n.clone(),
                     energy,
-                    q_load: Some(q_raw.clone()),
+                    q_load: Some(runs[0].q_raw.clone()),
+                    more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
+                    more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
                 };
                 cp::save(&c.path, h, &st)?;
                 if stop {
@@ -569,11 +673,13 @@ fn coupled_run(
             }
         }
     }
-    let l = &w.ledger;
-    energy.wall_work_j = l.wall_work_j;
-    energy.bed_energy_change_j = l.total_mechanical_j()
-        - (l.initial_kinetic_j + l.initial_potential_j + l.initial_elastic_j);
-    energy.dissipated_j = l.dissipated_j();
+    for r in &runs {
+        let l = &r.w.ledger;
+        energy.wall_work_j += l.wall_work_j;
+        energy.bed_energy_change_j += l.total_mechanical_j()
+            - (l.initial_kinetic_j + l.initial_potential_j + l.initial_elastic_j);
+        energy.dissipated_j += l.dissipated_j();
+    }
     energy.structure_energy_change_j = it.energy_j() - e_structure0;
     Ok(CoupledResult {
         history: hist,
@@ -619,6 +725,27 @@ pub fn run_dem_free_with_energy(
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<(TimeHistory, DemEnergy), String> {
+    let bed = DemBed {
+        damper,
+        point: damper_point,
+        coupling: opts,
+    };
+    run_dem_free_beds(structure, &[bed], spec, progress, checkpoint)
+}
+
+/// Free vibration with several DEM beds (one per container, each at its point), stepped
+/// together with the structure; the energy exchange sums the beds. With
+/// `scale_initial_by_bed_mass` the release is scaled by the beds' total mass (D Eq. 5.19).
+///
+/// # Errors
+/// See [`run_dem_free`]; beds with different time steps.
+pub fn run_dem_free_beds(
+    structure: &ModalStructure,
+    beds: &[DemBed],
+    spec: &FreeVibrationSpec,
+    progress: &mut dyn FnMut(f64),
+    checkpoint: Option<&CouplingCheckpoint>,
+) -> Result<(TimeHistory, DemEnergy), String> {
     let init = structure.point(&spec.initial_point)?;
     let k = spec.mode;
     if k >= structure.modes.len() || init[k] == 0.0 {
@@ -632,7 +759,8 @@ pub fn run_dem_free_with_energy(
     let mut q0 = DVector::zeros(n);
     let mut v0 = DVector::zeros(n);
     let scale = if spec.scale_initial_by_bed_mass {
-        crate::free::bed_mass_scale(init[k], damper.bed_mass_kg)
+        let mass: f64 = beds.iter().map(|b| b.damper.bed_mass_kg).sum();
+        crate::free::bed_mass_scale(init[k], mass)
     } else {
         1.0
     };
@@ -640,10 +768,8 @@ pub fn run_dem_free_with_energy(
     v0[k] = scale * spec.initial_velocity_m_s / init[k];
     let r = coupled_run(
         structure,
-        damper,
-        damper_point,
+        beds,
         &spec.output_point,
-        opts,
         q0,
         v0,
         spec.duration_s,
@@ -669,30 +795,25 @@ pub fn run_dem_sweep(
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<TimeHistory, String> {
-    run_dem_sweep_with_energy(
-        structure,
+    let bed = DemBed {
         damper,
-        damper_point,
-        spec,
-        opts,
-        progress,
-        checkpoint,
-    )
-    .map(|(h, _)| h)
+        point: damper_point,
+        coupling: opts,
+    };
+    run_dem_sweep_beds(structure, &[bed], spec, progress, checkpoint).map(|(h, _)| h)
 }
 
-/// [`run_dem_sweep`] that also returns the energy exchange [`DemEnergy`] (the shaker's work
-/// enters the structure's side: the coupling closure compares the structure's work on the bed
-/// with the walls' work on the particles, which the load does not touch).
+/// [`run_dem_sweep`] with several DEM beds, returning the energy exchange [`DemEnergy`] too
+/// (the shaker's work enters the structure's side: the coupling closure compares the
+/// structure's work on the beds with the walls' work on the particles, which the load does not
+/// touch).
 ///
 /// # Errors
-/// See [`run_dem_sweep`].
-pub fn run_dem_sweep_with_energy(
+/// See [`run_dem_sweep`]; beds with different time steps.
+pub fn run_dem_sweep_beds(
     structure: &ModalStructure,
-    damper: &Damper,
-    damper_point: &str,
+    beds: &[DemBed],
     spec: &SweepSpec,
-    opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
 ) -> Result<(TimeHistory, DemEnergy), String> {
@@ -701,10 +822,8 @@ pub fn run_dem_sweep_with_energy(
     let n = structure.modes.len();
     coupled_run(
         structure,
-        damper,
-        damper_point,
+        beds,
         &spec.output_point,
-        opts,
         DVector::zeros(n),
         DVector::zeros(n),
         spec.sweep.duration_s,

@@ -1,6 +1,6 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
-use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep, run_dem_sweep_with_energy};
+use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep_beds};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
@@ -104,46 +104,60 @@ pub fn run_couple(
         .iter()
         .filter(|d| matches!(d, DamperSpec::Dem { .. }))
         .count();
-    if dem_count > 1 || (dem_count == 1 && scn.dampers.len() > 1) {
-        return Err("a DEM damper (approach 1) must be the only damper of a scenario".into());
+    if dem_count > 0 && dem_count < scn.dampers.len() {
+        return Err(
+            "DEM dampers (approach 1) cannot be mixed with other damper models in a scenario: \
+             make every damper `model = \"dem\"` or none"
+                .into(),
+        );
     }
-    // The DEM bed's ParaView output: the damper scenario's `[output]` interval and format.
+    // The DEM beds (one per damper, each its own scenario and seed); the first bed's
+    // `[output]` interval and format give the ParaView output.
     let mut bed_vtk = None;
-    let dem = match scn.dampers.first() {
-        Some(
-            spec @ DamperSpec::Dem {
-                point,
-                scenario,
-                compensate_static_weight,
-                ..
-            },
-        ) => {
-            let kinematics = spec.dem_kinematics(0)?;
-            let p = if scenario.is_absolute() {
-                scenario.clone()
-            } else {
-                base.join(scenario)
-            };
-            let sc = pdamp_io::scenario::Scenario::load(&p)
-                .map_err(|e| format!("{}: {e}", p.display()))?;
-            inputs.extend_from_slice(sc.to_toml().as_bytes());
+    let mut dem_beds: Vec<(String, pdamp_design::Damper, DemCoupling)> = Vec::new();
+    for (i, spec) in scn.dampers.iter().enumerate() {
+        let DamperSpec::Dem {
+            point,
+            scenario,
+            compensate_static_weight,
+            ..
+        } = spec
+        else {
+            continue;
+        };
+        let kinematics = spec.dem_kinematics(i)?;
+        let p = if scenario.is_absolute() {
+            scenario.clone()
+        } else {
+            base.join(scenario)
+        };
+        let sc = pdamp_io::scenario::Scenario::load(&p)
+            .map_err(|e| format!("dampers[{i}]: {}: {e}", p.display()))?;
+        inputs.extend_from_slice(sc.to_toml().as_bytes());
+        if bed_vtk.is_none() {
             bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
-            let d = pdamp_design::Damper::from_scenario(
-                &sc,
-                p.parent().unwrap_or(Path::new(".")),
-                |_| {},
-            )?;
-            Some((
-                point.clone(),
-                d,
-                DemCoupling {
-                    compensate_static_weight: *compensate_static_weight,
-                    kinematics,
-                },
-            ))
         }
-        _ => None,
-    };
+        let d =
+            pdamp_design::Damper::from_scenario(&sc, p.parent().unwrap_or(Path::new(".")), |_| {})
+                .map_err(|e| format!("dampers[{i}]: {}: {e}", p.display()))?;
+        dem_beds.push((
+            point.clone(),
+            d,
+            DemCoupling {
+                compensate_static_weight: *compensate_static_weight,
+                kinematics,
+            },
+        ));
+    }
+    let beds: Vec<crate::dem::DemBed> = dem_beds
+        .iter()
+        .map(|(p, d, o)| crate::dem::DemBed {
+            damper: d,
+            point: p,
+            coupling: o,
+        })
+        .collect();
+    let dem = (!beds.is_empty()).then_some(beds.as_slice());
     let ck = CouplingCheckpoint {
         path: out.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
         inputs_digest: pdamp_io::checkpoint::digest(&inputs),
@@ -194,13 +208,11 @@ pub fn run_couple(
         AnalysisSpec::Free { .. } => {
             let spec = scn.analysis.free_vibration_spec().expect("a free analysis");
             let (hist, energy) = match &dem {
-                Some((p, d, o)) => {
-                    let (h, e) = crate::dem::run_dem_free_with_energy(
+                Some(beds) => {
+                    let (h, e) = crate::dem::run_dem_free_beds(
                         &structure,
-                        d,
-                        p,
+                        beds,
                         &spec,
-                        o,
                         progress,
                         Some(&ck),
                     )?;
@@ -251,16 +263,9 @@ pub fn run_couple(
             };
             if *segments <= 1 {
                 let (hist, energy) = match &dem {
-                    Some((p, d, o)) => {
-                        let (h, e) = run_dem_sweep_with_energy(
-                            &structure,
-                            d,
-                            p,
-                            &spec,
-                            o,
-                            progress,
-                            Some(&ck),
-                        )?;
+                    Some(beds) => {
+                        let (h, e) =
+                            run_dem_sweep_beds(&structure, beds, &spec, progress, Some(&ck))?;
                         (h, Some(e))
                     }
                     None => (forced::run_sweep(&structure, &dampers, &spec)?, None),
@@ -305,7 +310,7 @@ pub fn run_couple(
                     };
                     let hist = match &dem {
                         Some(_) if i < done.len() => done[i].clone().into_history(),
-                        Some((p, d, o)) => {
+                        Some(beds) => {
                             let cki = CouplingCheckpoint {
                                 path: out.join(format!("checkpoint_segment_{i}.bin")),
                                 inputs_digest: pdamp_io::checkpoint::digest(
@@ -318,12 +323,10 @@ pub fn run_couple(
                                 }),
                                 ..ck.clone()
                             };
-                            let h = run_dem_sweep(
+                            let (h, _) = run_dem_sweep_beds(
                                 &structure,
-                                d,
-                                p,
+                                beds,
                                 &sspec,
-                                o,
                                 &mut |f| progress((i as f64 + f) / n),
                                 Some(&cki),
                             )?;

@@ -76,3 +76,112 @@ fn clamped_particle_is_an_added_mass() {
     assert!((f_mean - f_exp).abs() / f_exp < 0.005);
     assert!((z_mean - z_exp).abs() / z_exp < 0.05);
 }
+
+/// A clamped sphere in a preloaded box (no gravity): a rigidly added mass.
+fn clamped(r: f64) -> (Damper, f64) {
+    let rho = 7850.0;
+    let soft = Material::new("soft", rho, 1e8, 0.3);
+    let model = ContactModel {
+        normal: NormalLaw::Hertz,
+        friction: Default::default(),
+        rolling: None,
+        adhesion: None,
+    };
+    let mut w = World::new(vec![soft], model, 5e-5);
+    w.gravity_m_s2 = Vec3::zeros();
+    w.add_particle(Vec3::zeros(), r, 0);
+    let h = r - 1e-4;
+    let body = RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+        "box",
+        Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(h, h, h))),
+        0,
+    );
+    w.add_body(body);
+    (
+        Damper::from_world(w, 0, Vec3::new(1.0, 0.0, 0.0), 0.0, 1, 0),
+        rho * 4.0 / 3.0 * PI * r.powi(3),
+    )
+}
+
+/// Several DEM beds in one coupled run (one per container): two clamped spheres at two points
+/// of one mode (φ = 1 and 0.6, unit modal mass, no structural damping) add the modal mass
+/// m₁φ₁² + m₂φ₂², so the mode runs at f₀/√(1 + m₁φ₁² + m₂φ₂²) (0.5 %), and the structure's
+/// and the beds' energies sum to a constant (elastic contacts; 1e-4 of the initial energy).
+/// A second bed at a node of the mode (φ = 0) leaves the single-bed run unchanged bit for bit.
+#[test]
+fn two_beds_add_their_modal_masses() {
+    use pdamp_structure::dem::{DemBed, run_dem_free_beds};
+    use pdamp_structure::modal::{ModalPoint, Mode};
+    let (f0, x0) = (5.0, 0.01);
+    let s = ModalStructure {
+        modes: vec![Mode {
+            frequency_hz: f0,
+            damping_ratio: 0.0,
+        }],
+        points: [("a", 1.0), ("b", 0.6), ("node", 0.0)]
+            .iter()
+            .map(|(n, v)| ModalPoint {
+                name: n.to_string(),
+                shape: vec![*v],
+            })
+            .collect(),
+    };
+    let spec = FreeVibrationSpec {
+        duration_s: 2.0,
+        time_step_s: 5e-5,
+        mode: 0,
+        initial_point: "a".into(),
+        initial_displacement_m: x0,
+        initial_velocity_m_s: 0.0,
+        output_point: "a".into(),
+        update: UpdateRule::Never,
+        sample_every: 1,
+        scale_initial_by_bed_mass: false,
+    };
+    let ((d1, m1), (d2, m2)) = (clamped(0.02), clamped(0.015));
+    let o = DemCoupling::default();
+    let bed = |damper, point| DemBed {
+        damper,
+        point,
+        coupling: &o,
+    };
+    let (h, e) = run_dem_free_beds(
+        &s,
+        &[bed(&d1, "a"), bed(&d2, "b")],
+        &spec,
+        &mut |_| {},
+        None,
+    )
+    .unwrap();
+    let cyc = free::damping_per_cycle(&free::decay_peaks(&h, 0.1).unwrap());
+    let f_mean = cyc.iter().map(|c| c.frequency_hz).sum::<f64>() / cyc.len() as f64;
+    let f_exp = f0 / (1.0 + m1 + m2 * 0.36).sqrt();
+    assert!(cyc.len() >= 6);
+    assert!((f_mean / f_exp - 1.0).abs() < 0.005, "{f_mean} vs {f_exp}");
+    let e0 = 0.5 * (TAU * f0).powi(2) * x0 * x0;
+    let drift = e.structure_energy_change_j + e.bed_energy_change_j;
+    assert!(drift.abs() < 1e-4 * e0, "{e:?} against {e0} J");
+    // a bed at a node: the single-bed run, bit for bit
+    let (one, _) = run_dem_free_beds(&s, &[bed(&d1, "a")], &spec, &mut |_| {}, None).unwrap();
+    let (two, _) = run_dem_free_beds(
+        &s,
+        &[bed(&d1, "a"), bed(&d2, "node")],
+        &spec,
+        &mut |_| {},
+        None,
+    )
+    .unwrap();
+    assert_eq!(one.displacement_m, two.displacement_m);
+    // beds that do not share a time step are refused, naming the bed
+    let (mut d3, _) = clamped(0.01);
+    d3.time_step_s *= 0.5;
+    let err = run_dem_free_beds(
+        &s,
+        &[bed(&d1, "a"), bed(&d3, "b")],
+        &spec,
+        &mut |_| {},
+        None,
+    )
+    .unwrap_err();
+    assert!(err.contains("DEM bed 2 at 'b'"), "{err}");
+}
