@@ -16,27 +16,7 @@ use std::f64::consts::{PI, TAU};
 
 #[test]
 fn clamped_particle_is_an_added_mass() {
-    let (r, rho): (f64, f64) = (0.02, 7850.0);
-    let m_p = rho * 4.0 / 3.0 * PI * r.powi(3);
-    let soft = Material::new("soft", rho, 1e8, 0.3);
-    let model = ContactModel {
-        normal: NormalLaw::Hertz,
-        friction: Default::default(),
-        rolling: None,
-        adhesion: None,
-    };
-    let mut w = World::new(vec![soft], model, 5e-5);
-    w.gravity_m_s2 = Vec3::zeros();
-    w.add_particle(Vec3::zeros(), r, 0);
-    // 0.1 mm preload on each of the six faces
-    let h = r - 1e-4;
-    let body = RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
-        "box",
-        Geometry::BoxInside(BoxInside::new(Vec3::zeros(), Vec3::new(h, h, h))),
-        0,
-    );
-    w.add_body(body);
-    let damper = Damper::from_world(w, 0, Vec3::new(1.0, 0.0, 0.0), 0.0, 1, 0);
+    let (damper, m_p) = clamped(0.02);
     let (mass, f0, zeta) = (1.0, 5.0, 0.01);
     let k = mass * (TAU * f0).powi(2);
     let s = ModalStructure::single_mode(mass, k, 2.0 * zeta * (k * mass).sqrt());
@@ -77,7 +57,9 @@ fn clamped_particle_is_an_added_mass() {
     assert!((z_mean - z_exp).abs() / z_exp < 0.05);
 }
 
-/// A clamped sphere in a preloaded box (no gravity): a rigidly added mass.
+/// A sphere of radius `r` clamped in a box with 0.1 mm preload on each of the six faces
+/// (elastic Hertz contacts, no gravity): a rigidly added mass. Returns the damper and the
+/// sphere's mass.
 fn clamped(r: f64) -> (Damper, f64) {
     let rho = 7850.0;
     let soft = Material::new("soft", rho, 1e8, 0.3);
