@@ -36,6 +36,29 @@ impl World {
         }
     }
 
+    /// Replaces the last [`World::move_wall_vertices`] of mesh wall `wall` of body `body` by a
+    /// move from the same start to `positions` (a coupling iteration; then
+    /// [`World::repeat_wall_pass`]), see [`crate::walls::TriMesh::replace_last_move`].
+    pub fn move_wall_vertices_again(
+        &mut self,
+        body: usize,
+        wall: usize,
+        positions: &[Vec3],
+    ) -> Result<(), MeshError> {
+        let dt = self.dt_s;
+        let w = self
+            .bodies
+            .get_mut(body)
+            .and_then(|b| b.walls.get_mut(wall))
+            .ok_or(MeshError::NoSuchWall { body, wall })?;
+        match &mut w.geometry {
+            Geometry::Mesh(m) => m.replace_last_move(positions, dt),
+            _ => Err(MeshError::NotAMesh {
+                wall: w.name.clone(),
+            }),
+        }
+    }
+
     /// The loads the particles exert on the vertices of mesh wall `wall` of body `body` in the
     /// last force evaluation, N (world frame; one per vertex, written into `out`): every
     /// contact's force on the wall split onto the vertices of its feature with the barycentric

@@ -149,7 +149,7 @@ pub(crate) struct PpChunk {
 /// Scratch of the pair loop, one per worker thread (kept between steps: no allocation once
 /// grown, and it stays in that core's cache).
 #[derive(Debug, Default)]
-struct PairScratch {
+pub(crate) struct PairScratch {
     /// The pairs of a chunk that touch or had a contact (index within the chunk's pair range)
     /// and their first partners.
     scan_pair: Vec<u32>,
@@ -157,12 +157,12 @@ struct PairScratch {
     /// Hertz–Mindlin contacts gathered for block evaluation.
     batch: HmBatch,
     /// Wall contacts found for one particle, and its new wall slots.
-    wall_contacts: Vec<WallContact>,
-    wall_fresh: Vec<WallSlot>,
+    pub(crate) wall_contacts: Vec<WallContact>,
+    pub(crate) wall_fresh: Vec<WallSlot>,
 }
 
 thread_local! {
-    static PAIR_SCRATCH: std::cell::RefCell<PairScratch> =
+    pub(crate) static PAIR_SCRATCH: std::cell::RefCell<PairScratch> =
         std::cell::RefCell::new(PairScratch::default());
 }
 
@@ -1004,6 +1004,7 @@ impl World {
             scratch_body_step: body_step,
             scratch_block_out: block_out,
             packed,
+            wall_repeat,
             ..
         } = self;
         let p = &*p;
@@ -1094,6 +1095,12 @@ impl World {
         if wall_list_stale {
             *wall_refreshes += 1;
         }
+        // A repeatable wall pass keeps the wall slots it starts from (see `wall_repeat`).
+        let mut no_record: [(Vec3, Vec3); 0] = [];
+        let record: &mut [(Vec3, Vec3)] = match wall_repeat.as_deref_mut() {
+            Some(r) => r.start_pass(wall_list, wall_slots, wall_list_stale),
+            None => &mut no_record,
+        };
         let nblocks = force_blocks(nl, pp_chunks, wall_list, n, block_start, chunk_block);
         cross_out.resize_with(nblocks * nchunks, Vec::new);
         block_loads.resize_with(nblocks, Vec::new);
@@ -1114,6 +1121,9 @@ impl World {
                 slots: &'a mut [Vec<WallSlot>],
                 cross: &'a mut [Vec<SecondOutput>],
                 loads: &'a mut Vec<(Vec3, Vec3)>,
+                /// Force and torque of each of the block's wall-list particles before its wall
+                /// contacts (only when the wall pass is repeatable; empty otherwise).
+                record: &'a mut [(Vec3, Vec3)],
             }
             // (on the stack: no allocation per step; `force_blocks` cuts at most MAX_BLOCKS)
             let mut parts: [Option<BlockParts>; MAX_BLOCKS] = std::array::from_fn(|_| None);
@@ -1125,6 +1135,7 @@ impl World {
                 &mut wall_slots[..],
                 &mut cross_out[..],
             );
+            let (mut rest_r, mut w_prev) = (record, 0usize);
             for (b, loads) in block_loads.iter_mut().enumerate().take(nblocks) {
                 let (c0, c1) = (block_start[b], block_start[b + 1]);
                 let (lo, hi) = ((c0 * PP_CHUNK).min(n), (c1 * PP_CHUNK).min(n));
@@ -1135,6 +1146,13 @@ impl World {
                 let (t, tr) = rest_t.split_at_mut(hi - lo);
                 let (w, wr) = rest_s.split_at_mut(hi - lo);
                 let (x, xr_) = rest_x.split_at_mut(nchunks);
+                let w_hi = if rest_r.is_empty() {
+                    w_prev
+                } else {
+                    wall_list.partition_point(|&i| (i as usize) < hi)
+                };
+                let (r, rr) = std::mem::take(&mut rest_r).split_at_mut(w_hi - w_prev);
+                w_prev = w_hi;
                 parts[b] = Some(BlockParts {
                     chunks: k,
                     pc: c,
@@ -1143,8 +1161,10 @@ impl World {
                     slots: w,
                     cross: x,
                     loads,
+                    record: r,
                 });
-                (rest_k, rest_c, rest_f, rest_t, rest_s, rest_x) = (kr, cr, fr, tr, wr, xr_);
+                (rest_k, rest_c, rest_f, rest_t, rest_s, rest_x, rest_r) =
+                    (kr, cr, fr, tr, wr, xr_, rr);
             }
             parts[..nblocks]
                 .par_iter_mut()
@@ -1191,6 +1211,7 @@ impl World {
                     let q_block = nl.row_start[lo] as usize;
                     let mut walls = EnergyIncrements::default();
                     let mut w = wall_list_ref.partition_point(|&i| (i as usize) < lo);
+                    let w_block = w;
                     PAIR_SCRATCH.with_borrow_mut(|scratch| {
                         for (ck, chunk) in part.chunks.iter_mut().enumerate() {
                             let c = c0 + ck;
@@ -1225,6 +1246,9 @@ impl World {
                                 && (i as usize) < chi
                             {
                                 let (i, a) = (i as usize, i as usize - lo);
+                                if let Some(r) = part.record.get_mut(w - w_block) {
+                                    *r = (acc.force[a], acc.torque[a]);
+                                }
                                 wall_contacts_of(
                                     (p.material[i], &xr[i], &kin[i]),
                                     interactions,
@@ -1239,13 +1263,7 @@ impl World {
                                     &mut walls,
                                 );
                                 // Loads on the bodies, in particle order.
-                                for s in &part.slots[a] {
-                                    let b = &bodies_ref[s.body as usize];
-                                    let l = &mut part.loads[s.body as usize];
-                                    l.0 -= s.force;
-                                    l.1 += (s.point - b.state.position_m).cross(&(-s.force))
-                                        - s.rolling_torque;
-                                }
+                                add_wall_loads(&part.slots[a], bodies_ref, part.loads);
                                 w += 1;
                             }
                         }
@@ -1277,7 +1295,15 @@ impl World {
 
         self.tock(t_particles, |p| &mut p.particle_forces_s);
         let t_loads = self.tick();
-        // 3. Loads on rigid bodies: the blocks' sums (each in particle order), in block order.
+        self.sum_body_loads(nblocks);
+        let inc = self.sum_increments();
+        self.tock(t_loads, |p| &mut p.energies_s);
+        inc
+    }
+
+    /// The loads on the rigid bodies: the sums of the first `nblocks` blocks of the pair pass
+    /// (each in particle order), in block order.
+    pub(crate) fn sum_body_loads(&mut self, nblocks: usize) {
         for (k, b) in self.bodies.iter_mut().enumerate() {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
@@ -1286,7 +1312,11 @@ impl World {
                 b.contact_torque_nm += l[k].1;
             }
         }
+    }
 
+    /// The energy increments of the last force evaluation: the chunks' particle–particle
+    /// sums, then every block's external work and wall terms, in block order.
+    pub(crate) fn sum_increments(&self) -> EnergyIncrements {
         let mut inc = EnergyIncrements::default();
         for &(dn, dtan, el) in self.pp_chunks.iter().map(|c| &c.sums) {
             inc.dissipated_normal_pp_j += dn;
@@ -1297,7 +1327,6 @@ impl World {
             inc.external_work_j += e;
             inc += w;
         }
-        self.tock(t_loads, |p| &mut p.energies_s);
         inc
     }
 }
@@ -1308,7 +1337,7 @@ impl World {
 /// the last rebuild; the refresh is repeated at every rebuild and whenever a body has translated
 /// by one skin since, rotated at all, or its deformable walls moved by one skin. Skipping the others therefore changes no result.
 #[allow(clippy::too_many_arguments)]
-fn refresh_wall_candidates(
+pub(crate) fn refresh_wall_candidates(
     p: &crate::particles::ParticleSet,
     interactions: &crate::interaction::InteractionTable,
     nl: &crate::neighbor::NeighborList,
@@ -1449,13 +1478,29 @@ fn deforming_surface_velocity(
     bs.vector_to_world(&mesh.surface_velocity(feature, &bs.to_body(point_world)))
 }
 
+/// Adds the loads that one particle's wall contacts `slots` put on the bodies to `loads` (one
+/// entry per body: force, torque about the body's position).
+#[inline]
+pub(crate) fn add_wall_loads(
+    slots: &[WallSlot],
+    bodies: &[crate::body::RigidBody],
+    loads: &mut [(Vec3, Vec3)],
+) {
+    for s in slots {
+        let b = &bodies[s.body as usize];
+        let l = &mut loads[s.body as usize];
+        l.0 -= s.force;
+        l.1 += (s.point - b.state.position_m).cross(&(-s.force)) - s.rolling_torque;
+    }
+}
+
 /// Contacts of particle `i` with all walls: finds them, matches them to the previous slots
 /// (same feature, or the same wall with a nearly parallel normal, so that history survives a
 /// sphere sliding from a face onto an edge), evaluates the laws and accumulates force, torque
 /// and energy.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn wall_contacts_of(
+pub(crate) fn wall_contacts_of(
     (material, xr, kin): (u16, &[f64; 4], &Kin),
     interactions: &crate::interaction::InteractionTable,
     bodies: &[crate::body::RigidBody],

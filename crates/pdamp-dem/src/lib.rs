@@ -25,6 +25,7 @@ pub mod math;
 pub mod neighbor;
 pub mod particles;
 pub mod state;
+pub mod wall_repeat;
 pub mod walls;
 pub mod world;
 

@@ -125,6 +125,9 @@ pub struct World {
     /// Half the time step of the last velocity-Verlet step while its second half kick is
     /// pending (see [`World::step_deferred`]), s.
     pub(crate) pending_half_kick_s: Option<f64>,
+    /// What a repetition of the last step's particle–wall pass needs (only when switched on
+    /// with [`World::set_wall_pass_repeatable`]).
+    pub(crate) wall_repeat: Option<Box<crate::wall_repeat::WallRepeat>>,
 }
 
 /// Kinetic energy (translation + rotation) and `m g·x` of one particle, J.
@@ -191,6 +194,7 @@ impl World {
             initialized: false,
             packed: false,
             pending_half_kick_s: None,
+            wall_repeat: None,
         }
     }
 
@@ -527,6 +531,12 @@ impl World {
                 self.step_gear(&params)
             }
         };
+        if let Some(r) = self.wall_repeat.as_deref_mut() {
+            r.step_taken(
+                &self.ledger,
+                matches!(self.integrator, Integrator::VelocityVerlet),
+            );
+        }
         let t = self.tick();
         self.ledger.add(&inc);
         if matches!(self.integrator, Integrator::Gear(_)) {

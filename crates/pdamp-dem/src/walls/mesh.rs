@@ -163,6 +163,9 @@ pub enum MeshError {
     /// The time step of a vertex move is not positive and finite.
     #[error("the time step of a vertex move must be positive and finite, got {0} s")]
     BadTimeStep(f64),
+    /// [`TriMesh::replace_last_move`] on a mesh that was never moved.
+    #[error("the mesh has not been moved yet: there is no move to replace")]
+    NoMoveToReplace,
 }
 
 /// Per-triangle derived data.
@@ -220,6 +223,9 @@ pub struct TriMesh {
     /// Sum of the largest vertex displacement of every [`TriMesh::move_vertices`], m: the wall
     /// candidates are refreshed when it has grown by a skin.
     deformation_m: f64,
+    /// The vertices and `deformation_m` before the last [`TriMesh::move_vertices`], so that
+    /// the move can be replaced ([`TriMesh::replace_last_move`]); empty before the first.
+    before_move: (Vec<Vec3>, f64),
 }
 
 /// Topology, per-triangle data and the grid of a [`TriMesh`].
@@ -449,6 +455,7 @@ impl TriMesh {
         Ok(TriMesh {
             velocity: Vec::new(),
             deformation_m: 0.0,
+            before_move: (Vec::new(), 0.0),
             vertices,
             faces,
             d: Arc::new(Derived {

@@ -22,6 +22,30 @@ impl TriMesh {
     /// contact history are kept; normals, barycentric data, the bounding box and the grid are
     /// refitted. A triangle that degenerates (zero area) is refused and the mesh left as it was.
     pub fn move_vertices(&mut self, positions: &[Vec3], dt_s: f64) -> Result<(), MeshError> {
+        self.check_move(positions, dt_s)?;
+        self.before_move.0.clear();
+        self.before_move.0.extend_from_slice(&self.vertices);
+        self.before_move.1 = self.deformation_m;
+        self.apply_move(positions, dt_s);
+        Ok(())
+    }
+
+    /// Replaces the last [`TriMesh::move_vertices`] by a move from the same start to
+    /// `positions` (the repeated wall pass of a coupling iteration, P Algorithm 1): the result
+    /// is that of calling `move_vertices(positions, dt_s)` instead of the last move, to the bit.
+    pub fn replace_last_move(&mut self, positions: &[Vec3], dt_s: f64) -> Result<(), MeshError> {
+        if self.before_move.0.len() != self.vertices.len() {
+            return Err(MeshError::NoMoveToReplace);
+        }
+        self.check_move(positions, dt_s)?;
+        self.vertices.copy_from_slice(&self.before_move.0);
+        self.deformation_m = self.before_move.1;
+        self.apply_move(positions, dt_s);
+        Ok(())
+    }
+
+    /// The checks of a move, on the new positions, before anything changes.
+    fn check_move(&self, positions: &[Vec3], dt_s: f64) -> Result<(), MeshError> {
         if positions.len() != self.vertices.len() {
             return Err(MeshError::VertexCount {
                 expected: self.vertices.len(),
@@ -37,7 +61,6 @@ impl TriMesh {
         if !(dt_s.is_finite() && dt_s > 0.0) {
             return Err(MeshError::BadTimeStep(dt_s));
         }
-        // Checked on the new positions before anything changes (the mesh stays as it was).
         for (t, f) in self.faces.iter().enumerate() {
             let p = f.map(|i| positions[i as usize]);
             let area2 = (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
@@ -49,6 +72,11 @@ impl TriMesh {
                 return Err(MeshError::Degenerate { triangle: t });
             }
         }
+        Ok(())
+    }
+
+    /// Moves the (checked) vertices from the current ones to `positions`.
+    fn apply_move(&mut self, positions: &[Vec3], dt_s: f64) {
         // In place when no clone shares the derived data (the usual case: a world's wall).
         let d: &mut Derived = Arc::make_mut(&mut self.d);
         for (t, f) in self.faces.iter().enumerate() {
@@ -77,7 +105,6 @@ impl TriMesh {
         self.deformation_m += largest;
         self.vertices.clear();
         self.vertices.extend_from_slice(positions);
-        Ok(())
     }
 
     /// Sets the vertex velocities (body frame, m/s) without moving the vertices — for a mesh
