@@ -223,6 +223,12 @@ impl World {
         self.neighbors.num_pairs()
     }
 
+    /// The particle pairs of the neighbour list `(i, j)`, `i < j`.
+    pub fn neighbor_pairs(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let nl = &self.neighbors;
+        (0..nl.num_pairs()).map(|k| (nl.first[k] as usize, nl.second[k] as usize))
+    }
+
     /// Number of touching particle–particle contacts.
     pub fn num_pp_contacts(&self) -> usize {
         self.pp_chunks.iter().map(|c| c.len()).sum()
@@ -247,12 +253,8 @@ impl World {
     /// Largest overlap relative to the smaller radius over all particle–particle contacts.
     pub fn max_relative_overlap(&self) -> f64 {
         let p = &self.particles;
-        (0..self.neighbors.num_pairs())
-            .map(|k| {
-                let (i, j) = (
-                    self.neighbors.first[k] as usize,
-                    self.neighbors.second[k] as usize,
-                );
+        self.neighbor_pairs()
+            .map(|(i, j)| {
                 let ov = p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm();
                 ov / p.radius[i].min(p.radius[j])
             })

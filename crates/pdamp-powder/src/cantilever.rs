@@ -903,7 +903,7 @@ fn run_core(
         damping: TableOneRatios::default(),
         max_tip_before_release_m: 0.0,
         prep,
-        particles: c.powder.len(),
+        particles: c.particles(),
         structure_dofs: c.structure.n_dof(),
         elements,
         interface_dofs: c.interface.n_dof(),
@@ -912,12 +912,13 @@ fn run_core(
         max_iterations: 0,
         wall_time_s: 0.0,
         structure_mass_kg: structure_mass,
-        powder_mass_kg: c.powder.mass.iter().sum(),
+        powder_mass_kg: c.particle_mass_kg(),
         energy_closure: 0.0,
     };
     let (mut c, mut res, first) = match (running, prepared) {
         (Some(st), _) => {
-            let mut c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)?;
+            let mut c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)
+                .map_err(|e| e.to_string())?;
             c.container = sc.powder.is_some().then_some(cavity);
             let res = CantileverResult {
                 time_s: st.time_s,
@@ -932,7 +933,8 @@ fn run_core(
         }
         (None, Some((mut powder, prep))) => {
             powder.gravity = sc.run.gravity_m_s2;
-            let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling);
+            let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling)
+                .map_err(|e| e.to_string())?;
             c.container = sc.powder.is_some().then_some(cavity);
             let res = result(&c, prep);
             (c, res, 1)
@@ -1063,7 +1065,8 @@ fn check_energy_health(c: &Coupled, energy: &[(f64, CoupledEnergy)]) -> Result<(
         .chain(std::iter::once(e.load_work_j.abs()))
         .fold(0.0, f64::max);
     crate::health::check_energy(e.dissipated_j, e.balance_j - b0, scale).map_err(|s| {
-        crate::health::HealthError::new(c.powder.t, "coupled run", s, &c.powder).to_string()
+        crate::health::HealthError::of_world(c.world.time_s, "coupled run", s, &c.world, &c.law)
+            .to_string()
     })
 }
 

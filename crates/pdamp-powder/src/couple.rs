@@ -1,35 +1,47 @@
-//! Dirichlet–Neumann partitioned DEM–FEM coupling (paper Sect. 2.3, Algorithm 1).
+//! Dirichlet–Neumann partitioned DEM–FEM coupling (paper Sect. 2.3, Algorithm 1) on the
+//! pdamp-dem engine.
 //!
 //! The particles are the Dirichlet partition: for given interface displacements
-//! $\mathbf d^{ps}$ (and the velocities the generalized-α relations imply) the particle
-//! operator $\mathcal P$ returns the contact forces. The structure is the Neumann partition:
-//! $\mathcal S^{-1}$ solves the generalized-α step under those forces. Contacts are found by
-//! closest-point projection onto the bilinear interface quads; the reaction on the structure is
-//! distributed to the nodes with the shape functions (eq. 15,
-//! $\mathbf f^{ps}_j = \sum_e\sum_i N^e_j(\xi_i)\mathbf f^e_i$). Fixed-point iterations with
-//! Aitken relaxation (Küttler & Wall 2008, paper ref. \[34\]) run until eq. 16,
-//! $|\Delta\mathbf d^{ps}_{n+1,k+1}|/(\Delta t\sqrt{n^{ps}_{dof}}) < \epsilon$, with the increment
-//! between successive iterates as in Algorithm 1.
+//! $\mathbf d^{ps}$ the particle operator $\mathcal P$ returns the contact forces. They live in a
+//! [`pdamp_dem::World`] whose body 0 carries the interface $\Gamma^{ps}$ as a deformable
+//! triangle-mesh wall: its vertices are the interface nodes (every bilinear face split into two
+//! triangles), moved to $\mathbf X + \mathbf d^{ps}$ before the step, so that the wall contacts
+//! of the step see the mean surface velocity $(\mathbf d^{ps}_{n+1}-\mathbf d_n)/\Delta t$ (the
+//! wall work then matches the trapezoidal interface work on the structure). The reaction on the
+//! structure is the contact forces split onto the vertices of the touched feature with the
+//! barycentric weights of the contact point — consistent nodal loads, the triangle counterpart
+//! of eq. 15. The structure is the Neumann partition: $\mathcal S^{-1}$ solves the
+//! generalized-α step under those loads. Fixed-point iterations with Aitken relaxation
+//! (Küttler & Wall 2008, paper ref. \[34\]) run until eq. 16,
+//! $|\Delta\mathbf d^{ps}_{n+1,k+1}|/(\Delta t\sqrt{n^{ps}_{dof}}) < \epsilon$.
 //!
-//! Within one step, particle–particle forces do not depend on $\mathbf d^{ps}$ (velocity
-//! Verlet positions are explicit), so an iteration re-evaluates only particle–wall contacts
-//! and the structural solve.
-//!
-//! Contacts with several faces: closest points strictly inside a face are always used; a
-//! closest point on a face boundary (edge/corner) is used only if no interior contact of the
-//! particle has a nearly parallel face normal and no accepted contact shares the point — this
-//! avoids double counting on coplanar neighbours and keeps both walls in concave corners.
+//! Within one step the particle–particle forces do not depend on $\mathbf d^{ps}$ (velocity
+//! Verlet positions are explicit), so an iteration repeats only the particle–wall pass, from the
+//! wall contact history at the start of the step ([`pdamp_dem::World::repeat_wall_pass`]).
+//! Contacts with several faces (edges, corners, coplanar neighbours) follow the mesh wall's
+//! rules of pdamp-dem: one contact per locally closest feature, no double counting.
 
-use rayon::prelude::*;
+use pdamp_dem::contact::{ContactModel, DmtAdhesion, FrictionLaw, NormalLaw};
+use pdamp_dem::wall_repeat::WallRepeatError;
+use pdamp_dem::walls::{Geometry, MeshError, TriMesh};
+use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World, WorldState};
 
-use crate::dem::Powder;
-use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
+use crate::dem::{Powder, PowderLaw};
 use crate::fe::{Aabb, Dynamics, DynamicsError, DynamicsState, Face, Structure};
 use crate::health::{self, HealthError, Symptom};
 
 /// Steps between the overlap checks of the coupled run (positions, velocities and the
 /// container are checked every step).
 pub const OVERLAP_CHECK_EVERY: u64 = 100;
+
+/// The body of the world that carries the interface, and its mesh wall.
+const BODY: usize = 0;
+const WALL: usize = 0;
+
+/// Young's modulus of the particle and wall materials of the world, Pa: not used by the
+/// powder's linear contact law (its stiffness is `normal_stiffness_n_m`), only a nominal value
+/// for the engine's material table (equal on both sides: no soft-wall rules).
+const NOMINAL_MODULUS_PA: f64 = 200e9;
 
 /// The interface $\Gamma^{ps}$: boundary faces of the structure in contact with the powder.
 #[derive(Debug, Clone)]
@@ -51,86 +63,6 @@ impl Interface {
     /// $n^{ps}_{dof}$.
     pub fn n_dof(&self) -> usize {
         3 * self.nodes.len()
-    }
-}
-
-/// Closest point on a bilinear quad with corner positions `x` to `p`: returns (s, t, point,
-/// interior, unit normal of the quad at the point (right-hand rule of the node order)).
-pub fn closest_point(x: &[[f64; 3]; 4], p: [f64; 3]) -> (f64, f64, [f64; 3], bool, [f64; 3]) {
-    let (mut s, mut t) = (0.0f64, 0.0f64);
-    let mut interior = true;
-    for _ in 0..8 {
-        let qp = crate::fe::quad::point(x, s, t);
-        let (c, a, b) = (qp.x, qp.dxds, qp.dxdt);
-        let r = [c[0] - p[0], c[1] - p[1], c[2] - p[2]];
-        let (aa, ab, bb) = (dot(a, a), dot(a, b), dot(b, b));
-        let (ra, rb) = (dot(r, a), dot(r, b));
-        let det = aa * bb - ab * ab;
-        let ds_ = -(bb * ra - ab * rb) / det;
-        let dt_ = -(aa * rb - ab * ra) / det;
-        let (s1, t1) = (s + ds_, t + dt_);
-        let (sc, tc) = (s1.clamp(-1.0, 1.0), t1.clamp(-1.0, 1.0));
-        interior = sc == s1 && tc == t1;
-        let done = (sc - s).abs() < 1e-13 && (tc - t).abs() < 1e-13;
-        s = sc;
-        t = tc;
-        if done {
-            break;
-        }
-    }
-    let qp = crate::fe::quad::point(x, s, t);
-    let (c, a, b) = (qp.x, qp.dxds, qp.dxdt);
-    let nn = crate::fe::quad::cross(a, b);
-    let l = dot(nn, nn).sqrt();
-    (
-        s,
-        t,
-        c,
-        interior && s.abs() < 1.0 && t.abs() < 1.0,
-        [nn[0] / l, nn[1] / l, nn[2] / l],
-    )
-}
-
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Geometric candidate: (face, s, t, closest point, interior, face normal, gap, contact normal).
-type GeoHit = (u32, f64, f64, [f64; 3], bool, [f64; 3], f64, [f64; 3]);
-
-/// One particle–face contact of an evaluation.
-#[derive(Debug, Clone, Copy, Default)]
-struct Hit {
-    face: u32,
-    s: f64,
-    t: f64,
-    force: [f64; 3],
-}
-
-/// Per-particle result of the particle operator.
-#[derive(Debug, Clone, Copy)]
-struct WallResult {
-    force: [f64; 3],
-    torque: [f64; 3],
-    hist: WallSlots,
-    hits: [Hit; 4],
-    nhits: u8,
-    elastic: f64,
-    dissipated: f64,
-}
-
-impl Default for WallResult {
-    fn default() -> Self {
-        Self {
-            force: [0.0; 3],
-            torque: [0.0; 3],
-            hist: EMPTY_SLOTS,
-            hits: [Hit::default(); 4],
-            nhits: 0,
-            elastic: 0.0,
-            dissipated: 0.0,
-        }
     }
 }
 
@@ -169,6 +101,15 @@ pub enum CoupleError {
     /// overlap), see [`crate::health`].
     #[error(transparent)]
     Health(#[from] Box<HealthError>),
+    /// The interface mesh could not be built or moved (a degenerate face).
+    #[error("interface mesh: {0}")]
+    Mesh(#[from] MeshError),
+    /// The repeated wall pass of an iteration failed (a defect: it is always prepared).
+    #[error("coupling iteration: {0}")]
+    Repeat(#[from] WallRepeatError),
+    /// A checkpoint state does not fit the scenario.
+    #[error("{0}")]
+    State(String),
     /// Fixed point did not converge.
     #[error(
         "coupling did not converge at t = {t_s} s: eq. 16 measure {measure:e} after {iterations} iterations"
@@ -204,33 +145,133 @@ pub struct CoupledEnergy {
     pub balance_j: f64,
 }
 
+/// The pdamp-dem contact model of the powder law (paper eq. 2–7): the linear spring–dashpot
+/// clipped at zero (eq. 2–4), the Coulomb-limited tangential spring with
+/// $k_T = \frac{1-\nu}{1-\nu/2}k_N$ and $d_T = d_N$ (eq. 5), DMT adhesion when γ > 0 (eq. 6–7).
+pub fn contact_model(law: &PowderLaw) -> ContactModel {
+    ContactModel {
+        normal: NormalLaw::Linear {
+            stiffness_n_m: law.normal_stiffness_n_m,
+            restitution: law.restitution,
+            clip_attractive: true,
+        },
+        friction: FrictionLaw::CoulombSpring {
+            friction_coefficient: law.friction,
+            stiffness_ratio: Some(law.tangential_ratio()),
+            damping_ratio: 1.0,
+        },
+        rolling: None,
+        adhesion: (law.surface_energy_j_m2 > 0.0).then_some(DmtAdhesion {
+            surface_energy_j_m2: law.surface_energy_j_m2,
+            hamaker_constant_j: law.hamaker_j,
+            cutoff_ratio: law.adhesion_cutoff,
+        }),
+    }
+}
+
+/// The interface as a triangle mesh at the reference configuration (each bilinear face
+/// split into two triangles along its diagonal 0–2, normals into the cavity) and the
+/// structure's node of every mesh vertex.
+fn interface_mesh(
+    structure: &Structure,
+    interface: &Interface,
+) -> Result<(TriMesh, Vec<usize>), MeshError> {
+    let nodes = &structure.mesh.nodes;
+    let local: std::collections::HashMap<usize, u32> = interface
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(k, &a)| (a, k as u32))
+        .collect();
+    let vertices: Vec<Vec3> = interface
+        .nodes
+        .iter()
+        .map(|&a| Vec3::new(nodes[a][0], nodes[a][1], nodes[a][2]))
+        .collect();
+    let mut triangles = Vec::with_capacity(2 * interface.faces.len());
+    for f in &interface.faces {
+        let q = f.nodes.map(|a| local[&a]);
+        triangles.push([q[0], q[1], q[2]]);
+        triangles.push([q[0], q[2], q[3]]);
+    }
+    let mesh = TriMesh::from_indexed(vertices, triangles)?;
+    // The mesh keeps the vertices it uses, welded: find each one's node by its coordinates.
+    let by_position: std::collections::HashMap<[u64; 3], usize> = interface
+        .nodes
+        .iter()
+        .map(|&a| (nodes[a].map(f64::to_bits), a))
+        .collect();
+    let vertex_node = mesh
+        .vertices()
+        .iter()
+        .map(|v| {
+            by_position
+                .get(&[v.x, v.y, v.z].map(f64::to_bits))
+                .copied()
+                .ok_or(MeshError::Empty)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((mesh, vertex_node))
+}
+
+/// The world of a coupled run without its particles: materials and contact law of `law`,
+/// gravity, time step, and the interface mesh wall on a fixed body (when the interface has
+/// faces). Returns the world and the structure's node of every mesh vertex.
+fn empty_world(
+    structure: &Structure,
+    interface: &Interface,
+    law: &PowderLaw,
+    density_kg_m3: f64,
+    gravity: [f64; 3],
+    dt: f64,
+) -> Result<(World, Vec<usize>), MeshError> {
+    let materials = vec![
+        Material::new("powder", density_kg_m3, NOMINAL_MODULUS_PA, law.poisson_ratio),
+        Material::new("structure", density_kg_m3, NOMINAL_MODULUS_PA, law.poisson_ratio),
+    ];
+    let mut w = World::new(materials, contact_model(law), dt);
+    w.gravity_m_s2 = Vec3::from(gravity);
+    let mut vertex_node = Vec::new();
+    if !interface.faces.is_empty() {
+        let (mesh, map) = interface_mesh(structure, interface)?;
+        vertex_node = map;
+        w.add_body(
+            RigidBody::new(
+                "structure",
+                BodyState::at_rest(Vec3::zeros()),
+                Motion::Fixed,
+            )
+            .with_wall("interface", Geometry::Mesh(mesh), 1),
+        );
+    }
+    w.set_wall_pass_repeatable(true);
+    Ok((w, vertex_node))
+}
+
 /// The dynamic state of a [`Coupled`] system between steps, for checkpoints: the structure's
-/// time integration, the particles (with their pair list and spring history), the
-/// particle–wall spring history, the interface force and work, the contact candidates and the
-/// fixed-point work vectors, and the iteration counters. The mesh, the interface and the
-/// factorization are rebuilt from the scenario.
+/// time integration, the particles (pdamp-dem state with contact histories), the interface mesh
+/// where the last step left it, the interface force and work, the fixed-point work vectors and
+/// the iteration counters. The structure, the interface and the factorization are rebuilt from
+/// the scenario.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub struct CoupledState {
     /// Structure.
     pub dynamics: DynamicsState,
     /// Particles.
-    pub powder: Powder,
+    pub world: WorldState,
+    /// Contact law and particle density.
+    pub law: PowderLaw,
+    density_kg_m3: f64,
+    /// Interface mesh vertices (m).
+    vertices: Vec<[f64; 3]>,
     counters: [u64; 4],
     f_ps: Vec<f64>,
-    elastic_pw_j: f64,
     interface_work_j: f64,
-    hist: Vec<WallSlots>,
-    cand_start: Vec<usize>,
-    cand: Vec<u32>,
-    cand_pos: Vec<[f64; 3]>,
-    cand_disp: f64,
     dk: Vec<f64>,
     f_trial: Vec<f64>,
     r_prev: Vec<f64>,
     r_cur: Vec<f64>,
     omega: f64,
-    xcur: Vec<[f64; 3]>,
-    vcur: Vec<[f64; 3]>,
 }
 
 /// The coupled particle–structure system.
@@ -239,8 +280,12 @@ pub struct Coupled {
     pub structure: Structure,
     /// Its time integration.
     pub dynamics: Dynamics,
-    /// The particles.
-    pub powder: Powder,
+    /// The particles; body 0 carries the interface as a deformable mesh wall.
+    pub world: World,
+    /// The powder's contact law.
+    pub law: PowderLaw,
+    /// Density of the particles (kg/m³).
+    pub density_kg_m3: f64,
     /// The interface.
     pub interface: Interface,
     /// Settings.
@@ -255,8 +300,6 @@ pub struct Coupled {
     pub steps: u64,
     /// Interface force on the structure at the committed state (all dofs) \[N\].
     pub f_ps: Vec<f64>,
-    /// Elastic energy of the particle–wall springs (committed) \[J\].
-    pub elastic_pw_j: f64,
     /// Work of the interface forces on the structure \[J\].
     pub interface_work_j: f64,
     /// The closed container of the particles in the reference configuration (the cavity);
@@ -264,71 +307,121 @@ pub struct Coupled {
     /// stops the run with [`Symptom::Escaped`]. `None` (default): open interfaces such as a
     /// plate.
     pub container: Option<Aabb>,
-    hist: Vec<WallSlots>,
-    results: Vec<WallResult>,
-    cand_start: Vec<usize>,
-    cand: Vec<u32>,
-    cand_pos: Vec<[f64; 3]>,
-    cand_disp: f64,
-    margin: f64,
+    /// Structure node of every mesh vertex, and the vertices (last iterate), m.
+    vertex_node: Vec<usize>,
+    vertices: Vec<Vec3>,
+    nodal: Vec<Vec3>,
     dk: Vec<f64>,
     f_trial: Vec<f64>,
     r_prev: Vec<f64>,
     r_cur: Vec<f64>,
     omega: f64,
-    xcur: Vec<[f64; 3]>,
-    vcur: Vec<[f64; 3]>,
 }
 
 impl Coupled {
-    /// Couples `powder` (positions inside the cavity) with the structure over `interface`.
+    /// Couples `powder` (positions inside the cavity; its law, gravity, time step, velocities
+    /// and spins) with the structure over `interface`. The particle–particle spring history of
+    /// `powder` does not carry over (the prepared bed is at rest).
     pub fn new(
         structure: Structure,
         dynamics: Dynamics,
         powder: Powder,
         interface: Interface,
         settings: CouplingSettings,
+    ) -> Result<Self, CoupleError> {
+        let density = match (powder.mass.first(), powder.radius.first()) {
+            (Some(&m), Some(&r)) => m / (4.0 / 3.0 * std::f64::consts::PI * r.powi(3)),
+            _ => 8000.0,
+        };
+        let (mut world, vertex_node) = empty_world(
+            &structure,
+            &interface,
+            &powder.law,
+            density,
+            powder.gravity,
+            dynamics.dt,
+        )?;
+        for i in 0..powder.len() {
+            let k = world.add_particle(Vec3::from(powder.pos[i]), powder.radius[i], 0);
+            world.particles.velocity[k] = Vec3::from(powder.vel[i]);
+            world.particles.angular_velocity[k] = Vec3::from(powder.omega[i]);
+        }
+        world.initialize();
+        let mut c = Self::assemble(structure, dynamics, world, powder.law, density, interface);
+        c.settings = settings;
+        c.vertex_node = vertex_node;
+        c.vertices = c.reference_vertices();
+        Ok(c)
+    }
+
+    fn assemble(
+        structure: Structure,
+        dynamics: Dynamics,
+        world: World,
+        law: PowderLaw,
+        density_kg_m3: f64,
+        interface: Interface,
     ) -> Self {
-        let n = powder.len();
         let ndof = structure.n_dof();
-        let nn = structure.mesh.nodes.len();
-        let rmin = powder.radius.iter().fold(f64::INFINITY, |m, &r| m.min(r));
         Self {
             structure,
             dynamics,
+            world,
+            law,
+            density_kg_m3,
             interface,
-            settings,
+            settings: CouplingSettings::default(),
             last_iterations: 0,
             total_iterations: 0,
             max_iterations_seen: 0,
             steps: 0,
             f_ps: vec![0.0; ndof],
-            elastic_pw_j: 0.0,
             interface_work_j: 0.0,
             container: None,
-            hist: vec![EMPTY_SLOTS; n],
-            results: vec![WallResult::default(); n],
-            cand_start: Vec::new(),
-            cand: Vec::new(),
-            cand_pos: Vec::new(),
-            cand_disp: 0.0,
-            margin: 0.5 * rmin.min(1.0),
+            vertex_node: Vec::new(),
+            vertices: Vec::new(),
+            nodal: Vec::new(),
             dk: vec![0.0; ndof],
             f_trial: vec![0.0; ndof],
             r_prev: Vec::new(),
             r_cur: Vec::new(),
             omega: 1.0,
-            xcur: vec![[0.0; 3]; nn],
-            vcur: vec![[0.0; 3]; nn],
-            powder,
         }
+    }
+
+    /// The mesh vertices at the reference configuration.
+    fn reference_vertices(&self) -> Vec<Vec3> {
+        let nodes = &self.structure.mesh.nodes;
+        self.vertex_node
+            .iter()
+            .map(|&a| Vec3::from(nodes[a]))
+            .collect()
+    }
+
+    /// The number of particles.
+    pub fn particles(&self) -> usize {
+        self.world.particles.len()
+    }
+
+    /// Total particle mass, kg.
+    pub fn particle_mass_kg(&self) -> f64 {
+        self.world.particles.total_mass()
+    }
+
+    /// The wall force on particle `i` in the last evaluation, N.
+    pub fn wall_force(&self, i: usize) -> [f64; 3] {
+        let f: Vec3 = self.world.wall_contacts()[i].iter().map(|s| s.force).sum();
+        [f.x, f.y, f.z]
     }
 
     /// The state for a checkpoint (see [`CoupledState`]).
     pub fn save_state(&self) -> CoupledState {
         CoupledState {
             dynamics: self.dynamics.save_state(),
-            powder: self.powder.clone(),
+            world: self.world.save_state(),
+            law: self.law,
+            density_kg_m3: self.density_kg_m3,
+            vertices: self.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
             counters: [
                 self.last_iterations as u64,
                 self.total_iterations,
@@ -336,363 +429,144 @@ impl Coupled {
                 self.steps,
             ],
             f_ps: self.f_ps.clone(),
-            elastic_pw_j: self.elastic_pw_j,
             interface_work_j: self.interface_work_j,
-            hist: self.hist.clone(),
-            cand_start: self.cand_start.clone(),
-            cand: self.cand.clone(),
-            cand_pos: self.cand_pos.clone(),
-            cand_disp: self.cand_disp,
             dk: self.dk.clone(),
             f_trial: self.f_trial.clone(),
             r_prev: self.r_prev.clone(),
             r_cur: self.r_cur.clone(),
             omega: self.omega,
-            xcur: self.xcur.clone(),
-            vcur: self.vcur.clone(),
         }
     }
 
-    /// The system of [`Coupled::new`] continued from `st` (saved by [`Coupled::save_state`]
-    /// for the same structure, interface and settings): the following steps are bit for bit
-    /// those of the saved run. `dynamics` is a fresh [`Dynamics`] of `structure`.
+    /// Rebuilds a system from a checkpoint state (see [`CoupledState`]); `structure`,
+    /// `dynamics` (its state is replaced) and `interface` come from the scenario. A state that
+    /// does not fit them is refused.
     pub fn from_state(
         structure: Structure,
         mut dynamics: Dynamics,
         interface: Interface,
         settings: CouplingSettings,
         st: CoupledState,
-    ) -> Result<Self, String> {
-        st.powder.check_consistency()?;
-        dynamics.restore_state(st.dynamics)?;
-        let (n, ndof) = (st.powder.len(), structure.n_dof());
-        let nn = structure.mesh.nodes.len();
-        let nf = interface.faces.len();
-        let cand_ok = (st.cand_start.is_empty() && st.cand.is_empty())
-            || (st.cand_start.len() == n + 1
-                && st.cand_start[0] == 0
-                && st.cand_start[n] == st.cand.len()
-                && st.cand_start.windows(2).all(|w| w[0] <= w[1])
-                && st.cand.iter().all(|&f| (f as usize) < nf));
-        if st.hist.len() != n
-            || !cand_ok
-            || st.cand_pos.is_empty() != st.cand_start.is_empty()
-            || !(st.cand_pos.is_empty() || st.cand_pos.len() == n)
-            || [&st.f_ps, &st.dk, &st.f_trial]
-                .iter()
-                .any(|v| v.len() != ndof)
-            || st.xcur.len() != nn
-            || st.vcur.len() != nn
+    ) -> Result<Self, CoupleError> {
+        let bad = |what: &str| CoupleError::State(what.to_string());
+        dynamics
+            .restore_state(st.dynamics)
+            .map_err(|e| CoupleError::State(e.to_string()))?;
+        st.law
+            .validate("coupling state: law.")
+            .map_err(CoupleError::State)?;
+        let ndof = structure.n_dof();
+        if [&st.f_ps, &st.dk, &st.f_trial]
+            .iter()
+            .any(|v| v.len() != ndof)
+            || !(st.density_kg_m3 > 0.0 && st.density_kg_m3.is_finite())
         {
-            return Err("coupling state does not match the structure and the particles".into());
+            return Err(bad(
+                "coupling state does not match the structure (degrees of freedom or density)",
+            ));
         }
-        let mut c = Self::new(structure, dynamics, st.powder, interface, settings);
+        let (mut world, vertex_node) = empty_world(
+            &structure,
+            &interface,
+            &st.law,
+            st.density_kg_m3,
+            [0.0; 3], // the state's gravity is restored below
+            dynamics.dt,
+        )?;
+        if st.vertices.len() != vertex_node.len() {
+            return Err(bad("coupling state: the interface mesh does not match"));
+        }
+        let vertices: Vec<Vec3> = st.vertices.iter().map(|v| Vec3::from(*v)).collect();
+        if !vertices.is_empty() {
+            world.move_wall_vertices(BODY, WALL, &vertices)?;
+        }
+        world.set_particles_of(&st.world).map_err(CoupleError::State)?;
+        world.restore_state(st.world).map_err(CoupleError::State)?;
+        let mut c = Self::assemble(
+            structure,
+            dynamics,
+            world,
+            st.law,
+            st.density_kg_m3,
+            interface,
+        );
         let [last, total, max, steps] = st.counters;
+        c.settings = settings;
+        c.vertex_node = vertex_node;
+        c.vertices = vertices;
         c.last_iterations = last as usize;
         c.total_iterations = total;
         c.max_iterations_seen = max as usize;
         c.steps = steps;
         c.f_ps = st.f_ps;
-        c.elastic_pw_j = st.elastic_pw_j;
         c.interface_work_j = st.interface_work_j;
-        c.hist = st.hist;
-        c.cand_start = st.cand_start;
-        c.cand = st.cand;
-        c.cand_pos = st.cand_pos;
-        c.cand_disp = st.cand_disp;
         c.dk = st.dk;
         c.f_trial = st.f_trial;
         c.r_prev = st.r_prev;
         c.r_cur = st.r_cur;
         c.omega = st.omega;
-        c.xcur = st.xcur;
-        c.vcur = st.vcur;
         Ok(c)
     }
 
-    /// Candidate faces per particle: faces whose current bounding box, enlarged by the particle
-    /// radius plus a margin, contains the particle centre. Rebuilt when particles or the
-    /// structure moved more than a quarter of the margin.
-    fn update_candidates(&mut self) {
-        let dmax = self
-            .interface
-            .nodes
-            .iter()
-            .map(|&a| (0..3).map(|k| self.dk[3 * a + k].abs()).fold(0.0, f64::max))
-            .fold(0.0, f64::max);
-        let moved = self.cand_pos.len() != self.powder.len()
-            || (dmax - self.cand_disp).abs() > 0.25 * self.margin
-            || self
-                .powder
-                .pos
-                .iter()
-                .zip(&self.cand_pos)
-                .any(|(a, b)| (0..3).any(|k| (a[k] - b[k]).abs() > 0.25 * self.margin));
-        if !moved {
-            return;
+    /// Moves the mesh to the interface displacements `self.dk` (the first move of a step, or
+    /// a replaced one).
+    fn move_interface(&mut self, again: bool) -> Result<(), CoupleError> {
+        if self.vertex_node.is_empty() {
+            return Ok(());
         }
         let nodes = &self.structure.mesh.nodes;
-        let faces = &self.interface.faces;
-        // face boxes and a uniform grid over them
-        let boxes: Vec<([f64; 3], [f64; 3])> = faces
-            .iter()
-            .map(|f| {
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for &a in &f.nodes {
-                    for k in 0..3 {
-                        let x = nodes[a][k] + self.dk[3 * a + k];
-                        lo[k] = lo[k].min(x);
-                        hi[k] = hi[k].max(x);
-                    }
-                }
-                (lo, hi)
-            })
-            .collect();
-        let rmax = self.powder.radius.iter().fold(0.0f64, |m, &r| m.max(r));
-        let reach = rmax + self.margin + self.powder.law.adhesion_range(rmax);
-        let mut glo = [f64::INFINITY; 3];
-        let mut ghi = [f64::NEG_INFINITY; 3];
-        let mut hmax = 0.0f64;
-        for (lo, hi) in &boxes {
-            for k in 0..3 {
-                glo[k] = glo[k].min(lo[k] - reach);
-                ghi[k] = ghi[k].max(hi[k] + reach);
-                hmax = hmax.max(hi[k] - lo[k]);
-            }
+        for (v, &a) in self.vertices.iter_mut().zip(&self.vertex_node) {
+            *v = Vec3::new(
+                nodes[a][0] + self.dk[3 * a],
+                nodes[a][1] + self.dk[3 * a + 1],
+                nodes[a][2] + self.dk[3 * a + 2],
+            );
         }
-        let cell0 = (hmax + 2.0 * reach).max(1e-9);
-        let mut nc: Vec<usize> = (0..3)
-            .map(|k| (((ghi[k] - glo[k]) / cell0).ceil() as usize).clamp(1, 512))
-            .collect();
-        // at most 8 cells per face (a structure blown apart must not allocate 512³ cells);
-        // cells grow instead, per axis, so that they still cover the whole range
-        let limit = (8 * faces.len()).max(4096);
-        while nc[0] * nc[1] * nc[2] > limit {
-            let k = (0..3).max_by_key(|&k| nc[k]).unwrap_or(0);
-            nc[k] = nc[k].div_ceil(2);
+        if again {
+            self.world
+                .move_wall_vertices_again(BODY, WALL, &self.vertices)?;
+        } else {
+            self.world.move_wall_vertices(BODY, WALL, &self.vertices)?;
         }
-        let cellk: Vec<f64> = (0..3)
-            .map(|k| {
-                let c = cell0.max((ghi[k] - glo[k]) / nc[k] as f64);
-                if c.is_finite() { c } else { f64::MAX }
-            })
-            .collect();
-        let idx = |p: [f64; 3]| -> Option<usize> {
-            let mut c = [0usize; 3];
-            for k in 0..3 {
-                let f = (p[k] - glo[k]) / cellk[k];
-                if f < 0.0 || f >= nc[k] as f64 {
-                    return None;
-                }
-                c[k] = f as usize;
-            }
-            Some(c[0] + nc[0] * (c[1] + nc[1] * c[2]))
-        };
-        let ncell = nc[0] * nc[1] * nc[2];
-        let mut cell_faces: Vec<Vec<u32>> = vec![Vec::new(); ncell];
-        for (fi, (lo, hi)) in boxes.iter().enumerate() {
-            let c0: Vec<usize> = (0..3)
-                .map(|k| (((lo[k] - reach - glo[k]) / cellk[k]).max(0.0) as usize).min(nc[k] - 1))
-                .collect();
-            let c1: Vec<usize> = (0..3)
-                .map(|k| (((hi[k] + reach - glo[k]) / cellk[k]).max(0.0) as usize).min(nc[k] - 1))
-                .collect();
-            for z in c0[2]..=c1[2] {
-                for y in c0[1]..=c1[1] {
-                    for x in c0[0]..=c1[0] {
-                        cell_faces[x + nc[0] * (y + nc[1] * z)].push(fi as u32);
-                    }
-                }
-            }
-        }
-        self.cand_start.clear();
-        self.cand.clear();
-        for (i, p) in self.powder.pos.iter().enumerate() {
-            self.cand_start.push(self.cand.len());
-            if let Some(c) = idx(*p) {
-                let r = self.powder.radius[i] + self.margin;
-                for &fi in &cell_faces[c] {
-                    let (lo, hi) = boxes[fi as usize];
-                    if (0..3).all(|k| p[k] >= lo[k] - r && p[k] <= hi[k] + r) {
-                        self.cand.push(fi);
-                    }
-                }
-            }
-        }
-        self.cand_start.push(self.cand.len());
-        self.cand_pos.clear();
-        self.cand_pos.extend_from_slice(&self.powder.pos);
-        self.cand_disp = dmax;
+        Ok(())
     }
 
-    /// The particle operator $\mathcal P$: wall forces for interface displacement `self.dk`;
-    /// writes the particle wall forces and the nodal reaction (eq. 15) into `f_trial`.
-    fn particle_operator(&mut self) {
-        let p = &self.dynamics.params;
-        let dt = self.dynamics.dt;
-        let (beta, gamma) = (p.beta, p.gamma);
-        for &a in &self.interface.nodes {
-            for k in 0..3 {
-                let g = 3 * a + k;
-                let d = &self.dynamics;
-                let acc = (self.dk[g] - d.d[g] - dt * d.v[g] - dt * dt * (0.5 - beta) * d.a[g])
-                    / (beta * dt * dt);
-                self.xcur[a][k] = self.structure.mesh.nodes[a][k] + self.dk[g];
-                self.vcur[a][k] = d.v[g] + dt * ((1.0 - gamma) * d.a[g] + gamma * acc);
-            }
+    /// The particle operator's reaction: the nodal loads of the last wall pass into `f_trial`.
+    fn gather_interface_loads(&mut self) -> Result<(), CoupleError> {
+        if self.vertex_node.is_empty() {
+            return Ok(());
         }
-        self.update_candidates();
-        let powder = &self.powder;
-        let faces = &self.interface.faces;
-        let (xcur, vcur) = (&self.xcur, &self.vcur);
-        let (cs, cand, hist) = (&self.cand_start, &self.cand, &self.hist);
-        let range_max = powder
-            .law
-            .adhesion_range(powder.radius.iter().fold(0.0f64, |m, &r| m.max(r)));
-        self.results
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(i, res)| {
-                *res = WallResult::default();
-                let list = &cand[cs[i]..cs[i + 1]];
-                if list.is_empty() {
-                    return;
-                }
-                let pos = powder.pos[i];
-                let r = powder.radius[i];
-                // gather geometric contacts
-                let mut geo: [GeoHit; 8] =
-                    [(0, 0.0, 0.0, [0.0; 3], false, [0.0; 3], 0.0, [0.0; 3]); 8];
-                let mut ng = 0;
-                for &fi in list {
-                    let f = &faces[fi as usize];
-                    let x = [
-                        xcur[f.nodes[0]],
-                        xcur[f.nodes[1]],
-                        xcur[f.nodes[2]],
-                        xcur[f.nodes[3]],
-                    ];
-                    let (s, t, c, interior, fnrm) = closest_point(&x, pos);
-                    let (n, gap) = if interior {
-                        // particle → wall direction is against the face normal (which points into the cavity)
-                        let dist = dot([pos[0] - c[0], pos[1] - c[1], pos[2] - c[2]], fnrm);
-                        ([-fnrm[0], -fnrm[1], -fnrm[2]], dist - r)
-                    } else {
-                        let v = [c[0] - pos[0], c[1] - pos[1], c[2] - pos[2]];
-                        let l = dot(v, v).sqrt();
-                        if l == 0.0 {
-                            continue;
-                        }
-                        ([v[0] / l, v[1] / l, v[2] / l], l - r)
-                    };
-                    if gap > range_max || (gap > 0.0 && range_max == 0.0) {
-                        continue;
-                    }
-                    if ng < 8 {
-                        geo[ng] = (fi, s, t, c, interior, fnrm, gap, n);
-                        ng += 1;
-                    }
-                }
-                // selection (module docs)
-                let mut keep = [false; 8];
-                for a in 0..ng {
-                    if geo[a].4 {
-                        keep[a] = true;
-                    }
-                }
-                for a in 0..ng {
-                    if geo[a].4 {
-                        continue;
-                    }
-                    let covered = (0..ng)
-                        .any(|b| b != a && geo[b].4 && dot(geo[b].5, geo[a].5) > 0.99)
-                        || (0..a).any(|b| {
-                            keep[b]
-                                && !geo[b].4
-                                && (0..3).all(|k| (geo[b].3[k] - geo[a].3[k]).abs() < 1e-9 * r)
-                        });
-                    keep[a] = !covered;
-                }
-                for a in 0..ng {
-                    if !keep[a] || res.nhits as usize >= 4 {
-                        continue;
-                    }
-                    let (fi, s, t, _, _, _, gap, n) = geo[a];
-                    let f = &faces[fi as usize];
-                    let nsh = crate::fe::quad::shape(s, t);
-                    let mut vw = [0.0; 3];
-                    for q in 0..4 {
-                        for k in 0..3 {
-                            vw[k] += nsh[q] * vcur[f.nodes[q]][k];
-                        }
-                    }
-                    let mut gt = wall::slot_get(&hist[i], fi);
-                    let (cr, tq) = wall::particle_wall(powder, i, n, gap, vw, &mut gt);
-                    wall::slot_put(&mut res.hist, fi, gt);
-                    for k in 0..3 {
-                        res.force[k] += cr.force[k];
-                        res.torque[k] += tq[k];
-                    }
-                    res.elastic += cr.elastic_j;
-                    res.dissipated += cr.dissipated_j;
-                    res.hits[res.nhits as usize] = Hit {
-                        face: fi,
-                        s,
-                        t,
-                        force: cr.force,
-                    };
-                    res.nhits += 1;
-                }
-            });
-        // eq. 15, gathered in particle order (deterministic)
-        for &a in &self.interface.nodes {
-            for k in 0..3 {
-                self.f_trial[3 * a + k] = 0.0;
-            }
+        self.world
+            .wall_nodal_forces(BODY, WALL, &mut self.nodal)?;
+        for (f, &a) in self.nodal.iter().zip(&self.vertex_node) {
+            self.f_trial[3 * a] = f.x;
+            self.f_trial[3 * a + 1] = f.y;
+            self.f_trial[3 * a + 2] = f.z;
         }
-        for res in &self.results {
-            for h in &res.hits[..res.nhits as usize] {
-                let f = &self.interface.faces[h.face as usize];
-                let nsh = crate::fe::quad::shape(h.s, h.t);
-                for q in 0..4 {
-                    for k in 0..3 {
-                        self.f_trial[3 * f.nodes[q] + k] -= nsh[q] * h.force[k];
-                    }
-                }
-            }
-        }
+        Ok(())
     }
 
     /// Sum of the particle wall forces and of the nodal interface forces of the committed step
-    /// (interface equilibrium: their sum vanishes since $\sum_j N_j = 1$) \[N\].
+    /// (interface equilibrium: their sum vanishes since the barycentric weights sum to one)
+    /// \[N\].
     pub fn interface_force_sums(&self) -> ([f64; 3], [f64; 3]) {
-        let mut fp = [0.0; 3];
-        for f in &self.powder.wall_force {
-            for k in 0..3 {
-                fp[k] += f[k];
-            }
-        }
+        let fp: Vec3 = self
+            .world
+            .wall_contacts()
+            .iter()
+            .flat_map(|s| s.iter().map(|s| s.force))
+            .sum();
         let mut fs = [0.0; 3];
         for &a in &self.interface.nodes {
             for k in 0..3 {
                 fs[k] += self.f_ps[3 * a + k];
             }
         }
-        (fp, fs)
+        ([fp.x, fp.y, fp.z], fs)
     }
 
     /// One coupled time step (Algorithm 1); returns the number of fixed-point iterations.
     pub fn step(&mut self) -> Result<usize, CoupleError> {
-        self.powder.predict();
-        self.check_particles()?;
-        self.powder.pair_forces();
-        if self.steps.is_multiple_of(OVERLAP_CHECK_EVERY) {
-            let p = &self.powder;
-            health::check_overlaps(p)
-                .map_err(|s| Box::new(HealthError::new(p.t, "coupled run", s, p)))?;
-        }
         let dt = self.dynamics.dt;
         let nps = self.interface.n_dof();
         // predictor of the interface displacements
@@ -705,12 +579,18 @@ impl Coupled {
                 }
             }
         }
+        self.move_interface(false)?;
+        self.world.step_deferred();
+        self.check_particles()?;
+        if self.steps.is_multiple_of(OVERLAP_CHECK_EVERY) {
+            health::check_world_overlaps(&self.world).map_err(|s| self.failure(s))?;
+        }
         self.r_prev.resize(nps, 0.0);
         self.r_cur.resize(nps, 0.0);
         let mut omega = self.settings.initial_relaxation;
         let mut k = 0;
         loop {
-            self.particle_operator();
+            self.gather_interface_loads()?;
             if let Err(e) = self
                 .dynamics
                 .solve(&mut self.structure, Some(&self.f_trial), k == 0)
@@ -765,9 +645,11 @@ impl Coupled {
                 }
             }
             std::mem::swap(&mut self.r_prev, &mut self.r_cur);
+            self.move_interface(true)?;
+            self.world.repeat_wall_pass()?;
         }
         self.omega = omega;
-        // commit: interface work (trapezoidal), structure, particle wall forces and history
+        // commit: interface work (trapezoidal), structure, the particles' second half kick
         let mut w = 0.0;
         for &a in &self.interface.nodes {
             for c in 0..3 {
@@ -780,18 +662,7 @@ impl Coupled {
         self.interface_work_j += w;
         self.dynamics.commit();
         std::mem::swap(&mut self.f_ps, &mut self.f_trial);
-        let mut el = 0.0;
-        let mut diss = 0.0;
-        for (i, r) in self.results.iter().enumerate() {
-            self.powder.wall_force[i] = r.force;
-            self.powder.wall_torque[i] = r.torque;
-            self.hist[i] = r.hist;
-            el += r.elastic;
-            diss += r.dissipated;
-        }
-        self.elastic_pw_j = el;
-        self.powder.ledger.dissipated_pw_j += diss;
-        self.powder.finish();
+        self.world.complete_step();
         self.last_iterations = k;
         self.total_iterations += k as u64;
         self.max_iterations_seen = self.max_iterations_seen.max(k);
@@ -799,12 +670,20 @@ impl Coupled {
         Ok(k)
     }
 
+    /// The health error of `symptom` now.
+    fn failure(&self, symptom: Symptom) -> Box<HealthError> {
+        Box::new(HealthError::of_world(
+            self.world.time_s,
+            "coupled run",
+            symptom,
+            &self.world,
+            &self.law,
+        ))
+    }
+
     /// Health of the particles after the drift of a step: finite states and centres inside
-    /// the container (if set); the overlaps are checked after the force pass, every
-    /// [`OVERLAP_CHECK_EVERY`] steps.
+    /// the container (if set); the overlaps are checked every [`OVERLAP_CHECK_EVERY`] steps.
     fn check_particles(&self) -> Result<(), Box<HealthError>> {
-        let p = &self.powder;
-        let fail = |symptom| Box::new(HealthError::new(p.t, "coupled run", symptom, p));
         let margin = self.container.map(|b| {
             let dmax = self
                 .interface
@@ -816,16 +695,14 @@ impl Coupled {
             let size = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max);
             (b, dmax + 1e-9 * size)
         });
-        health::check_particles(p, margin.as_ref().map(|(b, m)| (b, *m)))
-            .map_err(|(_, s)| fail(s))?;
-        Ok(())
+        health::check_world_particles(&self.world, margin.as_ref().map(|(b, m)| (b, *m)))
+            .map_err(|(_, s)| self.failure(s))
     }
 
     /// The health error of a non-finite structural state (first non-finite trial dof).
     fn structure_failure(&self) -> Box<HealthError> {
-        let p = &self.powder;
-        if let Err((_, s)) = health::check_particles(p, None) {
-            return Box::new(HealthError::new(p.t, "coupled run", s, p));
+        if let Err((_, s)) = health::check_world_particles(&self.world, None) {
+            return self.failure(s);
         }
         let node = self
             .dynamics
@@ -839,23 +716,19 @@ impl Coupled {
             .elements
             .iter()
             .position(|el| el.contains(&node));
-        Box::new(HealthError::new(
-            p.t,
-            "coupled run",
-            Symptom::NonFiniteStructure { node, element },
-            p,
-        ))
+        self.failure(Symptom::NonFiniteStructure { node, element })
     }
 
     /// Energies of the committed state.
     pub fn energy(&self) -> CoupledEnergy {
+        let l = &self.world.ledger;
         let mut e = CoupledEnergy {
             structure_kinetic_j: self.dynamics.kinetic_energy(&self.structure),
             structure_strain_j: self.dynamics.strain_energy,
-            particle_kinetic_j: self.powder.kinetic_energy(),
-            particle_potential_j: self.powder.potential_energy(),
-            contact_elastic_j: self.powder.elastic_pp_j + self.elastic_pw_j,
-            dissipated_j: self.powder.ledger.dissipated_pp_j + self.powder.ledger.dissipated_pw_j,
+            particle_kinetic_j: l.kinetic_j,
+            particle_potential_j: l.potential_j,
+            contact_elastic_j: l.elastic_j,
+            dissipated_j: l.dissipated_j(),
             load_work_j: self.dynamics.external_work - self.interface_work_j,
             balance_j: 0.0,
         };

@@ -16,6 +16,7 @@
 //!   [`ENERGY_CREATED_FRACTION`] of it (loose beds drift by ≤ 0.11).
 
 use crate::dem::{Powder, PowderLaw};
+use pdamp_dem::World;
 use crate::fe::Aabb;
 
 /// Largest healthy overlap relative to the smaller diameter of a pair.
@@ -156,6 +157,21 @@ impl Evidence {
         }
     }
 
+    /// The evidence of a pdamp-dem world whose contacts follow `law`.
+    pub fn of_world(w: &World, law: &PowderLaw) -> Self {
+        let m = w
+            .particles
+            .mass
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b));
+        Self {
+            time_step_s: w.dt_s,
+            contact_time_s: std::f64::consts::PI * (0.5 * m / law.normal_stiffness_n_m).sqrt(),
+            max_relative_overlap: world_max_relative_overlap(w).0,
+            dissipated_j: w.ledger.dissipated_j(),
+        }
+    }
+
     /// The likely cause of `symptom`, chosen from the evidence, with the fix.
     pub fn likely_cause(&self, symptom: &Symptom) -> String {
         let (r, o, tc) = (
@@ -213,7 +229,26 @@ pub struct HealthError {
 impl HealthError {
     /// The error for `symptom`, with the evidence of the particles and the cause.
     pub fn new(time_s: f64, stage: &'static str, symptom: Symptom, p: &Powder) -> Self {
-        let evidence = Evidence::of(p);
+        Self::with_evidence(time_s, stage, symptom, Evidence::of(p))
+    }
+
+    /// The error for `symptom` in a pdamp-dem world whose contacts follow `law`.
+    pub fn of_world(
+        time_s: f64,
+        stage: &'static str,
+        symptom: Symptom,
+        w: &World,
+        law: &PowderLaw,
+    ) -> Self {
+        Self::with_evidence(time_s, stage, symptom, Evidence::of_world(w, law))
+    }
+
+    fn with_evidence(
+        time_s: f64,
+        stage: &'static str,
+        symptom: Symptom,
+        evidence: Evidence,
+    ) -> Self {
         let cause = evidence.likely_cause(&symptom);
         Self {
             time_s,
@@ -238,12 +273,33 @@ pub fn check_particles(
     p: &Powder,
     container: Option<(&Aabb, f64)>,
 ) -> Result<(), (usize, Symptom)> {
-    for i in 0..p.len() {
-        for (quantity, v) in [
-            ("position", p.pos[i]),
-            ("velocity", p.vel[i]),
-            ("angular velocity", p.omega[i]),
-        ] {
+    check_states(p.len(), |i| [p.pos[i], p.vel[i], p.omega[i]], container)
+}
+
+/// [`check_particles`] for the particles of a pdamp-dem world.
+pub fn check_world_particles(
+    w: &World,
+    container: Option<(&Aabb, f64)>,
+) -> Result<(), (usize, Symptom)> {
+    let p = &w.particles;
+    let a = |v: &pdamp_dem::Vec3| [v.x, v.y, v.z];
+    check_states(
+        p.len(),
+        |i| [a(&p.position[i]), a(&p.velocity[i]), a(&p.angular_velocity[i])],
+        container,
+    )
+}
+
+/// The checks of [`check_particles`] on `n` particles whose position, velocity and spin
+/// `state(i)` gives.
+fn check_states(
+    n: usize,
+    state: impl Fn(usize) -> [[f64; 3]; 3],
+    container: Option<(&Aabb, f64)>,
+) -> Result<(), (usize, Symptom)> {
+    for i in 0..n {
+        let [x, v, w] = state(i);
+        for (quantity, v) in [("position", x), ("velocity", v), ("angular velocity", w)] {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err((
                     i,
@@ -256,7 +312,6 @@ pub fn check_particles(
             }
         }
         if let Some((b, margin)) = container {
-            let x = p.pos[i];
             let out = (0..3)
                 .map(|k| (b.min[k] - margin - x[k]).max(x[k] - b.max[k] - margin))
                 .fold(0.0f64, f64::max);
@@ -271,6 +326,31 @@ pub fn check_particles(
                 ));
             }
         }
+    }
+    Ok(())
+}
+
+/// The largest particle–particle overlap of a pdamp-dem world relative to the smaller
+/// diameter, with its pair (over the neighbour pairs).
+pub fn world_max_relative_overlap(w: &World) -> (f64, usize, usize) {
+    let p = &w.particles;
+    w.neighbor_pairs()
+        .map(|(i, j)| {
+            let overlap = p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm();
+            (overlap / (2.0 * p.radius[i].min(p.radius[j])), i, j)
+        })
+        .fold((0.0, 0, 0), |a, b| if b.0 > a.0 { b } else { a })
+}
+
+/// [`check_overlaps`] for a pdamp-dem world.
+pub fn check_world_overlaps(w: &World) -> Result<(), Symptom> {
+    let (rel, i, j) = world_max_relative_overlap(w);
+    if rel > MAX_RELATIVE_OVERLAP {
+        return Err(Symptom::Overlap {
+            particle: i,
+            partner: j,
+            relative: rel,
+        });
     }
     Ok(())
 }

@@ -620,7 +620,7 @@ fn coupled(pos: Vec<[f64; 3]>) -> Coupled {
         sc.run.gravity_m_s2,
         dt,
     );
-    let mut c = Coupled::new(s, dy, powder, interface, sc.run.coupling);
+    let mut c = Coupled::new(s, dy, powder, interface, sc.run.coupling).unwrap();
     c.container = Some(sc.beam.cavity());
     c
 }
@@ -650,7 +650,7 @@ fn coupled_run_stops_on_non_finite_particles_naming_particle_time_and_cause() {
     for _ in 0..3 {
         c.step().unwrap();
     }
-    c.powder.vel[5] = [f64::NAN, 0.0, 0.0];
+    c.world.particles.velocity[5] = pdamp_dem::Vec3::new(f64::NAN, 0.0, 0.0);
     let h = health(c.step().unwrap_err());
     assert!(
         matches!(

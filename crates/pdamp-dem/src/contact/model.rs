@@ -85,11 +85,11 @@ pub enum NormalLaw {
     },
     /// Linear spring–dashpot $F_n = k_N\delta + d_N\dot\delta$ with
     /// $d_N = 2|\ln e|\sqrt{k_N \bar M/(\ln^2 e + \pi^2)}$ [P Eq. (2)–(4)]; reproduces e exactly
-    /// when not clipped.
+    /// when not clipped (e = 1: an elastic spring).
     Linear {
         /// Spring stiffness $k_N$ in N/m.
         stiffness_n_m: f64,
-        /// Coefficient of restitution e in (0, 1).
+        /// Coefficient of restitution e in (0, 1].
         restitution: f64,
         /// Clip the total normal force at zero (as [P Eq. (2)] does); default false.
         #[serde(default)]
@@ -332,9 +332,9 @@ impl NormalLaw {
                     stiffness_n_m,
                 )?;
                 check(
-                    restitution > 0.0 && restitution < 1.0,
+                    restitution > 0.0 && restitution <= 1.0,
                     "normal.restitution",
-                    "lie in (0, 1)",
+                    "lie in (0, 1] (1: no damping)",
                     restitution,
                 )
             }

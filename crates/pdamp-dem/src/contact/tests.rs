@@ -859,10 +859,16 @@ fn validation_messages_name_the_field() {
         restitution: 1.0,
         clip_attractive: false,
     };
+    assert!(m.validate().is_ok(), "e = 1 is an elastic linear spring");
+    m.normal = NormalLaw::Linear {
+        stiffness_n_m: 1e5,
+        restitution: 1.2,
+        clip_attractive: false,
+    };
     assert!(
         m.validate()
             .unwrap_err()
-            .starts_with("normal.restitution must lie in (0, 1)")
+            .starts_with("normal.restitution must lie in (0, 1]")
     );
     m.normal = NormalLaw::Linear {
         stiffness_n_m: -1.0,
