@@ -213,15 +213,13 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
             header.format, header.pdamp_version
         ));
     }
+    // The kind too (before the body, whose layout is the kind's).
+    if header.kind != kind {
+        return Err(format!("written by a '{}' run, not '{kind}'", header.kind));
+    }
     let f: InFile<T> = options
         .deserialize(&data[MAGIC.len()..])
         .map_err(|e| format!("unreadable ({e})"))?;
-    if f.header.kind != kind {
-        return Err(format!(
-            "written by a '{}' run, not '{kind}'",
-            f.header.kind
-        ));
-    }
     if scenario_digest.is_some_and(|d| d != f.header.scenario_digest) {
         return Err(
             "written for a different scenario (the file changed since); start afresh without \

@@ -674,8 +674,9 @@ pub struct CantileverResult {
     pub energy_closure: f64,
 }
 
-/// Kind tag of `pdamp powder run` checkpoints.
-pub const CHECKPOINT_KIND: &str = "powder-run";
+/// Kind tag of `pdamp powder run` checkpoints (`-2`: the coupled run's particles are a
+/// pdamp-dem world; checkpoints of the earlier layout are refused by name).
+pub const CHECKPOINT_KIND: &str = "powder-run-2";
 
 /// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
 pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, String> {
