@@ -41,6 +41,50 @@ fn top_two(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
 }
 
 impl NeighborList {
+    /// Checks the list against `n` particles (a list read from a file): finite skin and range,
+    /// rows that cover the pairs in order, pairs `(i, j)` with `i < j < n` in the row of `i`,
+    /// reference positions for all particles (or none). The error says what is wrong.
+    pub fn check_consistency(&self, n: usize) -> Result<(), String> {
+        let bad = |what: &str| Err(format!("neighbour list: {what}"));
+        if !(self.skin_m.is_finite() && self.skin_m >= 0.0)
+            || !(self.extra_range_m.is_finite() && self.extra_range_m >= 0.0)
+        {
+            return bad("skin or range not finite and non-negative");
+        }
+        let m = self.first.len();
+        if self.second.len() != m {
+            return bad("pair columns of different lengths");
+        }
+        if !(self.reference_position.is_empty() || self.reference_position.len() == n) {
+            return bad("reference positions do not match the particles");
+        }
+        if self.row_start.is_empty() {
+            return if m == 0 {
+                Ok(())
+            } else {
+                bad("pairs without rows")
+            };
+        }
+        if self.row_start.len() != n + 1
+            || self.row_start[0] != 0
+            || self.row_start[n] as usize != m
+            || self.row_start.windows(2).any(|w| w[0] > w[1])
+        {
+            return bad("rows do not cover the pairs");
+        }
+        for i in 0..n {
+            for k in self.row_start[i] as usize..self.row_start[i + 1] as usize {
+                if self.first[k] as usize != i
+                    || self.second[k] as usize >= n
+                    || self.second[k] <= self.first[k]
+                {
+                    return bad("a pair is not in its first partner's row");
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// An empty list with the given skin.
     pub fn new(skin_m: f64) -> Self {
         Self {

@@ -115,6 +115,9 @@ impl World {
         if s.material.len() != s.radius.len() || s.id.len() != s.radius.len() {
             return Err("state: particle columns of different lengths".into());
         }
+        if let Some(i) = s.radius.iter().position(|r| !(r.is_finite() && *r > 0.0)) {
+            return Err(format!("state: particle {i} has radius {} m", s.radius[i]));
+        }
         if let Some((i, &m)) = s
             .material
             .iter()
@@ -131,6 +134,50 @@ impl World {
             self.add_particle(Vec3::zeros(), r, m);
         }
         self.particles.id.clone_from(&s.id);
+        Ok(())
+    }
+
+    /// Takes over the particles of `s`, a state of another world (a bed prepared between
+    /// other walls): radii, materials and ids, positions, velocities, spins, the neighbour list
+    /// and the particle–particle contacts with their history. Bodies, wall contacts, clock and
+    /// ledger stay this world's; it initialises again at its next step (forces, wall contacts,
+    /// ledger reset). A state whose contacts or neighbour pairs do not fit its particles is
+    /// refused.
+    pub fn adopt_particles(&mut self, s: &WorldState) -> Result<(), String> {
+        let n = s.radius.len();
+        if [
+            s.position.len(),
+            s.velocity.len(),
+            s.angular_velocity.len(),
+            s.external_force.len(),
+        ]
+        .iter()
+        .any(|&l| l != n)
+            || s.contacts.iter().any(|c| c.i >= c.j || c.j as usize >= n)
+            || s.neighbors
+                .first
+                .iter()
+                .chain(&s.neighbors.second)
+                .any(|&i| i as usize >= n)
+        {
+            return Err(
+                "bed state: particle columns, contacts or neighbour pairs inconsistent".into(),
+            );
+        }
+        s.neighbors
+            .check_consistency(n)
+            .map_err(|e| format!("bed state: {e}"))?;
+        self.set_particles_of(s)?;
+        let p = &mut self.particles;
+        p.position.clone_from(&s.position);
+        p.velocity.clone_from(&s.velocity);
+        p.angular_velocity.clone_from(&s.angular_velocity);
+        p.external_force.clone_from(&s.external_force);
+        self.neighbors = s.neighbors.clone();
+        self.set_pp_contacts(&s.contacts);
+        self.wall_slots.clear();
+        self.wall_ref.clear();
+        self.initialized = false;
         Ok(())
     }
 
@@ -186,6 +233,24 @@ impl World {
             || (s.initialized && s.wall_slots.len() != n)
         {
             return Err("checkpoint neighbour list is inconsistent".into());
+        }
+        s.neighbors
+            .check_consistency(n)
+            .map_err(|e| format!("checkpoint {e}"))?;
+        if !(s.dt_s.is_finite() && s.dt_s > 0.0 && s.time_s.is_finite())
+            || !s.gravity_m_s2.iter().all(|g| g.is_finite())
+        {
+            return Err("checkpoint time step, time or gravity not finite".into());
+        }
+        let walls_of = |b: u16| self.bodies.get(b as usize).map_or(0, |b| b.walls.len());
+        if s.wall_slots
+            .iter()
+            .flatten()
+            .any(|w| w.wall as usize >= walls_of(w.body))
+        {
+            return Err(
+                "checkpoint wall contacts refer to walls the scenario does not have".into(),
+            );
         }
         let p = &mut self.particles;
         p.position = s.position;

@@ -91,7 +91,8 @@ impl WallRepeat {
         self.latest_particles.clear();
         self.latest_particles.extend_from_slice(list);
         self.latest.clear();
-        self.latest.resize(list.len(), (Vec3::zeros(), Vec3::zeros()));
+        self.latest
+            .resize(list.len(), (Vec3::zeros(), Vec3::zeros()));
         &mut self.latest
     }
 
@@ -104,9 +105,7 @@ impl WallRepeat {
     /// The wall slots particle `i` had at the start of the step.
     fn saved_slots(&self, i: u32) -> &[WallSlot] {
         match self.saved_particles.binary_search(&i) {
-            Ok(k) => {
-                &self.saved[self.saved_start[k] as usize..self.saved_start[k + 1] as usize]
-            }
+            Ok(k) => &self.saved[self.saved_start[k] as usize..self.saved_start[k + 1] as usize],
             Err(_) => &[],
         }
     }

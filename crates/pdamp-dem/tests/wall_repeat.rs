@@ -73,9 +73,10 @@ fn membrane_world(repeatable: bool) -> World {
 fn surface(flat: &[Vec3], amp: f64, out: &mut Vec<Vec3>) {
     let pi = std::f64::consts::PI;
     out.clear();
-    out.extend(flat.iter().map(|p| {
-        p + Vec3::z() * (amp * (pi * p.x / SIDE).cos() * (pi * p.y / SIDE).cos())
-    }));
+    out.extend(
+        flat.iter()
+            .map(|p| p + Vec3::z() * (amp * (pi * p.x / SIDE).cos() * (pi * p.y / SIDE).cos())),
+    );
 }
 
 #[test]
@@ -123,10 +124,15 @@ fn repeated_wall_pass_equals_the_step_with_the_final_walls() {
         for (a, b) in nodal_a.iter().zip(&nodal_b) {
             worst_f = worst_f.max((a - b).norm() / scale);
         }
-        worst_load = worst_load.max((direct.body_load(0).0 - coupled.body_load(0).0).norm() / scale);
+        worst_load =
+            worst_load.max((direct.body_load(0).0 - coupled.body_load(0).0).norm() / scale);
         direct.complete_step();
         coupled.complete_step();
-        assert_eq!(direct.num_pw_contacts(), coupled.num_pw_contacts(), "step {k}");
+        assert_eq!(
+            direct.num_pw_contacts(),
+            coupled.num_pw_contacts(),
+            "step {k}"
+        );
         contact_steps += direct.num_pw_contacts();
         for (a, b) in direct
             .particles
@@ -161,9 +167,15 @@ fn repeated_wall_pass_equals_the_step_with_the_final_walls() {
     // The same arithmetic in the same order: equal to the bit.
     assert!(worst_x == 0.0, "positions differ by {worst_x:.3e} m");
     assert!(worst_f == 0.0, "nodal forces differ by {worst_f:.3e} m g");
-    assert!(worst_load == 0.0, "body loads differ by {worst_load:.3e} m g");
+    assert!(
+        worst_load == 0.0,
+        "body loads differ by {worst_load:.3e} m g"
+    );
     assert_eq!(a, b, "ledgers differ");
-    assert!(max_closure < 1e-4, "ledger closes only to {max_closure:.3e}");
+    assert!(
+        max_closure < 1e-4,
+        "ledger closes only to {max_closure:.3e}"
+    );
 }
 
 #[test]

@@ -17,14 +17,16 @@ use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
 pub use pdamp_io::run::RunOptions;
 use serde::{Deserialize, Serialize};
 
+use crate::bed::PowderBed;
 use crate::couple::{Coupled, CoupledEnergy, CoupledState, CouplingSettings, Interface};
 use crate::damping::{self, TableOneRatios};
-use crate::dem::{LogNormal, PowderLaw};
 use crate::fe::{
     self, Aabb, BoxMeshDivisions, Dynamics, GenAlpha, HexMesh, LoadRamp, MassKind, Rayleigh,
     Structure, SurfaceLoad, SvkMaterial,
 };
+use crate::law::PowderLaw;
 use crate::prep::{PrepReport, PrepSettings, Preparation};
+use crate::psd::LogNormal;
 
 fn d_len() -> f64 {
     0.132
@@ -871,14 +873,7 @@ fn run_core(
             Some((pw, Some(rep)))
         }
         (None, None) => Some((
-            crate::dem::Powder::new(
-                PowderLaw::PAPER,
-                Vec::new(),
-                Vec::new(),
-                8000.0,
-                [0.0; 3],
-                dt,
-            ),
+            PowderBed::at_rest(PowderLaw::PAPER, &[], &[], 8000.0, [0.0; 3], dt),
             None,
         )),
     };
@@ -933,7 +928,7 @@ fn run_core(
             (c, res, st.step + 1)
         }
         (None, Some((mut powder, prep))) => {
-            powder.gravity = sc.run.gravity_m_s2;
+            powder.world.gravity_m_s2 = pdamp_dem::Vec3::from(sc.run.gravity_m_s2);
             let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling)
                 .map_err(|e| e.to_string())?;
             c.container = sc.powder.is_some().then_some(cavity);

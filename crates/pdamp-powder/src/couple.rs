@@ -21,14 +21,14 @@
 //! Contacts with several faces (edges, corners, coplanar neighbours) follow the mesh wall's
 //! rules of pdamp-dem: one contact per locally closest feature, no double counting.
 
-use pdamp_dem::contact::{ContactModel, DmtAdhesion, FrictionLaw, NormalLaw};
 use pdamp_dem::wall_repeat::WallRepeatError;
 use pdamp_dem::walls::{Geometry, MeshError, TriMesh};
-use pdamp_dem::{BodyState, Material, Motion, RigidBody, Vec3, World, WorldState};
+use pdamp_dem::{BodyState, Motion, RigidBody, Vec3, World, WorldState};
 
-use crate::dem::{Powder, PowderLaw};
+use crate::bed::{PowderBed, WALL_MATERIAL, powder_world};
 use crate::fe::{Aabb, Dynamics, DynamicsError, DynamicsState, Face, Structure};
 use crate::health::{self, HealthError, Symptom};
+use crate::law::PowderLaw;
 
 /// Steps between the overlap checks of the coupled run (positions, velocities and the
 /// container are checked every step).
@@ -37,11 +37,6 @@ pub const OVERLAP_CHECK_EVERY: u64 = 100;
 /// The body of the world that carries the interface, and its mesh wall.
 const BODY: usize = 0;
 const WALL: usize = 0;
-
-/// Young's modulus of the particle and wall materials of the world, Pa: not used by the
-/// powder's linear contact law (its stiffness is `normal_stiffness_n_m`), only a nominal value
-/// for the engine's material table (equal on both sides: no soft-wall rules).
-const NOMINAL_MODULUS_PA: f64 = 200e9;
 
 /// The interface $\Gamma^{ps}$: boundary faces of the structure in contact with the powder.
 #[derive(Debug, Clone)]
@@ -145,30 +140,6 @@ pub struct CoupledEnergy {
     pub balance_j: f64,
 }
 
-/// The pdamp-dem contact model of the powder law (paper eq. 2–7): the linear spring–dashpot
-/// clipped at zero (eq. 2–4), the Coulomb-limited tangential spring with
-/// $k_T = \frac{1-\nu}{1-\nu/2}k_N$ and $d_T = d_N$ (eq. 5), DMT adhesion when γ > 0 (eq. 6–7).
-pub fn contact_model(law: &PowderLaw) -> ContactModel {
-    ContactModel {
-        normal: NormalLaw::Linear {
-            stiffness_n_m: law.normal_stiffness_n_m,
-            restitution: law.restitution,
-            clip_attractive: true,
-        },
-        friction: FrictionLaw::CoulombSpring {
-            friction_coefficient: law.friction,
-            stiffness_ratio: Some(law.tangential_ratio()),
-            damping_ratio: 1.0,
-        },
-        rolling: None,
-        adhesion: (law.surface_energy_j_m2 > 0.0).then_some(DmtAdhesion {
-            surface_energy_j_m2: law.surface_energy_j_m2,
-            hamaker_constant_j: law.hamaker_j,
-            cutoff_ratio: law.adhesion_cutoff,
-        }),
-    }
-}
-
 /// The interface as a triangle mesh at the reference configuration (each bilinear face
 /// split into two triangles along its diagonal 0–2, normals into the cavity) and the
 /// structure's node of every mesh vertex.
@@ -225,12 +196,7 @@ fn empty_world(
     gravity: [f64; 3],
     dt: f64,
 ) -> Result<(World, Vec<usize>), MeshError> {
-    let materials = vec![
-        Material::new("powder", density_kg_m3, NOMINAL_MODULUS_PA, law.poisson_ratio),
-        Material::new("structure", density_kg_m3, NOMINAL_MODULUS_PA, law.poisson_ratio),
-    ];
-    let mut w = World::new(materials, contact_model(law), dt);
-    w.gravity_m_s2 = Vec3::from(gravity);
+    let mut w = powder_world(law, density_kg_m3, gravity, dt);
     let mut vertex_node = Vec::new();
     if !interface.faces.is_empty() {
         let (mesh, map) = interface_mesh(structure, interface)?;
@@ -241,7 +207,7 @@ fn empty_world(
                 BodyState::at_rest(Vec3::zeros()),
                 Motion::Fixed,
             )
-            .with_wall("interface", Geometry::Mesh(mesh), 1),
+            .with_wall("interface", Geometry::Mesh(mesh), WALL_MATERIAL),
         );
     }
     w.set_wall_pass_repeatable(true);
@@ -319,35 +285,37 @@ pub struct Coupled {
 }
 
 impl Coupled {
-    /// Couples `powder` (positions inside the cavity; its law, gravity, time step, velocities
-    /// and spins) with the structure over `interface`. The particle–particle spring history of
-    /// `powder` does not carry over (the prepared bed is at rest).
+    /// Couples the particles of `bed` (inside the cavity; their law, gravity, velocities,
+    /// spins and particle–particle contacts) with the structure over `interface`, at the
+    /// structure's time step.
     pub fn new(
         structure: Structure,
         dynamics: Dynamics,
-        powder: Powder,
+        bed: PowderBed,
         interface: Interface,
         settings: CouplingSettings,
     ) -> Result<Self, CoupleError> {
-        let density = match (powder.mass.first(), powder.radius.first()) {
-            (Some(&m), Some(&r)) => m / (4.0 / 3.0 * std::f64::consts::PI * r.powi(3)),
-            _ => 8000.0,
-        };
+        let g = bed.world.gravity_m_s2;
         let (mut world, vertex_node) = empty_world(
             &structure,
             &interface,
-            &powder.law,
-            density,
-            powder.gravity,
+            &bed.law,
+            bed.density_kg_m3,
+            [g.x, g.y, g.z],
             dynamics.dt,
         )?;
-        for i in 0..powder.len() {
-            let k = world.add_particle(Vec3::from(powder.pos[i]), powder.radius[i], 0);
-            world.particles.velocity[k] = Vec3::from(powder.vel[i]);
-            world.particles.angular_velocity[k] = Vec3::from(powder.omega[i]);
-        }
+        world
+            .adopt_particles(&bed.world.save_state())
+            .map_err(CoupleError::State)?;
         world.initialize();
-        let mut c = Self::assemble(structure, dynamics, world, powder.law, density, interface);
+        let mut c = Self::assemble(
+            structure,
+            dynamics,
+            world,
+            bed.law,
+            bed.density_kg_m3,
+            interface,
+        );
         c.settings = settings;
         c.vertex_node = vertex_node;
         c.vertices = c.reference_vertices();
@@ -480,7 +448,9 @@ impl Coupled {
         if !vertices.is_empty() {
             world.move_wall_vertices(BODY, WALL, &vertices)?;
         }
-        world.set_particles_of(&st.world).map_err(CoupleError::State)?;
+        world
+            .set_particles_of(&st.world)
+            .map_err(CoupleError::State)?;
         world.restore_state(st.world).map_err(CoupleError::State)?;
         let mut c = Self::assemble(
             structure,
@@ -536,8 +506,7 @@ impl Coupled {
         if self.vertex_node.is_empty() {
             return Ok(());
         }
-        self.world
-            .wall_nodal_forces(BODY, WALL, &mut self.nodal)?;
+        self.world.wall_nodal_forces(BODY, WALL, &mut self.nodal)?;
         for (f, &a) in self.nodal.iter().zip(&self.vertex_node) {
             self.f_trial[3 * a] = f.x;
             self.f_trial[3 * a + 1] = f.y;

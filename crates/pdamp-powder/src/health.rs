@@ -15,9 +15,9 @@
 //!   scale, or a balance (stored + dissipated − work) grown by more than
 //!   [`ENERGY_CREATED_FRACTION`] of it (loose beds drift by ≤ 0.11).
 
-use crate::dem::{Powder, PowderLaw};
-use pdamp_dem::World;
 use crate::fe::Aabb;
+use crate::law::PowderLaw;
+use pdamp_dem::World;
 
 /// Largest healthy overlap relative to the smaller diameter of a pair.
 pub const MAX_RELATIVE_OVERLAP: f64 = 0.5;
@@ -147,16 +147,6 @@ impl Evidence {
         self.time_step_s / self.contact_time_s
     }
 
-    /// Evidence from the particles.
-    pub fn of(p: &Powder) -> Self {
-        Self {
-            time_step_s: p.dt,
-            contact_time_s: contact_time_s(&p.law, p),
-            max_relative_overlap: p.max_relative_overlap(),
-            dissipated_j: p.ledger.dissipated_pp_j + p.ledger.dissipated_pw_j,
-        }
-    }
-
     /// The evidence of a pdamp-dem world whose contacts follow `law`.
     pub fn of_world(w: &World, law: &PowderLaw) -> Self {
         let m = w
@@ -227,11 +217,6 @@ pub struct HealthError {
 }
 
 impl HealthError {
-    /// The error for `symptom`, with the evidence of the particles and the cause.
-    pub fn new(time_s: f64, stage: &'static str, symptom: Symptom, p: &Powder) -> Self {
-        Self::with_evidence(time_s, stage, symptom, Evidence::of(p))
-    }
-
     /// The error for `symptom` in a pdamp-dem world whose contacts follow `law`.
     pub fn of_world(
         time_s: f64,
@@ -260,23 +245,8 @@ impl HealthError {
     }
 }
 
-/// Shortest particle–particle contact time $\pi\sqrt{m_{eff}/k_N}$ of the linear law, with
-/// $m_{eff}$ of the two lightest particles \[s\] (infinite without particles).
-pub fn contact_time_s(law: &PowderLaw, p: &Powder) -> f64 {
-    let m = p.mass.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-    std::f64::consts::PI * (0.5 * m / law.normal_stiffness_n_m).sqrt()
-}
-
-/// Non-finite positions, velocities and spins; particle centres outside `container` enlarged
-/// by `margin_m` (when given).
-pub fn check_particles(
-    p: &Powder,
-    container: Option<(&Aabb, f64)>,
-) -> Result<(), (usize, Symptom)> {
-    check_states(p.len(), |i| [p.pos[i], p.vel[i], p.omega[i]], container)
-}
-
-/// [`check_particles`] for the particles of a pdamp-dem world.
+/// Non-finite positions, velocities and spins of the particles of a pdamp-dem world; particle
+/// centres outside `container` enlarged by `margin_m` (when given).
 pub fn check_world_particles(
     w: &World,
     container: Option<(&Aabb, f64)>,
@@ -285,12 +255,18 @@ pub fn check_world_particles(
     let a = |v: &pdamp_dem::Vec3| [v.x, v.y, v.z];
     check_states(
         p.len(),
-        |i| [a(&p.position[i]), a(&p.velocity[i]), a(&p.angular_velocity[i])],
+        |i| {
+            [
+                a(&p.position[i]),
+                a(&p.velocity[i]),
+                a(&p.angular_velocity[i]),
+            ]
+        },
         container,
     )
 }
 
-/// The checks of [`check_particles`] on `n` particles whose position, velocity and spin
+/// The checks of [`check_world_particles`] on `n` particles whose position, velocity and spin
 /// `state(i)` gives.
 fn check_states(
     n: usize,
@@ -342,7 +318,7 @@ pub fn world_max_relative_overlap(w: &World) -> (f64, usize, usize) {
         .fold((0.0, 0, 0), |a, b| if b.0 > a.0 { b } else { a })
 }
 
-/// [`check_overlaps`] for a pdamp-dem world.
+/// The first pair whose overlap exceeds [`MAX_RELATIVE_OVERLAP`] of the smaller diameter.
 pub fn check_world_overlaps(w: &World) -> Result<(), Symptom> {
     let (rel, i, j) = world_max_relative_overlap(w);
     if rel > MAX_RELATIVE_OVERLAP {
@@ -351,31 +327,6 @@ pub fn check_world_overlaps(w: &World) -> Result<(), Symptom> {
             partner: j,
             relative: rel,
         });
-    }
-    Ok(())
-}
-
-/// The first pair whose overlap exceeds [`MAX_RELATIVE_OVERLAP`] of the smaller diameter.
-pub fn check_overlaps(p: &Powder) -> Result<(), Symptom> {
-    let nl = &p.nl;
-    for e in 0..nl.pj.len() {
-        let (i, j) = (nl.pi[e] as usize, nl.pj[e] as usize);
-        if i >= p.len() || j >= p.len() {
-            continue;
-        }
-        let d = ((0..3)
-            .map(|k| (p.pos[j][k] - p.pos[i][k]).powi(2))
-            .sum::<f64>())
-        .sqrt();
-        let overlap = p.radius[i] + p.radius[j] - d;
-        let rel = overlap / (2.0 * p.radius[i].min(p.radius[j]));
-        if rel > MAX_RELATIVE_OVERLAP {
-            return Err(Symptom::Overlap {
-                particle: i,
-                partner: j,
-                relative: rel,
-            });
-        }
     }
     Ok(())
 }

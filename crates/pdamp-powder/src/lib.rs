@@ -6,10 +6,12 @@
 //! - [`fe`]: nonlinear hex8 solids (Saint Venant–Kirchhoff, total Lagrangian), generalized-α
 //!   with Newton and faer's sparse Cholesky, meshes (structured box with cavity, Gmsh, Abaqus),
 //!   modes and a Timoshenko beam reference (Sect. 2.2).
-//! - [`dem`]: cohesive powder DEM (Sect. 2.1: linear spring–dashpot, Coulomb tangential spring
-//!   with return mapping, DMT adhesion, velocity Verlet), log-normal size distributions,
-//!   coarse-graining.
-//! - [`prep`]: powder preparation (grid, settling, plate compression to a packing density).
+//! - [`law`], [`psd`], [`bed`]: the powder of Sect. 2.1 (contact law parameters and
+//!   coarse-graining, log-normal size distributions) on the pdamp-dem engine, which evaluates
+//!   the linear spring–dashpot, the Coulomb tangential spring with return mapping and DMT
+//!   adhesion, and integrates with velocity Verlet.
+//! - [`prep`]: powder preparation on pdamp-dem (grid, settling, plate compression to a packing
+//!   density).
 //! - [`couple`]: Dirichlet–Neumann coupling with Aitken relaxation (Sect. 2.3, Algorithm 1).
 //! - [`cantilever`]: the cantilever study of Sect. 2.4, damping ratios as in Table 1.
 //! - [`health`]: health checks of the DEM and the coupled run (typed errors, likely cause).
@@ -24,13 +26,15 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analytic;
+pub mod bed;
 pub mod cantilever;
 pub mod couple;
 pub mod damping;
-pub mod dem;
 pub mod fe;
 pub mod fuzz;
 pub mod health;
+pub mod law;
 pub mod prep;
+pub mod psd;
 pub mod study;
 pub mod vtk;

@@ -1,21 +1,31 @@
-//! Powder preparation (paper Sect. 2.4, Fig. 1a): particles drawn from the size distribution
-//! until their volume equals ϕ·V_cavity, placed on a Cartesian grid above the cavity floor,
-//! settled under gravity, then compressed by a displacement-controlled plate down to the cavity
-//! height, so that the packing density (particle volume / cavity volume) is the prescribed ϕ;
-//! finally relaxed with the plate held. The particles are prepared directly in the cavity's
-//! coordinates, so "extraction and insertion" is removing the box walls and the plate.
+//! Powder preparation (paper Sect. 2.4, Fig. 1a) on pdamp-dem: particles drawn from the size
+//! distribution until their volume equals ϕ·V_cavity, placed on a Cartesian grid above the
+//! cavity floor, settled under gravity, then compressed by a displacement-controlled plate down
+//! to the cavity height, so that the packing density (particle volume / cavity volume) is the
+//! prescribed ϕ; finally relaxed with the plate held. The particles are prepared directly in
+//! the cavity's coordinates, so "extraction and insertion" is removing the box walls and the
+//! plate: the coupled run takes over the particles with their contacts
+//! ([`crate::bed::PowderBed`]).
 //!
-//! [`Preparation`] holds the whole state of a preparation in progress (particles, walls, wall
-//! spring history, stage and step counters) and is serializable, so a long preparation can be
+//! The box is five one-sided planes on a fixed body, the plate a sixth on a body that moves
+//! along a prescribed track (at constant speed while compressing, then held). [`Preparation`]
+//! holds the whole state of a preparation in progress (the world with its contact history, the
+//! plate's track, stage and step counters) and is serializable, so a long preparation can be
 //! checkpointed and continued bit for bit; [`prepare`] runs one from start to end.
 
 use std::ops::ControlFlow;
+use std::sync::Arc;
 use std::time::Instant;
 
-use crate::dem::wall::{self, EMPTY_SLOTS, WallSlots};
-use crate::dem::{LogNormal, PlaneWall, Powder, PowderLaw, Rng};
+use pdamp_dem::walls::{Geometry, Plane};
+use pdamp_dem::{BodyState, Motion, RigidBody, TranslationTrack, Vec3, World, WorldState};
+use rand::{RngExt, SeedableRng};
+
+use crate::bed::{PARTICLE_MATERIAL, PowderBed, WALL_MATERIAL, powder_world};
 use crate::fe::Aabb;
 use crate::health::{self, HealthError};
+use crate::law::PowderLaw;
+use crate::psd::LogNormal;
 
 /// Preparation settings.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -94,15 +104,25 @@ enum Stage {
     Done,
 }
 
+/// The body carrying the plate (body 0 is the box).
+const PLATE: usize = 1;
+
+/// The plate's track: `(t1_s, z offset from its start height at t1 in m, vertical speed in
+/// m/s)`.
+type PlateTrack = (f64, f64, f64);
+
 /// A powder preparation in progress (see the module docs). Serializable: a preparation saved
 /// with [`Preparation::snapshot`] and continued with [`Preparation::run`] ends bit for bit as
 /// an uninterrupted one.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "PreparationData", into = "PreparationData")]
 pub struct Preparation {
-    powder: Powder,
-    planes: Vec<PlaneWall>,
-    hist: Vec<WallSlots>,
-    on_wall: [[f64; 3]; 6],
+    world: World,
+    plate: PlateTrack,
+    /// Height of the plate when the walls were built, m.
+    top_start: f64,
+    law: PowderLaw,
+    density_kg_m3: f64,
     stage: Stage,
     steps: u64,
     cavity: Aabb,
@@ -116,8 +136,133 @@ pub struct Preparation {
     bed_top: f64,
     plate_force: f64,
     wall_time_s: f64,
-    #[serde(skip)]
     segment_start: Option<Instant>,
+}
+
+/// The serialized form of a [`Preparation`]: the world's state and what rebuilds its walls.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct PreparationData {
+    world: WorldState,
+    plate: PlateTrack,
+    top_start: f64,
+    law: PowderLaw,
+    density_kg_m3: f64,
+    stage: Stage,
+    steps: u64,
+    cavity: Aabb,
+    settings: PrepSettings,
+    e_ref: f64,
+    e_ref_1g: f64,
+    relax_steps: u64,
+    settled: f64,
+    compressed: bool,
+    bed_top: f64,
+    plate_force: f64,
+    wall_time_s: f64,
+}
+
+impl From<Preparation> for PreparationData {
+    fn from(p: Preparation) -> Self {
+        Self {
+            world: p.world.save_state(),
+            plate: p.plate,
+            top_start: p.top_start,
+            law: p.law,
+            density_kg_m3: p.density_kg_m3,
+            stage: p.stage,
+            steps: p.steps,
+            cavity: p.cavity,
+            settings: p.settings,
+            e_ref: p.e_ref,
+            e_ref_1g: p.e_ref_1g,
+            relax_steps: p.relax_steps,
+            settled: p.settled,
+            compressed: p.compressed,
+            bed_top: p.bed_top,
+            plate_force: p.plate_force,
+            wall_time_s: p.wall_time_s(),
+        }
+    }
+}
+
+impl TryFrom<PreparationData> for Preparation {
+    type Error = String;
+    fn try_from(d: PreparationData) -> Result<Self, String> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let c = &d.cavity;
+        if !(finite(&c.min) && finite(&c.max) && (0..3).all(|k| c.min[k] < c.max[k]))
+            || !finite(&[d.plate.0, d.plate.1, d.plate.2, d.top_start])
+            || !(d.density_kg_m3 > 0.0 && d.density_kg_m3.is_finite())
+        {
+            return Err("preparation state: cavity, plate or density not finite".into());
+        }
+        d.law.validate("preparation state: law.")?;
+        let mut world = walls_world(&d.cavity, &d.law, d.density_kg_m3, 1.0, d.top_start);
+        world.set_particles_of(&d.world)?;
+        let mut p = Self {
+            world,
+            plate: d.plate,
+            top_start: d.top_start,
+            law: d.law,
+            density_kg_m3: d.density_kg_m3,
+            stage: d.stage,
+            steps: d.steps,
+            cavity: d.cavity,
+            settings: d.settings,
+            e_ref: d.e_ref,
+            e_ref_1g: d.e_ref_1g,
+            relax_steps: d.relax_steps,
+            settled: d.settled,
+            compressed: d.compressed,
+            bed_top: d.bed_top,
+            plate_force: d.plate_force,
+            wall_time_s: d.wall_time_s,
+            segment_start: None,
+        };
+        p.set_plate_track(p.plate, false);
+        p.world.restore_state(d.world)?;
+        Ok(p)
+    }
+}
+
+/// A world of the powder inside `cavity`: the five box walls on a fixed body, the plate at
+/// `top_start` (m) on a body that moves along a track (set by the caller).
+fn walls_world(
+    cavity: &Aabb,
+    law: &PowderLaw,
+    density_kg_m3: f64,
+    dt_s: f64,
+    top_start: f64,
+) -> World {
+    let mut w = powder_world(law, density_kg_m3, [0.0; 3], dt_s);
+    let (lo, hi) = (Vec3::from(cavity.min), Vec3::from(cavity.max));
+    let plane = |p: Vec3, n: [f64; 3]| Geometry::Plane(Plane::new(p, Vec3::from(n), false));
+    let mut sides = RigidBody::new("box", BodyState::at_rest(Vec3::zeros()), Motion::Fixed);
+    for (name, p, n) in [
+        ("x_min", lo, [1.0, 0.0, 0.0]),
+        ("x_max", hi, [-1.0, 0.0, 0.0]),
+        ("y_min", lo, [0.0, 1.0, 0.0]),
+        ("y_max", hi, [0.0, -1.0, 0.0]),
+        ("floor", lo, [0.0, 0.0, 1.0]),
+    ] {
+        sides = sides.with_wall(name, plane(p, n), WALL_MATERIAL);
+    }
+    w.add_body(sides);
+    let top = Vec3::new(cavity.min[0], cavity.min[1], top_start);
+    w.add_body(
+        RigidBody::new(
+            "plate",
+            BodyState::at_rest(Vec3::zeros()),
+            Motion::Prescribed(Arc::new(TranslationTrack {
+                t1_s: 0.0,
+                displacement_m: Vec3::zeros(),
+                velocity_m_s: Vec3::zeros(),
+                acceleration_m_s2: Vec3::zeros(),
+            })),
+        )
+        .with_wall("plate", plane(top, [0.0, 0.0, -1.0]), WALL_MATERIAL),
+    );
+    w
 }
 
 impl Preparation {
@@ -131,7 +276,7 @@ impl Preparation {
         dt: f64,
         s: &PrepSettings,
     ) -> Self {
-        let mut rng = Rng::new(s.seed);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(s.seed);
         let vcav = cavity.volume();
         let diam = psd.fill_volume(s.packing_density * vcav, &mut rng);
         let spacing = psd.d_max_m * 1.02;
@@ -141,56 +286,41 @@ impl Preparation {
         let ox = cavity.min[0] + 0.5 * (lx - (nx as f64 - 1.0) * spacing);
         let oy = cavity.min[1] + 0.5 * (ly - (ny as f64 - 1.0) * spacing);
         let mut pos = Vec::with_capacity(diam.len());
-        for (q, _) in diam.iter().enumerate() {
+        for (q, d) in diam.iter().enumerate() {
             let layer = q / (nx * ny);
             let rem = q % (nx * ny);
             let (i, j) = (rem % nx, rem / nx);
             let jit = 0.005 * spacing;
-            pos.push([
-                ox + i as f64 * spacing + jit * (rng.uniform() - 0.5),
-                oy + j as f64 * spacing + jit * (rng.uniform() - 0.5),
-                cavity.min[2] + 0.5 * spacing + layer as f64 * spacing,
-            ]);
+            let (u, v): (f64, f64) = (rng.random(), rng.random());
+            pos.push((
+                Vec3::new(
+                    ox + i as f64 * spacing + jit * (u - 0.5),
+                    oy + j as f64 * spacing + jit * (v - 0.5),
+                    cavity.min[2] + 0.5 * spacing + layer as f64 * spacing,
+                ),
+                0.5 * d,
+            ));
         }
-        let radius: Vec<f64> = diam.iter().map(|d| 0.5 * d).collect();
-        let p = Powder::new(
-            law,
-            pos,
-            radius,
-            density_kg_m3,
-            [0.0, 0.0, -9.81 * s.settling_gravity_factor],
-            dt,
-        );
-        let n = p.len();
-        let top_start = p
-            .pos
+        let top_start = pos
             .iter()
-            .zip(&p.radius)
-            .map(|(x, r)| x[2] + r)
+            .map(|(x, r)| x.z + r)
             .fold(cavity.max[2], f64::max)
             + spacing;
-        let plane = |point: [f64; 3], normal: [f64; 3]| PlaneWall {
-            point,
-            normal,
-            velocity: [0.0; 3],
-        };
-        let planes = vec![
-            plane(cavity.min, [1.0, 0.0, 0.0]),
-            plane(cavity.max, [-1.0, 0.0, 0.0]),
-            plane(cavity.min, [0.0, 1.0, 0.0]),
-            plane(cavity.max, [0.0, -1.0, 0.0]),
-            plane(cavity.min, [0.0, 0.0, 1.0]),
-            plane([cavity.min[0], cavity.min[1], top_start], [0.0, 0.0, -1.0]),
-        ];
-        let mtot: f64 = p.mass.iter().sum();
+        let mut world = walls_world(&cavity, &law, density_kg_m3, dt, top_start);
+        world.gravity_m_s2 = Vec3::new(0.0, 0.0, -9.81 * s.settling_gravity_factor);
+        for (x, r) in pos {
+            world.add_particle(x, r, PARTICLE_MATERIAL);
+        }
+        let mtot = world.particles.total_mass();
         // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
         let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
         let e_ref_1g = 1e-4 * mtot * 9.81 * psd.d50_m;
-        Self {
-            powder: p,
-            planes,
-            hist: vec![EMPTY_SLOTS; n],
-            on_wall: [[0.0; 3]; 6],
+        let mut p = Self {
+            world,
+            plate: (0.0, 0.0, 0.0),
+            top_start,
+            law,
+            density_kg_m3,
             stage: Stage::Settling { chunk: 0 },
             steps: 0,
             cavity,
@@ -204,43 +334,53 @@ impl Preparation {
             plate_force: 0.0,
             wall_time_s: 0.0,
             segment_start: None,
+        };
+        p.world.initialize();
+        p
+    }
+
+    /// Puts the plate on `track` from now on; with `jump`, its pose is set to the track's at
+    /// the current time at once (a placement, not a motion over the next step).
+    fn set_plate_track(&mut self, track: PlateTrack, jump: bool) {
+        self.plate = track;
+        let b = &mut self.world.bodies[PLATE];
+        b.motion = Motion::Prescribed(Arc::new(TranslationTrack {
+            t1_s: track.0,
+            displacement_m: Vec3::new(0.0, 0.0, track.1),
+            velocity_m_s: Vec3::new(0.0, 0.0, track.2),
+            acceleration_m_s2: Vec3::zeros(),
+        }));
+        if jump {
+            let s = b.prescribed_state(self.world.time_s);
+            b.state = s;
+            b.previous = s;
         }
+    }
+
+    /// Height of the plate now, m.
+    fn plate_height(&self) -> f64 {
+        self.top_start + self.world.bodies[PLATE].state.position_m.z
     }
 
     /// Number of particles.
     pub fn particles(&self) -> usize {
-        self.powder.len()
+        self.world.particles.len()
     }
 
     /// Simulated preparation time so far \[s\].
     pub fn time_s(&self) -> f64 {
-        self.powder.t
+        self.world.time_s
     }
 
-    /// Checks that a deserialized preparation is self-consistent (array lengths, finite and
-    /// positive time step and cavity, finite walls and reference energies).
+    /// Checks that a deserialized preparation is self-consistent (the world's checks ran when
+    /// it was restored; here the time step and the reference energies).
     pub fn check_consistency(&self) -> Result<(), String> {
-        self.powder.check_consistency()?;
-        if self.hist.len() != self.powder.len() || self.planes.len() != 6 {
-            return Err("preparation state: wall history does not match the particles".into());
-        }
-        let c = &self.cavity;
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        let ok = self.powder.dt > 0.0
-            && self.powder.dt.is_finite()
-            && finite(&c.min)
-            && finite(&c.max)
-            && (0..3).all(|k| c.min[k] < c.max[k])
-            && self
-                .planes
-                .iter()
-                .all(|w| finite(&w.point) && finite(&w.normal) && finite(&w.velocity))
+        let ok = self.world.dt_s > 0.0
+            && self.world.dt_s.is_finite()
             && finite(&[self.e_ref, self.e_ref_1g, self.bed_top, self.settled]);
         if !ok {
-            return Err(
-                "preparation state: time step, cavity, walls or reference energies not finite"
-                    .into(),
-            );
+            return Err("preparation state: time step or reference energies not finite".into());
         }
         Ok(())
     }
@@ -260,25 +400,28 @@ impl Preparation {
     /// box walls and below the plate, no runaway overlap, no negative dissipation beyond a
     /// tenth of the bed's potential-energy scale M·g·H.
     pub fn check_health(&self) -> Result<(), Box<HealthError>> {
-        let p = &self.powder;
-        let fail = |s| Box::new(HealthError::new(p.t, self.stage_name(), s, p));
+        let w = &self.world;
+        let fail = |s| {
+            Box::new(HealthError::of_world(
+                w.time_s,
+                self.stage_name(),
+                s,
+                w,
+                &self.law,
+            ))
+        };
         let c = self.cavity;
-        let top = self.planes[5].point[2].max(c.max[2]);
+        let top = self.plate_height().max(c.max[2]);
         let bx = Aabb {
             min: c.min,
             max: [c.max[0], c.max[1], top],
         };
         let size = (0..3).map(|k| bx.max[k] - bx.min[k]).fold(0.0, f64::max);
-        health::check_particles(p, Some((&bx, 1e-9 * size))).map_err(|(_, s)| fail(s))?;
-        health::check_overlaps(p).map_err(fail)?;
-        let g = (0..3)
-            .map(|k| p.gravity[k] * p.gravity[k])
-            .sum::<f64>()
-            .sqrt()
-            .max(9.81);
-        let scale = p.mass.iter().sum::<f64>() * g * size;
-        let diss = p.ledger.dissipated_pp_j + p.ledger.dissipated_pw_j;
-        health::check_energy(diss, 0.0, scale).map_err(fail)?;
+        health::check_world_particles(w, Some((&bx, 1e-9 * size))).map_err(|(_, s)| fail(s))?;
+        health::check_world_overlaps(w).map_err(fail)?;
+        let g = w.gravity_m_s2.norm().max(9.81);
+        let scale = w.particles.total_mass() * g * size;
+        health::check_energy(w.ledger.dissipated_j(), 0.0, scale).map_err(fail)?;
         Ok(())
     }
 
@@ -300,11 +443,7 @@ impl Preparation {
     }
 
     fn step(&mut self) -> Result<(), Box<HealthError>> {
-        let p = &mut self.powder;
-        p.predict();
-        p.pair_forces();
-        wall::plane_forces(p, &self.planes, &mut self.hist, &mut self.on_wall);
-        p.finish();
+        self.world.step();
         self.steps += 1;
         if self.steps.is_multiple_of(SETTLE_CHUNK as u64) {
             self.check_health()?;
@@ -314,7 +453,7 @@ impl Preparation {
 
     fn end_settling(&mut self) {
         // switch to real gravity and let the bed relax briefly
-        self.powder.gravity = G0;
+        self.world.gravity_m_s2 = Vec3::from(G0);
         self.stage = Stage::Relaxing {
             done: 0,
             moved: false,
@@ -322,18 +461,24 @@ impl Preparation {
     }
 
     fn start_compression(&mut self) {
-        let (p, cavity, s) = (&self.powder, self.cavity, self.settings);
+        let (cavity, s) = (self.cavity, self.settings);
+        let p = &self.world.particles;
         let bed_top = p
-            .pos
+            .position
             .iter()
             .zip(&p.radius)
-            .map(|(x, r)| x[2] + r)
+            .map(|(x, r)| x.z + r)
             .fold(f64::NEG_INFINITY, f64::max);
+        let volume: f64 = p
+            .radius
+            .iter()
+            .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+            .sum();
         let area = (cavity.max[0] - cavity.min[0]) * (cavity.max[1] - cavity.min[1]);
-        self.settled = p.volume() / (area * (bed_top - cavity.min[2]));
+        self.settled = volume / (area * (bed_top - cavity.min[2]));
         self.compressed = bed_top > cavity.max[2];
         self.bed_top = bed_top;
-        let dt = p.dt;
+        let dt = self.world.dt_s;
         if !self.compressed {
             self.start_holding();
             return;
@@ -342,14 +487,14 @@ impl Preparation {
         let dist = bed_top - cavity.max[2];
         let nsteps = (dist / (s.plate_speed_m_s * dt)).ceil() as u64;
         let dz = dist / nsteps as f64;
-        self.planes[5].point[2] = bed_top;
-        self.planes[5].velocity = [0.0, 0.0, -dz / dt];
+        let t0 = self.world.time_s;
+        self.set_plate_track((t0, bed_top - self.top_start, -dz / dt), true);
         self.stage = Stage::Compressing { q: 0, nsteps, dz };
     }
 
     fn start_holding(&mut self) {
-        self.planes[5].point[2] = self.cavity.max[2];
-        self.planes[5].velocity = [0.0; 3];
+        let t = self.world.time_s;
+        self.set_plate_track((t, self.cavity.max[2] - self.top_start, 0.0), true);
         self.stage = Stage::Holding { q: 0 };
     }
 
@@ -358,7 +503,7 @@ impl Preparation {
         match self.stage {
             Stage::Settling { chunk } => {
                 let t_end = self.settings.max_settling_time_s;
-                if chunk == 0 && self.powder.t >= t_end {
+                if chunk == 0 && self.world.time_s >= t_end {
                     self.end_settling();
                     return Ok(true);
                 }
@@ -367,10 +512,10 @@ impl Preparation {
                     chunk: (chunk + 1) % SETTLE_CHUNK,
                 };
                 if chunk + 1 == SETTLE_CHUNK {
-                    let ke = self.powder.kinetic_energy();
-                    progress("settling", self.powder.t / t_end);
-                    let dt = self.powder.dt;
-                    if ke < self.e_ref && self.powder.t > 10.0 * dt * SETTLE_CHUNK as f64 {
+                    let ke = self.world.ledger.kinetic_j;
+                    progress("settling", self.world.time_s / t_end);
+                    let dt = self.world.dt_s;
+                    if ke < self.e_ref && self.world.time_s > 10.0 * dt * SETTLE_CHUNK as f64 {
                         self.end_settling();
                     }
                 }
@@ -383,11 +528,11 @@ impl Preparation {
                 // or until `max_settling_time_s` more. Otherwise the prepared bed carries the
                 // excess into the coupled run, where its release looks like damping.
                 let t_max = self.relax_steps
-                    + (self.settings.max_settling_time_s / self.powder.dt).ceil() as u64;
+                    + (self.settings.max_settling_time_s / self.world.dt_s).ceil() as u64;
                 let chunk = SETTLE_CHUNK as u64;
                 if done >= t_max
                     || (done >= self.relax_steps && done % chunk == 0 && done > 0 && {
-                        let ke = self.powder.kinetic_energy();
+                        let ke = self.world.ledger.kinetic_j;
                         // a bed settled under 1 g has nothing to release: rest suffices
                         (moved || self.settings.settling_gravity_factor <= 1.0)
                             && ke < self.e_ref_1g
@@ -399,7 +544,7 @@ impl Preparation {
                 self.step()?;
                 let mut moved = moved;
                 if (done + 1) % chunk == 0 {
-                    let ke = self.powder.kinetic_energy();
+                    let ke = self.world.ledger.kinetic_j;
                     moved |= ke >= self.e_ref_1g;
                     if (done + 1) % (50 * chunk) == 0 {
                         progress("relaxing under 1 g", (done + 1) as f64 / t_max as f64);
@@ -412,7 +557,6 @@ impl Preparation {
             }
             Stage::Compressing { q, nsteps, dz } => {
                 if q < nsteps {
-                    self.planes[5].point[2] = self.bed_top - dz * (q + 1) as f64;
                     self.step()?;
                     if q % 500 == 0 {
                         progress("compressing", q as f64 / nsteps as f64);
@@ -429,7 +573,7 @@ impl Preparation {
             Stage::Holding { q } => {
                 if q < self.relax_steps {
                     self.step()?;
-                    self.plate_force = self.on_wall[5][2];
+                    self.plate_force = self.world.body_load(PLATE).0.z;
                     if q % 500 == 0 {
                         progress("relaxing", q as f64 / self.relax_steps as f64);
                     }
@@ -462,34 +606,41 @@ impl Preparation {
         Ok(ControlFlow::Continue(()))
     }
 
-    /// The prepared powder (at rest, clock and ledger reset) and the report; call after
+    /// The prepared particles (at rest, with their contacts) and the report; call after
     /// [`Preparation::run`] returned `Continue`.
-    pub fn finish(mut self) -> (Powder, PrepReport) {
+    pub fn finish(mut self) -> (PowderBed, PrepReport) {
         let wall_time_s = self.wall_time_s();
-        let p = &mut self.powder;
-        for v in p.vel.iter_mut() {
-            *v = [0.0; 3];
-        }
-        for w in p.omega.iter_mut() {
-            *w = [0.0; 3];
-        }
-        for w in p.wall_force.iter_mut() {
-            *w = [0.0; 3];
-        }
+        let w = &mut self.world;
+        w.particles
+            .velocity
+            .iter_mut()
+            .for_each(|v| *v = Vec3::zeros());
+        w.particles
+            .angular_velocity
+            .iter_mut()
+            .for_each(|v| *v = Vec3::zeros());
+        let volume: f64 = w
+            .particles
+            .radius
+            .iter()
+            .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+            .sum();
         let rep = PrepReport {
-            particles: p.len(),
+            particles: w.particles.len(),
             settled_packing_density: self.settled,
-            packing_density: p.volume() / self.cavity.volume(),
+            packing_density: volume / self.cavity.volume(),
             compressed: self.compressed,
             plate_force_n: self.plate_force,
-            max_relative_overlap: p.max_relative_overlap(),
-            simulated_time_s: p.t,
+            max_relative_overlap: health::world_max_relative_overlap(w).0,
+            simulated_time_s: w.time_s,
             steps: self.steps,
             wall_time_s,
         };
-        p.t = 0.0;
-        p.ledger = Default::default();
-        (self.powder, rep)
+        let mut bed = PowderBed::at_rest(self.law, &[], &[], self.density_kg_m3, G0, w.dt_s);
+        bed.world
+            .adopt_particles(&w.save_state())
+            .expect("a world's own state fits its particles");
+        (bed, rep)
     }
 }
 
@@ -503,7 +654,7 @@ pub fn prepare(
     dt: f64,
     s: &PrepSettings,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<(Powder, PrepReport), Box<HealthError>> {
+) -> Result<(PowderBed, PrepReport), Box<HealthError>> {
     let mut prep = Preparation::new(cavity, psd, law, density_kg_m3, dt, s);
     let _ = prep.run(progress, &mut |_| ControlFlow::Continue(()))?;
     Ok(prep.finish())

@@ -84,8 +84,16 @@ impl PowderSnapshots {
         let k = self.next_index;
         let v3 = |a: &[f64; 3]| Vec3::new(a[0], a[1], a[2]);
         let p = &c.world.particles;
-        let pos: Vec<Vec3> = p.position.iter().map(|x| Vec3::new(x.x, x.y, x.z)).collect();
-        let vel: Vec<Vec3> = p.velocity.iter().map(|x| Vec3::new(x.x, x.y, x.z)).collect();
+        let pos: Vec<Vec3> = p
+            .position
+            .iter()
+            .map(|x| Vec3::new(x.x, x.y, x.z))
+            .collect();
+        let vel: Vec<Vec3> = p
+            .velocity
+            .iter()
+            .map(|x| Vec3::new(x.x, x.y, x.z))
+            .collect();
         let speed: Vec<f64> = vel.iter().map(|v| v.norm()).collect();
         pdamp_io::vtk::write_particles_vtp_with(
             vtk.join(format!("powder_{k:06}.vtp")),

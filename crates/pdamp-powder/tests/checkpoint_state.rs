@@ -6,13 +6,16 @@
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+use pdamp_dem::Vec3;
 use pdamp_io::checkpoint::{self as ck, CheckpointHeader};
+use pdamp_powder::bed::PowderBed;
 use pdamp_powder::couple::{Coupled, CoupledState, CouplingSettings, Interface};
-use pdamp_powder::dem::{LogNormal, Powder, PowderLaw};
 use pdamp_powder::fe::{
     Aabb, BoxMeshDivisions, Dynamics, GenAlpha, HexMesh, MassKind, Rayleigh, Structure, SvkMaterial,
 };
+use pdamp_powder::law::PowderLaw;
 use pdamp_powder::prep::{self, PrepSettings, Preparation};
+use pdamp_powder::psd::LogNormal;
 
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("pdamp-powder-ck-{}-{name}", std::process::id()));
@@ -85,7 +88,10 @@ fn preparation_continued_from_checkpoints_is_bit_identical() {
     assert!(stops > 20, "{stops}");
     (rep.wall_time_s, rep_ref.wall_time_s) = (0.0, 0.0);
     assert_eq!(rep, rep_ref);
-    assert!(bytes(&dir, "a.bin", &p) == bytes(&dir, "b.bin", &p_ref));
+    assert!(
+        bytes(&dir, "a.bin", &p.world.save_state())
+            == bytes(&dir, "b.bin", &p_ref.world.save_state())
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -135,21 +141,20 @@ fn system() -> Coupled {
         [0.01099, 0.0093, z],
         [0.00900, 0.01119, z + 1e-5],
     ];
-    let mut p = Powder::new(
+    let mut p = PowderBed::at_rest(
         PowderLaw::PAPER,
-        pos,
-        vec![R, R, R, 0.9 * R],
+        &pos,
+        &[R, R, R, 0.9 * R],
         8000.0,
         [0.0, 0.0, -9.81],
         dt,
     );
-    p.vel = vec![
-        [0.05, 0.0, -0.02],
-        [-0.03, 0.01, 0.0],
-        [0.0, -0.04, -0.05],
-        [0.02, 0.02, -0.1],
-    ];
-    p.omega[1] = [0.0, 30.0, 0.0];
+    let v = &mut p.world.particles.velocity;
+    v[0] = Vec3::new(0.05, 0.0, -0.02);
+    v[1] = Vec3::new(-0.03, 0.01, 0.0);
+    v[2] = Vec3::new(0.0, -0.04, -0.05);
+    v[3] = Vec3::new(0.02, 0.02, -0.1);
+    p.world.particles.angular_velocity[1] = Vec3::new(0.0, 30.0, 0.0);
     Coupled::new(
         s,
         dy,

@@ -590,10 +590,11 @@ fn abaqus_reader_refuses_bad_meshes_with_the_real_line() {
 
 // ---------------------------------------------------------------- defect 4: health checks
 
+use pdamp_powder::bed::PowderBed;
 use pdamp_powder::couple::{CoupleError, Coupled};
-use pdamp_powder::dem::{Powder, PowderLaw};
 use pdamp_powder::fe::{Dynamics, GenAlpha};
 use pdamp_powder::health::Symptom;
+use pdamp_powder::law::PowderLaw;
 
 /// The tiny beam with `pos` particles (r = 1 mm) in its cavity, not yet stepped.
 fn coupled(pos: Vec<[f64; 3]>) -> Coupled {
@@ -612,10 +613,10 @@ fn coupled(pos: Vec<[f64; 3]>) -> Coupled {
     .unwrap();
     let interface = cantilever::cavity_interface(&s, &sc.beam.cavity());
     let radius = vec![1e-3; pos.len()];
-    let powder = Powder::new(
+    let powder = PowderBed::at_rest(
         PowderLaw::PAPER.coarse_grained(2.0),
-        pos,
-        radius,
+        &pos,
+        &radius,
         8000.0,
         sc.run.gravity_m_s2,
         dt,
@@ -770,9 +771,9 @@ fn energy_check_and_cause_follow_the_evidence() {
 
 #[test]
 fn preparation_with_a_too_large_time_step_stops_blaming_the_time_step() {
-    use pdamp_powder::dem::LogNormal;
     use pdamp_powder::fe::Aabb;
     use pdamp_powder::prep::{PrepSettings, prepare};
+    use pdamp_powder::psd::LogNormal;
     let cavity = Aabb {
         min: [0.0; 3],
         max: [0.01, 0.01, 0.02],
@@ -808,15 +809,17 @@ fn preparation_with_a_too_large_time_step_stops_blaming_the_time_step() {
 
 #[test]
 fn neighbor_list_survives_non_finite_positions() {
-    let mut nl = pdamp_powder::dem::NeighborList::new(1e-4);
+    // the engine's neighbour list (pdamp-dem), as the powder runs use it
+    use pdamp_dem::Vec3;
+    let mut nl = pdamp_dem::neighbor::NeighborList::new(1e-4);
     let pos = vec![
-        [0.0; 3],
-        [f64::INFINITY, 0.0, 0.0],
-        [f64::NAN; 3],
-        [1e-3, 0.0, 0.0],
-        [-f64::INFINITY; 3],
+        Vec3::zeros(),
+        Vec3::new(f64::INFINITY, 0.0, 0.0),
+        Vec3::repeat(f64::NAN),
+        Vec3::new(1e-3, 0.0, 0.0),
+        Vec3::repeat(-f64::INFINITY),
     ];
-    nl.rebuild(&pos, &[1e-3; 5], 0.0);
-    assert_eq!(nl.pi.len(), 1, "only the finite pair 0–3");
-    nl.check_consistency(5).unwrap();
+    nl.rebuild(&pos, &[1e-3; 5]);
+    assert_eq!(nl.num_pairs(), 1, "only the finite pair 0–3");
+    assert_eq!((nl.first[0], nl.second[0]), (0, 3));
 }

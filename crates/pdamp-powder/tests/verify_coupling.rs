@@ -8,12 +8,14 @@
 //! - Energy balance of the coupled system (elastic contact, ρ∞ = 1): stored energy of particle
 //!   and plate + dissipation − load work stays constant within 1e-3 of the initial energy.
 
+use pdamp_dem::walls::{Geometry, Plane};
+use pdamp_dem::{BodyState, Motion, RigidBody, Vec3};
+use pdamp_powder::bed::{PowderBed, WALL_MATERIAL};
 use pdamp_powder::couple::{Coupled, CouplingSettings, Interface};
-use pdamp_powder::dem::wall::{self, EMPTY_SLOTS, PlaneWall};
-use pdamp_powder::dem::{Powder, PowderLaw};
 use pdamp_powder::fe::{
     BoxMeshDivisions, Dynamics, GenAlpha, HexMesh, MassKind, Rayleigh, Structure, SvkMaterial,
 };
+use pdamp_powder::law::PowderLaw;
 
 const R: f64 = 1e-3;
 const TOP: f64 = 2e-3;
@@ -46,17 +48,17 @@ fn plate(e_pa: f64) -> (Structure, Interface) {
     )
 }
 
-fn particle(law: PowderLaw, height: f64, vz: f64, dt: f64) -> Powder {
+fn particle(law: PowderLaw, height: f64, vz: f64, dt: f64) -> PowderBed {
     // slightly off the plate centre so that the contact is inside a face
-    let mut p = Powder::new(
+    let mut p = PowderBed::at_rest(
         law,
-        vec![[0.0093, 0.0107, TOP + R + height]],
-        vec![R],
+        &[[0.0093, 0.0107, TOP + R + height]],
+        &[R],
         8000.0,
         [0.0, 0.0, -9.81],
         dt,
     );
-    p.vel[0] = [0.0, 0.0, vz];
+    p.world.particles.velocity[0] = Vec3::new(0.0, 0.0, vz);
     p
 }
 
@@ -64,7 +66,7 @@ fn coupled(e_pa: f64, law: PowderLaw, rho_inf: f64, dt: f64) -> Coupled {
     coupled_with(e_pa, particle(law, 1e-5, -0.2, dt), rho_inf, dt)
 }
 
-fn coupled_with(e_pa: f64, p: Powder, rho_inf: f64, dt: f64) -> Coupled {
+fn coupled_with(e_pa: f64, p: PowderBed, rho_inf: f64, dt: f64) -> Coupled {
     let (mut s, iface) = plate(e_pa);
     let n = s.n_dof();
     let dy = Dynamics::new(
@@ -95,20 +97,18 @@ fn bouncing_and_resting_particle_matches_rigid_plate() {
     let dt = 1e-6;
     let steps = 2_000; // the first impact (contact time ≈ 0.24 ms) and the start of the rebound
     // rigid plane
-    let mut p = particle(law, 1e-5, -0.2, dt);
-    let plane = [PlaneWall {
-        point: [0.0, 0.0, TOP],
-        normal: [0.0, 0.0, 1.0],
-        velocity: [0.0; 3],
-    }];
-    let mut hist = vec![EMPTY_SLOTS; 1];
+    let mut p = particle(law, 1e-5, -0.2, dt).world;
+    p.add_body(
+        RigidBody::new("plane", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+            "top",
+            Geometry::Plane(Plane::new(Vec3::new(0.0, 0.0, TOP), Vec3::z(), false)),
+            WALL_MATERIAL,
+        ),
+    );
     let mut f_rigid = Vec::with_capacity(steps);
     for _ in 0..steps {
-        p.predict();
-        p.pair_forces();
-        wall::plane_forces(&mut p, &plane, &mut hist, &mut [[0.0; 3]]);
-        p.finish();
-        f_rigid.push(p.wall_force[0][2]);
+        p.step();
+        f_rigid.push(-p.body_load(0).0.z);
     }
     // deformable plate, 1000 × steel stiffness
     let mut c = coupled(175e12, law, 0.8, dt);

@@ -3,10 +3,13 @@
 //! the contact elastic energy of a bed at rest under g (linear springs); if the relaxation under
 //! 1 g is cut short, the bed springs up after insertion and its release is booked as dissipation.
 
-use pdamp_powder::dem::wall::{self, EMPTY_SLOTS, PlaneWall};
-use pdamp_powder::dem::{LogNormal, PowderLaw};
+use pdamp_dem::walls::{BoxInside, Geometry};
+use pdamp_dem::{BodyState, Motion, RigidBody, Vec3};
+use pdamp_powder::bed::WALL_MATERIAL;
 use pdamp_powder::fe::Aabb;
+use pdamp_powder::law::PowderLaw;
 use pdamp_powder::prep::{self, PrepSettings};
+use pdamp_powder::psd::LogNormal;
 
 #[test]
 fn prepared_bed_is_at_rest_under_one_g() {
@@ -26,48 +29,38 @@ fn prepared_bed_is_at_rest_under_one_g() {
         relax_time_s: 2e-3,
         ..PrepSettings::default()
     };
-    let (mut p, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
+    let (bed, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
     assert!(!rep.compressed, "the bed must stay below the cavity top");
-    let n = p.len();
-    let mass: f64 = p.mass.iter().sum();
+    let n = bed.len();
+    let mass = bed.world.particles.total_mass();
     // the prepared bed, left alone in the rigid cavity under 1 g for 20 ms
-    let plane = |point: [f64; 3], normal: [f64; 3]| PlaneWall {
-        point,
-        normal,
-        velocity: [0.0; 3],
-    };
-    let planes = [
-        plane(cavity.min, [1.0, 0.0, 0.0]),
-        plane(cavity.max, [-1.0, 0.0, 0.0]),
-        plane(cavity.min, [0.0, 1.0, 0.0]),
-        plane(cavity.max, [0.0, -1.0, 0.0]),
-        plane(cavity.min, [0.0, 0.0, 1.0]),
-        plane(cavity.max, [0.0, 0.0, -1.0]),
-    ];
-    let mut hist = vec![EMPTY_SLOTS; n];
-    let mut on_wall = [[0.0; 3]; 6];
-    let e_pot0 = p.potential_energy();
+    let mut p = bed.world;
+    let (lo, hi) = (Vec3::from(cavity.min), Vec3::from(cavity.max));
+    p.add_body(
+        RigidBody::new("cavity", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+            "box",
+            Geometry::BoxInside(BoxInside::new(0.5 * (lo + hi), 0.5 * (hi - lo))),
+            WALL_MATERIAL,
+        ),
+    );
+    p.initialize();
+    let e_pot0 = p.ledger.potential_j;
+    let el0 = p.ledger.elastic_j;
     let mut ke_max = 0.0f64;
     let steps = (0.02 / dt) as usize;
-    let mut el0 = None;
     for _ in 0..steps {
-        p.predict();
-        p.pair_forces();
-        wall::plane_forces(&mut p, &planes, &mut hist, &mut on_wall);
-        p.finish();
-        el0.get_or_insert(p.elastic_pp_j);
-        ke_max = ke_max.max(p.kinetic_energy());
+        p.step();
+        ke_max = ke_max.max(p.ledger.kinetic_j);
     }
-    let rise = p.potential_energy() - e_pot0;
-    let el0 = el0.unwrap();
-    let el_loss = el0 - p.elastic_pp_j;
+    let rise = p.ledger.potential_j - e_pot0;
+    let el_loss = el0 - p.ledger.elastic_j;
     // reference: the weight of the bed times one D50
     let w_d = mass * 9.81 * psd.d50_m;
     eprintln!(
         "{n} particles, settled ϕ {:.3}, prep {} steps; over 20 ms under 1 g: potential energy \
-         change {rise:.3e} J, pp elastic energy {el0:.3e} → {:.3e} J, peak kinetic energy \
+         change {rise:.3e} J, contact elastic energy {el0:.3e} → {:.3e} J, peak kinetic energy \
          {ke_max:.3e} J; M g D50 = {w_d:.3e} J",
-        rep.settled_packing_density, rep.steps, p.elastic_pp_j
+        rep.settled_packing_density, rep.steps, p.ledger.elastic_j
     );
     // At rest: no springing up, no release of stored contact energy, no motion. Measured: rise
     // −1.3e-4 M g D50, pp elastic energy −3 %, peak KE 9e-4 M g D50. The same bed relaxed for

@@ -1,34 +1,8 @@
-//! Log-normal particle size distributions with cut-offs (paper Table A.2) and a small
-//! deterministic random generator (SplitMix64), so that particle sets depend only on the seed.
+//! Log-normal particle size distributions with cut-offs (paper Table A.2): the scenario's
+//! description, sampled by pdamp-dem's [`SizeDistribution`] from a seeded ChaCha8 generator, so
+//! that particle sets depend only on the seed.
 
-/// SplitMix64 generator.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// Generator from a seed.
-    pub fn new(seed: u64) -> Self {
-        Self(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box–Muller).
-    pub fn normal(&mut self) -> f64 {
-        let u1 = 1.0 - self.uniform();
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
-}
+use pdamp_dem::generate::SizeDistribution;
 
 /// Log-normal diameter distribution $\ln D \sim \mathcal N(\ln D_{50}, \sigma^2)$, truncated to
 /// $[D_{min}, D_{max}]$ by rejection.
@@ -55,22 +29,24 @@ impl LogNormal {
             d_max_m: d50_m * 1.414_770,
         }
     }
-    /// One diameter \[m\].
-    pub fn sample(&self, rng: &mut Rng) -> f64 {
-        loop {
-            let d = self.d50_m * (self.sigma * rng.normal()).exp();
-            if d >= self.d_min_m && d <= self.d_max_m {
-                return d;
-            }
+    /// The same distribution as pdamp-dem's [`SizeDistribution`] (in radii), which samples it.
+    pub fn distribution(&self) -> SizeDistribution {
+        SizeDistribution::LogNormal {
+            median_diameter_m: self.d50_m,
+            sigma: self.sigma,
+            min_radius_m: Some(0.5 * self.d_min_m),
+            max_radius_m: Some(0.5 * self.d_max_m),
         }
     }
-    /// Diameters until their total volume reaches `volume_m3` (the last one overshoots by less
-    /// than one particle volume).
-    pub fn fill_volume(&self, volume_m3: f64, rng: &mut Rng) -> Vec<f64> {
+
+    /// Diameters drawn until their total volume reaches `volume_m3` (the last one overshoots
+    /// by less than one particle volume), \[m\].
+    pub fn fill_volume<R: rand::Rng + ?Sized>(&self, volume_m3: f64, rng: &mut R) -> Vec<f64> {
+        let dist = self.distribution();
         let mut out = Vec::new();
         let mut v = 0.0;
         while v < volume_m3 {
-            let d = self.sample(rng);
+            let d = 2.0 * dist.sample(rng);
             v += std::f64::consts::PI / 6.0 * d * d * d;
             out.push(d);
         }
@@ -122,6 +98,7 @@ impl LogNormal {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::SeedableRng;
 
     #[test]
     fn lognormal_percentiles_match_table_a2() {
@@ -129,11 +106,19 @@ mod tests {
         let d90 = 0.0265646 * (1.281_551_6 * 0.2707f64).exp();
         assert!((d90 - 0.0375828).abs() < 2e-6, "{d90}");
         let psd = LogNormal::paper(1e-3);
-        let mut rng = Rng::new(1);
-        let mut d: Vec<f64> = (0..20000).map(|_| psd.sample(&mut rng)).collect();
+        let dist = psd.distribution();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let mut d: Vec<f64> = (0..20000).map(|_| 2.0 * dist.sample(&mut rng)).collect();
         d.sort_by(f64::total_cmp);
         // truncation is symmetric in ln D, so the median stays D50 (sampling error ≈ 0.5 %)
         assert!((d[10000] / 1e-3 - 1.0).abs() < 0.01, "{}", d[10000]);
         assert!(d[0] >= psd.d_min_m && d[19999] <= psd.d_max_m);
+        // the mean volume of the samples against the quadrature of `mean_volume_m3` (1 %)
+        let v: f64 = d
+            .iter()
+            .map(|d| std::f64::consts::PI / 6.0 * d.powi(3))
+            .sum::<f64>()
+            / d.len() as f64;
+        assert!((v / psd.mean_volume_m3() - 1.0).abs() < 0.01, "{v}");
     }
 }
