@@ -362,6 +362,16 @@ impl Preparation {
         self.top_start + self.world.bodies[PLATE].state.position_m.z
     }
 
+    /// The world being prepared (particles, box and plate).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The world, to set diagnostics such as [`World::profile`].
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
     /// Number of particles.
     pub fn particles(&self) -> usize {
         self.world.particles.len()
