@@ -46,9 +46,8 @@ impl NeighborList {
     /// reference positions for all particles (or none). The error says what is wrong.
     pub fn check_consistency(&self, n: usize) -> Result<(), String> {
         let bad = |what: &str| Err(format!("neighbour list: {what}"));
-        if !(self.skin_m.is_finite() && self.skin_m >= 0.0)
-            || !(self.extra_range_m.is_finite() && self.extra_range_m >= 0.0)
-        {
+        let finite_non_negative = |x: f64| x.is_finite() && x >= 0.0;
+        if !(finite_non_negative(self.skin_m) && finite_non_negative(self.extra_range_m)) {
             return bad("skin or range not finite and non-negative");
         }
         let m = self.first.len();

@@ -237,9 +237,8 @@ impl World {
         s.neighbors
             .check_consistency(n)
             .map_err(|e| format!("checkpoint {e}"))?;
-        if !(s.dt_s.is_finite() && s.dt_s > 0.0 && s.time_s.is_finite())
-            || !s.gravity_m_s2.iter().all(|g| g.is_finite())
-        {
+        let clock_ok = s.dt_s.is_finite() && s.dt_s > 0.0 && s.time_s.is_finite();
+        if !(clock_ok && s.gravity_m_s2.iter().all(|g| g.is_finite())) {
             return Err("checkpoint time step, time or gravity not finite".into());
         }
         let walls_of = |b: u16| self.bodies.get(b as usize).map_or(0, |b| b.walls.len());

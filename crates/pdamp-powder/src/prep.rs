@@ -190,10 +190,10 @@ impl TryFrom<PreparationData> for Preparation {
     fn try_from(d: PreparationData) -> Result<Self, String> {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let c = &d.cavity;
-        if !(finite(&c.min) && finite(&c.max) && (0..3).all(|k| c.min[k] < c.max[k]))
-            || !finite(&[d.plate.0, d.plate.1, d.plate.2, d.top_start])
-            || !(d.density_kg_m3 > 0.0 && d.density_kg_m3.is_finite())
-        {
+        let cavity_ok = finite(&c.min) && finite(&c.max) && (0..3).all(|k| c.min[k] < c.max[k]);
+        let plate_ok = finite(&[d.plate.0, d.plate.1, d.plate.2, d.top_start]);
+        let density_ok = d.density_kg_m3 > 0.0 && d.density_kg_m3.is_finite();
+        if !(cavity_ok && plate_ok && density_ok) {
             return Err("preparation state: cavity, plate or density not finite".into());
         }
         d.law.validate("preparation state: law.")?;
