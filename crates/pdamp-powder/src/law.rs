@@ -1,6 +1,6 @@
 //! The parameters of the cohesive powder contact law of paper Sect. 2.1, used for
 //! particle–particle and particle–wall contacts (walls enter with $r_{eff} = r_i$,
-//! $m_{eff} = m_i$); pdamp-dem evaluates it ([`crate::couple::contact_model`]):
+//! $m_{eff} = m_i$); pdamp-dem evaluates it ([`crate::bed::contact_model`]):
 //!
 //! - normal spring–dashpot, eq. 2–4: $\mathbf f_{CN} = \min(0, k_Ng_N + d_N\dot g_N)\,\mathbf n$ for
 //!   $g_N \le 0$, $d_N = 2|\ln e|\sqrt{k_Nm_{eff}/(\ln^2e+\pi^2)}$;
