@@ -214,6 +214,19 @@ fn empty_world(
     Ok((w, vertex_node))
 }
 
+/// Wall time of the coupled steps by partition, s: the particles (drift, forces, wall passes
+/// and their repetitions, kicks, health checks), the structural solves, and the coupling
+/// itself (nodal loads, residuals, relaxation, interface work, commit).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepTiming {
+    /// Particles (pdamp-dem), s.
+    pub dem_s: f64,
+    /// Structural solves (generalized-α Newton), s.
+    pub structure_s: f64,
+    /// The coupling's own work, s.
+    pub coupling_s: f64,
+}
+
 /// The dynamic state of a [`Coupled`] system between steps, for checkpoints: the structure's
 /// time integration, the particles (pdamp-dem state with contact histories), the interface mesh
 /// where the last step left it, the interface force and work, the fixed-point work vectors and
@@ -273,6 +286,8 @@ pub struct Coupled {
     /// stops the run with [`Symptom::Escaped`]. `None` (default): open interfaces such as a
     /// plate.
     pub container: Option<Aabb>,
+    /// Wall time of the steps of this process by partition (not in checkpoints).
+    pub timing: StepTiming,
     /// Structure node of every mesh vertex, and the vertices (last iterate), m.
     vertex_node: Vec<usize>,
     vertices: Vec<Vec3>,
@@ -346,6 +361,7 @@ impl Coupled {
             f_ps: vec![0.0; ndof],
             interface_work_j: 0.0,
             container: None,
+            timing: StepTiming::default(),
             vertex_node: Vec::new(),
             vertices: Vec::new(),
             nodal: Vec::new(),
@@ -548,22 +564,34 @@ impl Coupled {
                 }
             }
         }
+        let clock = std::time::Instant::now();
+        let mut lap = clock;
+        let mut split = |t: &mut f64| {
+            let now = std::time::Instant::now();
+            *t += (now - lap).as_secs_f64();
+            lap = now;
+        };
+        let mut timing = self.timing;
+        split(&mut timing.coupling_s);
         self.move_interface(false)?;
         self.world.step_deferred();
         self.check_particles()?;
         if self.steps.is_multiple_of(OVERLAP_CHECK_EVERY) {
             health::check_world_overlaps(&self.world).map_err(|s| self.failure(s))?;
         }
+        split(&mut timing.dem_s);
         self.r_prev.resize(nps, 0.0);
         self.r_cur.resize(nps, 0.0);
         let mut omega = self.settings.initial_relaxation;
         let mut k = 0;
         loop {
             self.gather_interface_loads()?;
-            if let Err(e) = self
+            split(&mut timing.coupling_s);
+            let solved = self
                 .dynamics
-                .solve(&mut self.structure, Some(&self.f_trial), k == 0)
-            {
+                .solve(&mut self.structure, Some(&self.f_trial), k == 0);
+            split(&mut timing.structure_s);
+            if let Err(e) = solved {
                 // a diverged structure (or particles) is a health failure, not a solver one
                 if self.dynamics.d1.iter().any(|x| !x.is_finite())
                     || self.f_trial.iter().any(|x| !x.is_finite())
@@ -615,7 +643,9 @@ impl Coupled {
             }
             std::mem::swap(&mut self.r_prev, &mut self.r_cur);
             self.move_interface(true)?;
+            split(&mut timing.coupling_s);
             self.world.repeat_wall_pass()?;
+            split(&mut timing.dem_s);
         }
         self.omega = omega;
         // commit: interface work (trapezoidal), structure, the particles' second half kick
@@ -631,7 +661,10 @@ impl Coupled {
         self.interface_work_j += w;
         self.dynamics.commit();
         std::mem::swap(&mut self.f_ps, &mut self.f_trial);
+        split(&mut timing.coupling_s);
         self.world.complete_step();
+        split(&mut timing.dem_s);
+        self.timing = timing;
         self.last_iterations = k;
         self.total_iterations += k as u64;
         self.max_iterations_seen = self.max_iterations_seen.max(k);
