@@ -108,3 +108,36 @@ impl PowderBed {
         self.world.particles.is_empty()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scenario's coarse-grained law (`PowderLaw::coarse_grained`, what `reference_d50_m`
+    /// selects) is the engine's coarse-graining transform of the real law.
+    #[test]
+    fn coarse_grained_law_is_the_engines_transform() {
+        let law = PowderLaw {
+            surface_energy_j_m2: 0.085,
+            ..PowderLaw::PAPER
+        };
+        for f in [0.5, 2.0, 4.0] {
+            let ours = contact_model(&law.coarse_grained(f));
+            let engine = contact_model(&law).coarse_grained(f).unwrap();
+            match (&ours.normal, &engine.normal) {
+                (
+                    NormalLaw::Linear {
+                        stiffness_n_m: a, ..
+                    },
+                    NormalLaw::Linear {
+                        stiffness_n_m: b, ..
+                    },
+                ) => assert!((a / b - 1.0).abs() < 1e-15),
+                _ => panic!("linear law expected"),
+            }
+            let (a, b) = (ours.adhesion.unwrap(), engine.adhesion.unwrap());
+            assert!((a.surface_energy_j_m2 / b.surface_energy_j_m2 - 1.0).abs() < 1e-15);
+            assert_eq!(ours.friction, engine.friction);
+        }
+    }
+}

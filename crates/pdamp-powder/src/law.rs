@@ -45,7 +45,8 @@ impl PowderLaw {
         adhesion_cutoff: 0.01,
     };
 
-    /// Coarse-graining by the size factor `f = r'/r` (Sect. 2.4, Bierwisch et al. 2009):
+    /// Coarse-graining by the size factor `f = r'/r` (Sect. 2.4, Bierwisch et al. 2009), the
+    /// parameters of pdamp-dem's transform `ContactModel::coarse_grained` (tested equal):
     /// $k' = f k$; damping follows from eq. 4 with the scaled masses, which gives $d' = f^2 d$;
     /// the surface energy scales with $f$ … here the paper's rule $\gamma' = f^2\gamma$ (Sect. 3.6).
     pub fn coarse_grained(&self, f: f64) -> Self {

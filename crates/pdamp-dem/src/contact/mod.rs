@@ -12,6 +12,7 @@ use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
 mod adhesion;
+mod coarse_grain;
 mod friction;
 pub mod hertz;
 mod model;

@@ -1075,3 +1075,46 @@ fn one_pass_hertz_mindlin_equals_general_path() {
         }
     }
 }
+
+/// Coarse-graining (P Sect. 2.4): a linear contact of spheres twice the size with k' = 2 k is
+/// the same impact, geometrically similar — restitution and relative overlap unchanged, the
+/// contact time doubled; Hertz is left alone and the DMT surface energy grows by f².
+#[test]
+fn coarse_grained_linear_contact_is_geometrically_similar() {
+    let linear = model(NormalLaw::Linear {
+        stiffness_n_m: 5642.0,
+        restitution: 0.4,
+        clip_attractive: true,
+    });
+    let (r, v0, f) = (0.5e-3, 0.3, 2.0);
+    let fine = impact(&linear, r, false, v0);
+    let mut coarse_model = linear.coarse_grained(f).unwrap();
+    coarse_model.prepare();
+    let coarse = impact(&coarse_model, f * r, false, v0);
+    assert!(
+        (coarse.restitution / fine.restitution - 1.0).abs() < 1e-3,
+        "{fine:?} {coarse:?}"
+    );
+    assert!((coarse.contact_time_s / fine.contact_time_s / f - 1.0).abs() < 1e-3);
+    assert!((coarse.max_overlap_m / fine.max_overlap_m / f - 1.0).abs() < 1e-3);
+    // against a wall too (the clipped law's restitution is not e there, but the same at both
+    // sizes)
+    let (wf, wc) = (
+        impact(&linear, r, true, v0),
+        impact(&coarse_model, f * r, true, v0),
+    );
+    assert!(
+        (wc.restitution / wf.restitution - 1.0).abs() < 1e-3,
+        "{wf:?} {wc:?}"
+    );
+    assert!((wc.contact_time_s / wf.contact_time_s / f - 1.0).abs() < 1e-3);
+    // Hertz unchanged; adhesion γ' = f² γ; a bad factor refused
+    let hertz = model(NormalLaw::Hertz);
+    assert_eq!(hertz.coarse_grained(3.0).unwrap(), hertz);
+    let mut sticky = linear.clone();
+    sticky.adhesion = Some(dmt());
+    let g = sticky.coarse_grained(3.0).unwrap().adhesion.unwrap();
+    assert!((g.surface_energy_j_m2 / dmt().surface_energy_j_m2 - 9.0).abs() < 1e-12);
+    assert!(linear.coarse_grained(0.0).is_err());
+    assert!(linear.coarse_grained(f64::NAN).is_err());
+}
