@@ -677,7 +677,7 @@ pub struct CantileverResult {
     /// Wall time of the coupled steps by partition (particles, structure, coupling) in this
     /// process (a resumed run counts from the resume).
     #[serde(default)]
-    pub step_time_split_s: crate::couple::StepTiming,
+    pub coupled_step_wall_time_s: crate::couple::StepTiming,
 }
 
 /// Kind tag of `pdamp powder run` checkpoints (`-2`: the coupled run's particles are a
@@ -914,7 +914,7 @@ fn run_core(
         structure_mass_kg: structure_mass,
         powder_mass_kg: c.particle_mass_kg(),
         energy_closure: 0.0,
-        step_time_split_s: Default::default(),
+        coupled_step_wall_time_s: Default::default(),
     };
     let (mut c, mut res, first) = match (running, prepared) {
         (Some(st), _) => {
@@ -1022,7 +1022,7 @@ fn run_core(
         }
     }
     res.wall_time_s = wall(&clock);
-    res.step_time_split_s = c.timing;
+    res.coupled_step_wall_time_s = c.timing;
     res.mean_iterations = c.total_iterations as f64 / c.steps.max(1) as f64;
     res.max_iterations = c.max_iterations_seen;
     res.damping = damping::table_one(&res.time_s, &res.tip_m, t_release);

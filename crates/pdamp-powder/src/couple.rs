@@ -220,11 +220,11 @@ fn empty_world(
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepTiming {
     /// Particles (pdamp-dem), s.
-    pub dem_s: f64,
+    pub particles_wall_time_s: f64,
     /// Structural solves (generalized-α Newton), s.
-    pub structure_s: f64,
+    pub structure_wall_time_s: f64,
     /// The coupling's own work, s.
-    pub coupling_s: f64,
+    pub coupling_wall_time_s: f64,
 }
 
 /// The dynamic state of a [`Coupled`] system between steps, for checkpoints: the structure's
@@ -572,25 +572,25 @@ impl Coupled {
             lap = now;
         };
         let mut timing = self.timing;
-        split(&mut timing.coupling_s);
+        split(&mut timing.coupling_wall_time_s);
         self.move_interface(false)?;
         self.world.step_deferred();
         self.check_particles()?;
         if self.steps.is_multiple_of(OVERLAP_CHECK_EVERY) {
             health::check_world_overlaps(&self.world).map_err(|s| self.failure(s))?;
         }
-        split(&mut timing.dem_s);
+        split(&mut timing.particles_wall_time_s);
         self.r_prev.resize(nps, 0.0);
         self.r_cur.resize(nps, 0.0);
         let mut omega = self.settings.initial_relaxation;
         let mut k = 0;
         loop {
             self.gather_interface_loads()?;
-            split(&mut timing.coupling_s);
+            split(&mut timing.coupling_wall_time_s);
             let solved = self
                 .dynamics
                 .solve(&mut self.structure, Some(&self.f_trial), k == 0);
-            split(&mut timing.structure_s);
+            split(&mut timing.structure_wall_time_s);
             if let Err(e) = solved {
                 // a diverged structure (or particles) is a health failure, not a solver one
                 if self.dynamics.d1.iter().any(|x| !x.is_finite())
@@ -643,9 +643,9 @@ impl Coupled {
             }
             std::mem::swap(&mut self.r_prev, &mut self.r_cur);
             self.move_interface(true)?;
-            split(&mut timing.coupling_s);
+            split(&mut timing.coupling_wall_time_s);
             self.world.repeat_wall_pass()?;
-            split(&mut timing.dem_s);
+            split(&mut timing.particles_wall_time_s);
         }
         self.omega = omega;
         // commit: interface work (trapezoidal), structure, the particles' second half kick
@@ -661,9 +661,9 @@ impl Coupled {
         self.interface_work_j += w;
         self.dynamics.commit();
         std::mem::swap(&mut self.f_ps, &mut self.f_trial);
-        split(&mut timing.coupling_s);
+        split(&mut timing.coupling_wall_time_s);
         self.world.complete_step();
-        split(&mut timing.dem_s);
+        split(&mut timing.particles_wall_time_s);
         self.timing = timing;
         self.last_iterations = k;
         self.total_iterations += k as u64;
