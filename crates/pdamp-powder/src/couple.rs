@@ -146,7 +146,7 @@ pub struct CoupledEnergy {
 fn interface_mesh(
     structure: &Structure,
     interface: &Interface,
-) -> Result<(TriMesh, Vec<usize>), MeshError> {
+) -> Result<(TriMesh, Vec<usize>), CoupleError> {
     let nodes = &structure.mesh.nodes;
     let local: std::collections::HashMap<usize, u32> = interface
         .nodes
@@ -179,7 +179,13 @@ fn interface_mesh(
             by_position
                 .get(&[v.x, v.y, v.z].map(f64::to_bits))
                 .copied()
-                .ok_or(MeshError::Empty)
+                .ok_or_else(|| {
+                    CoupleError::State(format!(
+                        "interface: two nodes share the position {:?} m (welded into one mesh \
+                         vertex); the interface must not touch itself",
+                        [v.x, v.y, v.z]
+                    ))
+                })
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((mesh, vertex_node))
@@ -195,7 +201,7 @@ fn empty_world(
     density_kg_m3: f64,
     gravity: [f64; 3],
     dt: f64,
-) -> Result<(World, Vec<usize>), MeshError> {
+) -> Result<(World, Vec<usize>), CoupleError> {
     let mut w = powder_world(law, density_kg_m3, gravity, dt);
     let mut vertex_node = Vec::new();
     if !interface.faces.is_empty() {
