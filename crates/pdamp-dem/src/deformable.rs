@@ -9,7 +9,7 @@
 //! the wall candidates are refreshed when the surface has moved by a skin.
 
 use crate::math::Vec3;
-use crate::walls::{Geometry, MeshError};
+use crate::walls::{Geometry, MeshError, TriMesh};
 use crate::world::World;
 
 impl World {
@@ -23,17 +23,7 @@ impl World {
         positions: &[Vec3],
     ) -> Result<(), MeshError> {
         let dt = self.dt_s;
-        let w = self
-            .bodies
-            .get_mut(body)
-            .and_then(|b| b.walls.get_mut(wall))
-            .ok_or(MeshError::NoSuchWall { body, wall })?;
-        match &mut w.geometry {
-            Geometry::Mesh(m) => m.move_vertices(positions, dt),
-            _ => Err(MeshError::NotAMesh {
-                wall: w.name.clone(),
-            }),
-        }
+        self.mesh_wall_mut(body, wall)?.move_vertices(positions, dt)
     }
 
     /// Replaces the last [`World::move_wall_vertices`] of mesh wall `wall` of body `body` by a
@@ -46,13 +36,19 @@ impl World {
         positions: &[Vec3],
     ) -> Result<(), MeshError> {
         let dt = self.dt_s;
+        self.mesh_wall_mut(body, wall)?
+            .replace_last_move(positions, dt)
+    }
+
+    /// The triangle mesh of wall `wall` of body `body`.
+    fn mesh_wall_mut(&mut self, body: usize, wall: usize) -> Result<&mut TriMesh, MeshError> {
         let w = self
             .bodies
             .get_mut(body)
             .and_then(|b| b.walls.get_mut(wall))
             .ok_or(MeshError::NoSuchWall { body, wall })?;
         match &mut w.geometry {
-            Geometry::Mesh(m) => m.replace_last_move(positions, dt),
+            Geometry::Mesh(m) => Ok(m),
             _ => Err(MeshError::NotAMesh {
                 wall: w.name.clone(),
             }),

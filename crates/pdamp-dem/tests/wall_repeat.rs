@@ -7,31 +7,8 @@
 mod common;
 use common::*;
 use pdamp_dem::wall_repeat::WallRepeatError;
-use pdamp_dem::walls::{Geometry, TriMesh};
+use pdamp_dem::walls::Geometry;
 use pdamp_dem::{BodyState, Motion, RigidBody, Vec3, World};
-
-/// A flat square patch of side `side` at z = 0, `n` × `n` cells of two triangles, normals +z.
-fn patch(side: f64, n: usize) -> TriMesh {
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            v.push(Vec3::new(
-                side * (i as f64 / n as f64 - 0.5),
-                side * (j as f64 / n as f64 - 0.5),
-                0.0,
-            ));
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut f = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    TriMesh::from_indexed(v, f).unwrap()
-}
 
 const SIDE: f64 = 0.06;
 
