@@ -681,8 +681,9 @@ pub struct CantileverResult {
 }
 
 /// Kind tag of `pdamp powder run` checkpoints (`-2`: the coupled run's particles are a
-/// pdamp-dem world; checkpoints of the earlier layout are refused by name).
-pub const CHECKPOINT_KIND: &str = "powder-run-2";
+/// pdamp-dem world; `-3`: the structure state says which precision its tangent factor has;
+/// checkpoints of earlier layouts are refused by name).
+pub const CHECKPOINT_KIND: &str = "powder-run-3";
 
 /// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
 pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, String> {

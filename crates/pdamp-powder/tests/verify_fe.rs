@@ -369,6 +369,117 @@ fn static_tip_deflection_under_the_paper_load() {
 }
 
 #[test]
+fn single_precision_modified_newton_converges_to_the_double_precision_full_newton_answer() {
+    // The paper load on a coarse paper beam with a fast ramp, 40 steps: modified Newton with
+    // the single-precision factor of the reference tangent against full Newton with a
+    // double-precision factor of the current tangent in every iteration. Both stop at a
+    // relative residual of 1e-12, so the displacements agree to ≈ 1e-11 of their size (the
+    // single-precision factor only changes the path, not the answer; a factor that solved the
+    // wrong system, or a residual in single precision, would show here as 1e-7 or worse).
+    let beam = paper_beam(0.001, 0.006, 0.004);
+    let load = LoadSpec {
+        pressure_pa: 1e5,
+        rise_s: 2e-4,
+        hold_s: f64::INFINITY,
+    };
+    let run = |full: bool| {
+        let (mut s, _) = build_structure(&beam, &load, [0.0, 0.0, -9.81]);
+        let n = s.n_dof();
+        let mut dy = Dynamics::new(
+            &mut s,
+            GenAlpha::from_rho_inf(0.8),
+            5e-6,
+            vec![0.0; n],
+            vec![0.0; n],
+            Rayleigh::default(),
+        )
+        .unwrap();
+        dy.newton.tolerance = 1e-12;
+        dy.newton.full_newton = full;
+        let mut iterations = 0;
+        for _ in 0..40 {
+            iterations += dy.step(&mut s).unwrap();
+        }
+        (dy.d, iterations)
+    };
+    let (modified, it_modified) = run(false);
+    let (full, it_full) = run(true);
+    let size = full.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = modified
+        .iter()
+        .zip(&full)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    eprintln!(
+        "modified Newton (single-precision factor) vs full Newton: max |Δd| = {:.2e} of max |d| = {size:.3e} m; iterations {it_modified} vs {it_full}",
+        diff / size
+    );
+    assert!(size > 1e-6, "the load must deform the beam: {size}");
+    assert!(diff < 1e-9 * size, "{diff} of {size}");
+    // four digits per iteration (the tangent changes little at strains of 1e-5)
+    assert!(it_modified <= 4 * 40, "{it_modified} iterations");
+}
+
+#[test]
+fn double_precision_factor_is_part_of_the_checkpoint() {
+    // A run whose tangent factor went to double precision (automatically when the single-
+    // precision factor stops converging, or asked for) must resume with it: the two factors
+    // take different Newton paths, whose converged states differ in the last bits.
+    let mut s = tube(0.05, 0.006, 0.005);
+    let n = s.n_dof();
+    let tip = s.mesh.nearest_node([0.01, 0.0, 0.05]);
+    let new = |s: &mut Structure| {
+        Dynamics::new(
+            s,
+            GenAlpha::from_rho_inf(0.8),
+            2e-6,
+            vec![0.0; n],
+            vec![0.0; n],
+            Rayleigh::default(),
+        )
+        .unwrap()
+    };
+    let mut load = vec![0.0; n];
+    load[3 * tip] = 10.0;
+    let step = |dy: &mut Dynamics, s: &mut Structure| {
+        dy.solve(s, Some(&load), true).unwrap();
+        dy.commit();
+    };
+    let mut single = new(&mut s);
+    let mut double = new(&mut s);
+    double.use_double_factor().unwrap();
+    for _ in 0..10 {
+        step(&mut single, &mut s);
+        step(&mut double, &mut s);
+    }
+    assert!(!single.save_state().double_factor);
+    let saved = double.save_state();
+    assert!(saved.double_factor);
+    let mut resumed = new(&mut s);
+    resumed.restore_state(saved).unwrap();
+    let mut from_single = new(&mut s);
+    from_single.restore_state(single.save_state()).unwrap();
+    let mut differs = false;
+    for _ in 0..10 {
+        step(&mut double, &mut s);
+        step(&mut resumed, &mut s);
+        step(&mut single, &mut s);
+        step(&mut from_single, &mut s);
+        let same = |a: &Dynamics, b: &Dynamics| {
+            a.d.iter()
+                .zip(&b.d)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        assert!(same(&double, &resumed) && same(&single, &from_single));
+        differs |= !same(&single, &double);
+    }
+    assert!(double.d[3 * tip] > 0.0);
+    assert!(
+        differs,
+        "the two factors must take different paths (else this test cannot fail)"
+    );
+}
+
+#[test]
 fn gmsh_and_abaqus_import_give_the_same_hex() {
     let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n$Elements\n1\n1 5 2 0 1 1 2 3 4 5 6 7 8\n$EndElements\n";
     let inp = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n*ELEMENT, TYPE=C3D8, ELSET=E\n1, 1, 2, 3, 4, 5, 6, 7, 8\n";

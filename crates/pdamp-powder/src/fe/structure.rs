@@ -69,6 +69,10 @@ pub struct Structure {
     pub free_dofs: Vec<usize>,
     /// Mass matrix on the free dofs (pattern equal to the stiffness pattern).
     pub mass: CsrMatrix,
+    /// The mass matrix per free node (`mass` = `mass_nodal` ⊗ I₃, both kinds): the products
+    /// with the mass matrix use it ([`Structure::mass_mul`]), a third of the entries of `mass`,
+    /// whose pattern is the stiffness pattern so that effective matrices can be combined.
+    pub mass_nodal: CsrMatrix,
     /// Tangent stiffness at the reference configuration (free dofs).
     pub k0: CsrMatrix,
     /// Surface loads.
@@ -124,12 +128,27 @@ impl Structure {
             .collect();
         let rho = material.density_kg_m3;
         let mut tm = Vec::with_capacity(mesh.elements.len() * 576);
+        let mut tn = Vec::with_capacity(mesh.elements.len() * 64);
         let mut body_force = vec![0.0; ndof];
         for (e, g) in gps.iter().enumerate() {
             let me = svk::element_mass(g, rho);
             let ef = &elem_free[e];
             for a in 0..8 {
                 let row_sum: f64 = me[a].iter().sum();
+                // a clamped node has all three dofs fixed: free dofs come in node triples
+                if ef[3 * a] != usize::MAX {
+                    for b in 0..8 {
+                        if ef[3 * b] == usize::MAX {
+                            continue;
+                        }
+                        let v = match mass_kind {
+                            MassKind::Consistent => me[a][b],
+                            MassKind::Lumped if a == b => row_sum,
+                            MassKind::Lumped => 0.0,
+                        };
+                        tn.push((ef[3 * a] / 3, ef[3 * b] / 3, v));
+                    }
+                }
                 for i in 0..3 {
                     body_force[3 * mesh.elements[e][a] + i] += row_sum * gravity_m_s2[i];
                 }
@@ -153,6 +172,7 @@ impl Structure {
         }
         let nfree = free_dofs.len();
         let mass = CsrMatrix::from_triplets(nfree, tm);
+        let mass_nodal = CsrMatrix::from_triplets(nfree / 3, tn);
         let mut s = Structure {
             mesh,
             material,
@@ -160,6 +180,7 @@ impl Structure {
             free,
             free_dofs,
             mass,
+            mass_nodal,
             k0: CsrMatrix::default(),
             loads: Vec::new(),
             body_force,
@@ -168,6 +189,48 @@ impl Structure {
         };
         let zero = vec![0.0; ndof];
         s.k0 = s.tangent(&zero);
+        s
+    }
+
+    /// `y = M x` on the free dofs, by nodes (equal to `mass.mul`, which adds the zero
+    /// entries between directions too). Rows in parallel, each in the same order for any
+    /// thread count.
+    pub fn mass_mul(&self, x: &[f64], y: &mut [f64]) {
+        use rayon::prelude::*;
+        let m = &self.mass_nodal;
+        y[..3 * m.n]
+            .par_chunks_mut(3)
+            .with_min_len(512)
+            .enumerate()
+            .for_each(|(a, y)| {
+                let mut s = [0.0; 3];
+                for k in m.row_ptr[a]..m.row_ptr[a + 1] {
+                    let (v, b) = (m.values[k], 3 * m.col_idx[k]);
+                    s[0] += v * x[b];
+                    s[1] += v * x[b + 1];
+                    s[2] += v * x[b + 2];
+                }
+                y.copy_from_slice(&s);
+            });
+    }
+
+    /// `xᵀ M x` for `x` on all dofs (clamped entries ignored), without copying it to the free
+    /// dofs; the same sums in the same order as `mass.quad` of the free part.
+    pub fn mass_quad_all(&self, x: &[f64]) -> f64 {
+        let (m, g) = (&self.mass_nodal, &self.free_dofs);
+        let mut s = 0.0;
+        for a in 0..m.n {
+            let mut t = [0.0; 3];
+            for k in m.row_ptr[a]..m.row_ptr[a + 1] {
+                let (v, b) = (m.values[k], 3 * m.col_idx[k]);
+                for i in 0..3 {
+                    t[i] += v * x[g[b + i]];
+                }
+            }
+            for i in 0..3 {
+                s += x[g[3 * a + i]] * t[i];
+            }
+        }
         s
     }
 
