@@ -87,8 +87,19 @@ fn main() {
     let steps: usize = std::env::var("GA_STEPS")
         .map(|s| s.parse().unwrap())
         .unwrap_or(200);
-    for _ in 0..steps {
-        its += dy.step(&mut s).unwrap();
+    let mut block = 0;
+    for k in 0..steps {
+        let it = dy.step(&mut s).unwrap();
+        its += it;
+        block += it;
+        if (k + 1) % 500 == 0 {
+            println!(
+                "t = {:.2} ms: {:.2} iterations per step over the last 500",
+                dy.t * 1e3,
+                block as f64 / 500.0
+            );
+            block = 0;
+        }
     }
     println!(
         "step {:.3} ms, mean iterations {:.2}",
