@@ -11,12 +11,14 @@
 //!
 //! Newton: the effective tangent
 //! $\frac{1-\alpha_m}{\beta\Delta t^2}\mathbf M + \frac{(1-\alpha_f)\gamma}{\beta\Delta t}\mathbf C + (1-\alpha_f)\mathbf K_T$
-//! is factorized at the reference configuration, in single precision, and reused ("modified Newton", the default:
-//! the strains of the studied structures are ~1e-4, so the tangent barely changes and each
-//! iteration gains about four digits); `full_newton` refactorizes with the current tangent in
-//! every iteration (quadratic convergence, for large deformations).
+//! is factorized at the reference configuration, stored in single precision, and reused
+//! ("modified Newton", the default: the strains of the studied structures are ~1e-4, so the
+//! tangent barely changes and each iteration gains two to four digits); `full_newton`
+//! refactorizes with the current tangent in every iteration (quadratic convergence, for large
+//! deformations).
 
 use super::sparse::{Cholesky, CsrMatrix, SingleCholesky, SolverError};
+use super::structure::Structure;
 
 /// The factor of the effective tangent: single precision for modified Newton (the residual
 /// that decides convergence is double precision, see [`SingleCholesky`]; measured on the
@@ -55,7 +57,6 @@ impl TangentFactor {
         }
     }
 }
-use super::structure::Structure;
 
 /// Parameters of the generalized-α method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -240,7 +241,12 @@ impl Dynamics {
             a[g] = rhs[k];
         }
         let keff = effective_matrix(s, &params, dt, &rayleigh, &s.k0);
-        let factor = TangentFactor::Single(SingleCholesky::new(&keff)?);
+        // (a matrix whose single-precision rounding is no longer positive definite gets the
+        // double-precision factor from the start, as a restored run of it does)
+        let factor = match SingleCholesky::new(&keff) {
+            Ok(c) => TangentFactor::Single(c),
+            Err(_) => TangentFactor::Double(Cholesky::new(&keff)?),
+        };
         Ok(Self {
             params,
             dt,
