@@ -109,15 +109,45 @@ pub struct Cholesky {
 
 const PAR: Par = Par::Seq;
 
+/// The symbolic Cholesky factorization (AMD ordering) of the pattern of `a`.
+fn symbolic_of(a: &CsrMatrix) -> Result<SymbolicCholesky<usize>, SolverError> {
+    let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
+    factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+        .map_err(|e| SolverError::Factor(format!("{e:?}")))
+}
+
+/// Numeric $LL^\top$ factorization into `factor` of the matrix with `a`'s pattern and the
+/// entries `values` (`a.values`, or those rounded to another precision).
+fn factorize_numeric<T: faer::traits::ComplexField>(
+    symbolic: &SymbolicCholesky<usize>,
+    factor: &mut Vec<T>,
+    a: &CsrMatrix,
+    values: &[T],
+) -> Result<(), SolverError> {
+    let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
+    factor.resize(symbolic.len_val(), T::zero_impl());
+    let mut mem =
+        MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<T>(PAR, Default::default()))
+            .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
+    symbolic
+        .factorize_numeric_llt::<T>(
+            factor,
+            SparseColMatRef::new(sym, values),
+            Side::Lower,
+            Default::default(),
+            PAR,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
+    Ok(())
+}
+
 impl Cholesky {
     /// Factorizes `a` (symbolic and numeric).
     pub fn new(a: &CsrMatrix) -> Result<Self, SolverError> {
-        let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
-        let symbolic =
-            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
-                .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
         let mut c = Self {
-            symbolic,
+            symbolic: symbolic_of(a)?,
             values: Vec::new(),
             n: a.n,
         };
@@ -127,25 +157,7 @@ impl Cholesky {
 
     /// Numeric refactorization of a matrix with the same pattern.
     pub fn refactor(&mut self, a: &CsrMatrix) -> Result<(), SolverError> {
-        let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
-        self.values.resize(self.symbolic.len_val(), 0.0);
-        let mut mem = MemBuffer::try_new(
-            self.symbolic
-                .factorize_numeric_llt_scratch::<f64>(PAR, Default::default()),
-        )
-        .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        self.symbolic
-            .factorize_numeric_llt::<f64>(
-                &mut self.values,
-                SparseColMatRef::new(sym, &a.values),
-                Side::Lower,
-                Default::default(),
-                PAR,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        Ok(())
+        factorize_numeric(&self.symbolic, &mut self.values, a, &a.values)
     }
 
     /// Stored entries of the factor.
@@ -184,10 +196,7 @@ impl SingleCholesky {
     /// Factorizes `a` (symbolic and numeric): the entries are rounded to single precision
     /// and factorized in single precision.
     pub fn new(a: &CsrMatrix) -> Result<Self, SolverError> {
-        let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
-        let symbolic =
-            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
-                .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
+        let symbolic = symbolic_of(a)?;
         let mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f32>(1, PAR))
             .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
         let mut c = Self {
@@ -203,26 +212,8 @@ impl SingleCholesky {
 
     /// Numeric refactorization of a matrix with the same pattern.
     pub fn refactor(&mut self, a: &CsrMatrix) -> Result<(), SolverError> {
-        let sym = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.row_ptr, None, &a.col_idx);
         let single: Vec<f32> = a.values.iter().map(|&v| v as f32).collect();
-        self.values.resize(self.symbolic.len_val(), 0.0);
-        let mut mem = MemBuffer::try_new(
-            self.symbolic
-                .factorize_numeric_llt_scratch::<f32>(PAR, Default::default()),
-        )
-        .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        self.symbolic
-            .factorize_numeric_llt::<f32>(
-                &mut self.values,
-                SparseColMatRef::new(sym, &single),
-                Side::Lower,
-                Default::default(),
-                PAR,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| SolverError::Factor(format!("{e:?}")))?;
-        Ok(())
+        factorize_numeric(&self.symbolic, &mut self.values, a, &single)
     }
 
     /// Solves `A x = b` approximately in place: the right-hand side is scaled by a power of two
