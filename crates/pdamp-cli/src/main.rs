@@ -838,6 +838,7 @@ fn cmd_run(
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {
         let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
+            .map_err(|e| e.to_string())
             .and_then(|s| energy_plot(out).map(|()| s));
         dir.set_outcome(&s);
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?

@@ -53,7 +53,7 @@ impl Bed {
 
     /// Checks the columns: equal lengths, finite values, positive radii, material indices in
     /// range. The message names the first offending particle (0-based) and column.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), BedError> {
         let n = self.len();
         for (name, len) in [
             ("radius_m", self.radius_m.len()),
@@ -62,38 +62,88 @@ impl Bed {
             ("angular_velocity_rad_s", self.angular_velocity_rad_s.len()),
         ] {
             if len != n {
-                return Err(format!(
-                    "bed column {name} has {len} entries, position_m has {n}"
-                ));
+                return Err(BedError::ColumnLength {
+                    column: name,
+                    len,
+                    expected: n,
+                });
             }
         }
         let finite = |v: &Vec3| v.iter().all(|c| c.is_finite());
         for i in 0..n {
             if !finite(&self.position_m[i]) {
-                return Err(format!("bed particle {i}: position_m is not finite"));
+                return Err(BedError::Particle {
+                    index: i,
+                    column: "position_m",
+                    message: "position_m is not finite".into(),
+                });
             }
             let r = self.radius_m[i];
             if !(r.is_finite() && r > 0.0) {
-                return Err(format!(
-                    "bed particle {i}: radius_m must be finite and > 0, got {r}"
-                ));
+                return Err(BedError::Particle {
+                    index: i,
+                    column: "radius_m",
+                    message: format!("radius_m must be finite and > 0, got {r}"),
+                });
             }
             if self.material[i] as usize >= self.materials.len() {
-                return Err(format!(
-                    "bed particle {i}: material index {} but the bed names {} material(s)",
-                    self.material[i],
-                    self.materials.len()
-                ));
+                return Err(BedError::Particle {
+                    index: i,
+                    column: "material",
+                    message: format!(
+                        "material index {} but the bed names {} material(s)",
+                        self.material[i],
+                        self.materials.len()
+                    ),
+                });
             }
             if !finite(&self.velocity_m_s[i]) {
-                return Err(format!("bed particle {i}: velocity_m_s is not finite"));
+                return Err(BedError::Particle {
+                    index: i,
+                    column: "velocity_m_s",
+                    message: "velocity_m_s is not finite".into(),
+                });
             }
             if !finite(&self.angular_velocity_rad_s[i]) {
-                return Err(format!(
-                    "bed particle {i}: angular_velocity_rad_s is not finite"
-                ));
+                return Err(BedError::Particle {
+                    index: i,
+                    column: "angular_velocity_rad_s",
+                    message: "angular_velocity_rad_s is not finite".into(),
+                });
             }
         }
         Ok(())
+    }
+}
+
+/// A bed's columns do not fit together or hold a bad value ([`Bed::validate`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BedError {
+    /// A column has another length than `position_m`.
+    #[error("bed column {column} has {len} entries, position_m has {expected}")]
+    ColumnLength {
+        /// The column.
+        column: &'static str,
+        /// Its length.
+        len: usize,
+        /// Length of `position_m`.
+        expected: usize,
+    },
+    /// A particle's value is not finite or out of range.
+    #[error("bed particle {index}: {message}")]
+    Particle {
+        /// 0-based index of the particle in the bed.
+        index: usize,
+        /// The column.
+        column: &'static str,
+        /// What is wrong (starts with the column).
+        message: String,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<BedError> for String {
+    fn from(e: BedError) -> String {
+        e.to_string()
     }
 }

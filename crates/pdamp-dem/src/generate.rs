@@ -11,6 +11,7 @@
 //! Drop-down settling ([D Fig. 2.2b]) is done by the simulation pipeline, not here.
 //! All generators are deterministic: the same inputs (and seed) give bit-identical output.
 
+use crate::ParameterError;
 use crate::math::Vec3;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -74,13 +75,9 @@ impl SizeDistribution {
     }
 
     /// Checks ranges; returns a message naming the offending field.
-    pub fn validate(&self) -> Result<(), String> {
-        fn positive(name: &str, v: f64) -> Result<(), String> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(format!("{name} must be finite and > 0, got {v}"))
-            }
+    pub fn validate(&self) -> Result<(), ParameterError> {
+        fn positive(name: &str, v: f64) -> Result<(), ParameterError> {
+            ParameterError::check(v.is_finite() && v > 0.0, name, "be finite and > 0", v)
         }
         match *self {
             SizeDistribution::Monodisperse { radius_m } => positive("radius_m", radius_m),
@@ -91,8 +88,11 @@ impl SizeDistribution {
                 positive("min_radius_m", min_radius_m)?;
                 positive("max_radius_m", max_radius_m)?;
                 if min_radius_m > max_radius_m {
-                    return Err(format!(
-                        "min_radius_m ({min_radius_m}) must not exceed max_radius_m ({max_radius_m})"
+                    return Err(ParameterError::invalid(
+                        "min_radius_m",
+                        format!(
+                            "min_radius_m ({min_radius_m}) must not exceed max_radius_m ({max_radius_m})"
+                        ),
                     ));
                 }
                 Ok(())
@@ -105,7 +105,11 @@ impl SizeDistribution {
             } => {
                 positive("median_diameter_m", median_diameter_m)?;
                 if !(sigma.is_finite() && sigma >= 0.0) {
-                    return Err(format!("sigma must be finite and >= 0, got {sigma}"));
+                    return Err(ParameterError::out_of_range(
+                        "sigma",
+                        "be finite and >= 0",
+                        sigma,
+                    ));
                 }
                 if let Some(r) = min_radius_m {
                     positive("min_radius_m", r)?;
@@ -115,8 +119,9 @@ impl SizeDistribution {
                 }
                 match (min_radius_m, max_radius_m) {
                     (Some(lo), Some(hi)) if lo >= hi => {
-                        return Err(format!(
-                            "min_radius_m ({lo}) must be below max_radius_m ({hi})"
+                        return Err(ParameterError::invalid(
+                            "min_radius_m",
+                            format!("min_radius_m ({lo}) must be below max_radius_m ({hi})"),
                         ));
                     }
                     _ => {}
@@ -126,8 +131,11 @@ impl SizeDistribution {
                     if min_radius_m.is_some_and(|lo| r50 < lo)
                         || max_radius_m.is_some_and(|hi| r50 > hi)
                     {
-                        return Err(format!(
-                            "with sigma = 0 the median radius {r50} m must lie within min_radius_m/max_radius_m"
+                        return Err(ParameterError::invalid(
+                            "sigma",
+                            format!(
+                                "with sigma = 0 the median radius {r50} m must lie within min_radius_m/max_radius_m"
+                            ),
                         ));
                     }
                     return Ok(());
@@ -136,8 +144,11 @@ impl SizeDistribution {
                     .lognormal_window()
                     .map_or(1.0, |(a, b)| normal_cdf(b) - normal_cdf(a));
                 if mass < MIN_TRUNCATION_MASS {
-                    return Err(format!(
-                        "min_radius_m/max_radius_m keep only {mass:.3e} of the log-normal probability mass (need >= {MIN_TRUNCATION_MASS:e})"
+                    return Err(ParameterError::invalid(
+                        "min_radius_m/max_radius_m",
+                        format!(
+                            "min_radius_m/max_radius_m keep only {mass:.3e} of the log-normal probability mass (need >= {MIN_TRUNCATION_MASS:e})"
+                        ),
                     ));
                 }
                 Ok(())
@@ -454,18 +465,24 @@ pub enum Region {
 
 impl Region {
     /// Checks ranges; returns a message naming the offending field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParameterError> {
         let finite = |v: &Vec3| v.iter().all(|c| c.is_finite());
         match self {
             Region::Box { min_m, max_m } => {
                 if !finite(min_m) || !finite(max_m) {
-                    return Err("min_m and max_m must be finite".into());
+                    return Err(ParameterError::invalid(
+                        "min_m",
+                        "min_m and max_m must be finite",
+                    ));
                 }
                 if (0..3).any(|i| min_m[i] >= max_m[i]) {
-                    return Err(format!(
-                        "min_m {:?} must be below max_m {:?} in every component",
-                        min_m.as_slice(),
-                        max_m.as_slice()
+                    return Err(ParameterError::invalid(
+                        "min_m",
+                        format!(
+                            "min_m {:?} must be below max_m {:?} in every component",
+                            min_m.as_slice(),
+                            max_m.as_slice()
+                        ),
                     ));
                 }
                 Ok(())
@@ -477,18 +494,25 @@ impl Region {
                 length_m,
             } => {
                 if !finite(base_center_m) {
-                    return Err("base_center_m must be finite".into());
+                    return Err(ParameterError::invalid(
+                        "base_center_m",
+                        "base_center_m must be finite",
+                    ));
                 }
                 if !finite(axis) || axis.norm() == 0.0 {
-                    return Err("axis must be finite and non-zero".into());
+                    return Err(ParameterError::invalid(
+                        "axis",
+                        "axis must be finite and non-zero",
+                    ));
                 }
-                if !(radius_m.is_finite() && *radius_m > 0.0) {
-                    return Err(format!("radius_m must be finite and > 0, got {radius_m}"));
-                }
-                if !(length_m.is_finite() && *length_m > 0.0) {
-                    return Err(format!("length_m must be finite and > 0, got {length_m}"));
-                }
-                Ok(())
+                let (r, l) = (*radius_m, *length_m);
+                ParameterError::check(
+                    r.is_finite() && r > 0.0,
+                    "radius_m",
+                    "be finite and > 0",
+                    r,
+                )?;
+                ParameterError::check(l.is_finite() && l > 0.0, "length_m", "be finite and > 0", l)
             }
         }
     }
@@ -664,6 +688,71 @@ pub fn orthonormal_frame(up: &Vec3) -> Option<(Vec3, Vec3, Vec3)> {
 // Lattice packings
 // ------------------------------------------------------------------------------------------------
 
+/// Errors of the packing generators ([`grid_packing`], [`tight_packing`], [`random_insertion`],
+/// [`lattice_sites`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PackingError {
+    /// A region, radius, spacing, gap or layering parameter out of range.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// The lattice would need more candidate sites than 5e7.
+    #[error(
+        "lattice packing would need about {sites:.3e} candidate sites (spacing {spacing_m} m too small for the region)"
+    )]
+    TooManySites {
+        /// Estimated number of candidate sites.
+        sites: f64,
+        /// Lattice spacing in m.
+        spacing_m: f64,
+    },
+    /// The region holds fewer lattice sites than particles.
+    #[error(
+        "region holds only {fitted} of {requested} particles on a {lattice:?} lattice with spacing {spacing_m:.6e} m (2 r_max + gap)"
+    )]
+    RegionTooSmall {
+        /// Sites that fit.
+        fitted: usize,
+        /// Particles to place.
+        requested: usize,
+        /// The lattice.
+        lattice: Lattice,
+        /// Nearest-neighbour spacing in m.
+        spacing_m: f64,
+    },
+    /// More particles than the insertion grid can index.
+    #[error("too many particles ({count})")]
+    TooManyParticles {
+        /// Particles requested.
+        count: usize,
+    },
+    /// Random insertion found no free position for a particle.
+    #[error(
+        "random insertion placed only {placed} of {requested} particles: particle {particle} (radius {radius_m:.6e} m) found no free position in {attempts} attempts{}",
+        if *in_top_layer { " in the top layer" } else { "" }
+    )]
+    NoFreePosition {
+        /// Particles placed before.
+        placed: usize,
+        /// Particles to place.
+        requested: usize,
+        /// Index of the particle that found no place.
+        particle: usize,
+        /// Its radius in m.
+        radius_m: f64,
+        /// Attempts per particle.
+        attempts: usize,
+        /// Whether layered insertion had reached its top layer.
+        in_top_layer: bool,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<PackingError> for String {
+    fn from(e: PackingError) -> String {
+        e.to_string()
+    }
+}
+
 /// Lattice of a regular packing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -692,7 +781,7 @@ pub fn lattice_sites(
     clearance_m: f64,
     up: &Vec3,
     lattice: Lattice,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     lattice_sites_limited(region, spacing_m, clearance_m, up, lattice, usize::MAX)
 }
 
@@ -704,17 +793,20 @@ fn lattice_sites_limited(
     up: &Vec3,
     lattice: Lattice,
     limit: usize,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     region.validate()?;
     if !(d.is_finite() && d > 0.0) {
-        return Err(format!("lattice spacing must be finite and > 0, got {d}"));
+        return Err(ParameterError::out_of_range("lattice spacing", "be finite and > 0", d).into());
     }
     if !(c.is_finite() && c >= 0.0) {
-        return Err(format!(
-            "lattice clearance must be finite and >= 0, got {c}"
-        ));
+        return Err(
+            ParameterError::out_of_range("lattice clearance", "be finite and >= 0", c).into(),
+        );
     }
-    let (e1, e2, e3) = orthonormal_frame(up).ok_or("up direction must be finite and non-zero")?;
+    let (e1, e2, e3) = orthonormal_frame(up).ok_or(ParameterError::invalid(
+        "up",
+        "up direction must be finite and non-zero",
+    ))?;
     let (lo1, hi1) = region.extent_along(&e1);
     let (lo2, hi2) = region.extent_along(&e2);
     let (lo3, hi3) = region.extent_along(&e3);
@@ -733,10 +825,10 @@ fn lattice_sites_limited(
         return Ok(Vec::new());
     }
     if (n1 + 2.0) * (n2 + 2.0) * n3 > MAX_LATTICE_SITES {
-        return Err(format!(
-            "lattice packing would need about {:.3e} candidate sites (spacing {d} m too small for the region)",
-            n1 * n2 * n3
-        ));
+        return Err(PackingError::TooManySites {
+            sites: n1 * n2 * n3,
+            spacing_m: d,
+        });
     }
     let (n1, n2, n3) = (n1 as i64, n2 as i64, n3 as i64);
     let x0 = lo1 + 0.5 * (hi1 - lo1 - (n1 - 1) as f64 * d);
@@ -775,13 +867,12 @@ fn lattice_sites_limited(
     Ok(out)
 }
 
-fn check_radii(radii: &[f64]) -> Result<f64, String> {
+fn check_radii(radii: &[f64]) -> Result<f64, ParameterError> {
     let mut r_max = 0.0f64;
     for (i, &r) in radii.iter().enumerate() {
         if !(r.is_finite() && r > 0.0) {
-            return Err(format!(
-                "radius of particle {i} must be finite and > 0, got {r}"
-            ));
+            let key = format!("radius of particle {i}");
+            return Err(ParameterError::out_of_range(key, "be finite and > 0", r));
         }
         r_max = r_max.max(r);
     }
@@ -794,13 +885,13 @@ fn lattice_packing(
     gap_m: f64,
     up: &Vec3,
     lattice: Lattice,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     let r_max = check_radii(radii)?;
     if radii.is_empty() {
         return Ok(Vec::new());
     }
     if !(gap_m.is_finite() && gap_m >= 0.0) {
-        return Err(format!("gap_m must be finite and >= 0, got {gap_m}"));
+        return Err(ParameterError::out_of_range("gap_m", "be finite and >= 0", gap_m).into());
     }
     let spacing = 2.0 * r_max + gap_m;
     let mut sites = lattice_sites_limited(
@@ -812,11 +903,12 @@ fn lattice_packing(
         radii.len(),
     )?;
     if sites.len() < radii.len() {
-        return Err(format!(
-            "region holds only {} of {} particles on a {lattice:?} lattice with spacing {spacing:.6e} m (2 r_max + gap)",
-            sites.len(),
-            radii.len()
-        ));
+        return Err(PackingError::RegionTooSmall {
+            fitted: sites.len(),
+            requested: radii.len(),
+            lattice,
+            spacing_m: spacing,
+        });
     }
     sites.truncate(radii.len());
     Ok(sites)
@@ -831,7 +923,7 @@ pub fn grid_packing(
     radii: &[f64],
     gap_m: f64,
     up: &Vec3,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     lattice_packing(region, radii, gap_m, up, Lattice::SimpleCubic)
 }
 
@@ -843,7 +935,7 @@ pub fn tight_packing(
     radii: &[f64],
     gap_m: f64,
     up: &Vec3,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     lattice_packing(region, radii, gap_m, up, Lattice::Hcp)
 }
 
@@ -987,7 +1079,7 @@ pub fn random_insertion(
     seed: u64,
     max_attempts_per_particle: usize,
     layering: Option<&Layering>,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     random_insertion_clear_of(
         region,
         radii,
@@ -1008,17 +1100,21 @@ pub fn random_insertion_clear_of(
     max_attempts_per_particle: usize,
     layering: Option<&Layering>,
     blocked: &dyn Fn(&Vec3, f64) -> bool,
-) -> Result<Vec<Vec3>, String> {
+) -> Result<Vec<Vec3>, PackingError> {
     region.validate()?;
     let r_max = check_radii(radii)?;
     if radii.is_empty() {
         return Ok(Vec::new());
     }
     if max_attempts_per_particle == 0 {
-        return Err("max_attempts_per_particle must be > 0".into());
+        return Err(ParameterError::invalid(
+            "max_attempts_per_particle",
+            "max_attempts_per_particle must be > 0",
+        )
+        .into());
     }
     if radii.len() >= EMPTY as usize {
-        return Err(format!("too many particles ({})", radii.len()));
+        return Err(PackingError::TooManyParticles { count: radii.len() });
     }
     let (lo, hi) = region.bounding_box();
     let mut grid = CellGrid::new(lo, hi, 2.0 * r_max, radii.len());
@@ -1036,13 +1132,15 @@ pub fn random_insertion_clear_of(
         None => None,
         Some(l) => {
             if !(l.layer_height_m.is_finite() && l.layer_height_m > 0.0) {
-                return Err(format!(
-                    "layer_height_m must be finite and > 0, got {}",
-                    l.layer_height_m
-                ));
+                let h = l.layer_height_m;
+                return Err(
+                    ParameterError::out_of_range("layer_height_m", "be finite and > 0", h).into(),
+                );
             }
-            let (e1, e2, e3) =
-                orthonormal_frame(&l.up).ok_or("layering: up must be finite and non-zero")?;
+            let (e1, e2, e3) = orthonormal_frame(&l.up).ok_or(ParameterError::invalid(
+                "layering.up",
+                "layering: up must be finite and non-zero",
+            ))?;
             let ext = [
                 region.extent_along(&e1),
                 region.extent_along(&e2),
@@ -1098,15 +1196,14 @@ pub fn random_insertion_clear_of(
             }
         };
         let Some(p) = placed else {
-            return Err(format!(
-                "random insertion placed only {n_placed} of {} particles: particle {i} (radius {r:.6e} m) found no free position in {max_attempts_per_particle} attempts{}",
-                radii.len(),
-                if layers.is_some() {
-                    " in the top layer"
-                } else {
-                    ""
-                }
-            ));
+            return Err(PackingError::NoFreePosition {
+                placed: n_placed,
+                requested: radii.len(),
+                particle: i,
+                radius_m: r,
+                attempts: max_attempts_per_particle,
+                in_top_layer: layers.is_some(),
+            });
         };
         grid.insert(n_placed as u32, &p);
         pos.push(p);
@@ -1299,11 +1396,11 @@ mod tests {
         }
         .validate()
         .unwrap_err();
-        assert!(e.contains("min_radius_m"), "{e}");
+        assert_eq!(e.key(), "min_radius_m", "{e}");
         let e = SizeDistribution::Monodisperse { radius_m: -1.0 }
             .validate()
             .unwrap_err();
-        assert!(e.contains("radius_m"), "{e}");
+        assert_eq!(e.key(), "radius_m", "{e}");
         let e = SizeDistribution::LogNormal {
             median_diameter_m: 1e-3,
             sigma: -0.1,
@@ -1312,14 +1409,20 @@ mod tests {
         }
         .validate()
         .unwrap_err();
-        assert!(e.contains("sigma"), "{e}");
+        assert_eq!(e.key(), "sigma", "{e}");
         let narrow = SizeDistribution::LogNormal {
             median_diameter_m: 1e-3,
             sigma: 0.1,
             min_radius_m: Some(1.0e-3),
             max_radius_m: Some(1.1e-3),
         };
-        assert!(narrow.validate().unwrap_err().contains("probability mass"));
+        assert!(
+            narrow
+                .validate()
+                .unwrap_err()
+                .to_string()
+                .contains("probability mass")
+        );
         let e = Region::Cylinder {
             base_center_m: Vec3::zeros(),
             axis: Vec3::zeros(),
@@ -1328,7 +1431,7 @@ mod tests {
         }
         .validate()
         .unwrap_err();
-        assert!(e.contains("axis"), "{e}");
+        assert_eq!(e.key(), "axis", "{e}");
     }
 
     #[test]
@@ -1388,7 +1491,18 @@ mod tests {
         // Error states how many fit.
         let many = vec![0.5e-3; 100_000];
         let e = grid_packing(&region, &many, 0.0, &up).unwrap_err();
-        assert!(e.contains("holds only 2000 of 100000"), "{e}");
+        assert!(e.to_string().contains("holds only 2000 of 100000"), "{e}");
+        assert!(
+            matches!(
+                e,
+                PackingError::RegionTooSmall {
+                    fitted: 2000,
+                    requested: 100_000,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
         // Gravity along −x: bottom is the x = 0 face.
         let pos = grid_packing(&region, &radii, 1e-5, &Vec3::x()).unwrap();
         assert!(pos.windows(2).all(|w| w[1].x >= w[0].x - 1e-12));
@@ -1468,7 +1582,21 @@ mod tests {
         // Too many particles: error names how many were placed.
         let many = vec![0.7e-3; 20_000];
         let e = random_insertion(&region, &many, 1, 50, None).unwrap_err();
-        assert!(e.contains("placed only") && e.contains("of 20000"), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("placed only") && msg.contains("of 20000"),
+            "{e}"
+        );
+        assert!(
+            matches!(
+                e,
+                PackingError::NoFreePosition {
+                    requested: 20000,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
     }
 
     #[test]

@@ -240,7 +240,7 @@ impl std::error::Error for ImpactError {}
 pub fn checked_head_on_impact(req: &ImpactRequest) -> Result<ImpactResult, ImpactError> {
     let bad = |key, message: String| Err(ImpactError { key, message });
     if let Err(m) = req.material.validate() {
-        return bad("material", m);
+        return bad("material", m.to_string());
     }
     if !(req.radius_m > 0.0 && req.radius_m <= 1.0) {
         return bad(
@@ -303,7 +303,7 @@ pub fn checked_head_on_impact(req: &ImpactRequest) -> Result<ImpactResult, Impac
         adhesion: None,
     };
     if let Err(m) = model.validate() {
-        return bad("law", m);
+        return bad("law", m.to_string());
     }
     let r = head_on_impact(&ImpactSetup {
         partner: req.partner,

@@ -44,46 +44,64 @@ impl GearParams {
     /// Checks the controller settings against the initial step `dt_s` (errors start with the
     /// key, e.g. `safety_factor must …`): Δt_min ≤ Δt ≤ Δt_max, positive finite tolerances,
     /// 1 to 100 corrector steps and a safety factor κ_s in (0, 1] [D Eq. 2.105].
-    pub fn validate(&self, dt_s: f64) -> Result<(), String> {
+    pub fn validate(&self, dt_s: f64) -> Result<(), crate::ParameterError> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
         if !pos(self.dt_min_s) || self.dt_min_s > dt_s {
-            return Err(format!(
-                "dt_min_s must be > 0 and at most the time step {dt_s:e} s, got {}; e.g. 1e-16",
-                self.dt_min_s
+            return Err(crate::ParameterError::invalid(
+                "dt_min_s",
+                format!(
+                    "dt_min_s must be > 0 and at most the time step {dt_s:e} s, got {}; e.g. 1e-16",
+                    self.dt_min_s
+                ),
             ));
         }
         if let Some(m) = self.dt_max_s
             && (!pos(m) || m < dt_s)
         {
-            return Err(format!(
-                "dt_max_s must be finite and at least the time step {dt_s:e} s, got {m}; leave it out for π/ω_max [D Eq. 2.83]"
+            return Err(crate::ParameterError::invalid(
+                "dt_max_s",
+                format!(
+                    "dt_max_s must be finite and at least the time step {dt_s:e} s, got {m}; leave it out for π/ω_max [D Eq. 2.83]"
+                ),
             ));
         }
         if !pos(self.tolerance_abs) {
-            return Err(format!(
-                "tolerance_abs must be > 0 (m/s²), got {}; e.g. 1e-6",
-                self.tolerance_abs
+            return Err(crate::ParameterError::invalid(
+                "tolerance_abs",
+                format!(
+                    "tolerance_abs must be > 0 (m/s²), got {}; e.g. 1e-6",
+                    self.tolerance_abs
+                ),
             ));
         }
         if !(self.tolerance_rel.is_finite() && (0.0..1.0).contains(&self.tolerance_rel)) {
-            return Err(format!(
-                "tolerance_rel must lie in [0, 1), got {}; e.g. 1e-6",
-                self.tolerance_rel
+            return Err(crate::ParameterError::invalid(
+                "tolerance_rel",
+                format!(
+                    "tolerance_rel must lie in [0, 1), got {}; e.g. 1e-6",
+                    self.tolerance_rel
+                ),
             ));
         }
         if !(1..=100).contains(&self.max_corrections) {
-            return Err(format!(
-                "max_corrections must lie in 1..=100, got {}; e.g. 10",
-                self.max_corrections
+            return Err(crate::ParameterError::invalid(
+                "max_corrections",
+                format!(
+                    "max_corrections must lie in 1..=100, got {}; e.g. 10",
+                    self.max_corrections
+                ),
             ));
         }
         if !(self.safety_factor.is_finite()
             && self.safety_factor > 0.0
             && self.safety_factor <= 1.0)
         {
-            return Err(format!(
-                "safety_factor must lie in (0, 1], got {}; e.g. 0.9 [D Eq. 2.105]",
-                self.safety_factor
+            return Err(crate::ParameterError::invalid(
+                "safety_factor",
+                format!(
+                    "safety_factor must lie in (0, 1], got {}; e.g. 0.9 [D Eq. 2.105]",
+                    self.safety_factor
+                ),
             ));
         }
         Ok(())

@@ -14,6 +14,7 @@ pub mod contact;
 pub mod deformable;
 pub mod drop_down;
 pub mod energy;
+pub mod error;
 mod forces;
 pub mod generate;
 pub mod health;
@@ -35,6 +36,7 @@ pub use body::{
 };
 pub use contact::{ContactModel, FrictionLaw, NormalLaw};
 pub use energy::EnergyLedger;
+pub use error::ParameterError;
 pub use forces::{PairState, PpContact, WallSlot};
 pub use integrate::{GearParams, Integrator};
 pub use material::Material;

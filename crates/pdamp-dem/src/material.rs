@@ -34,23 +34,32 @@ impl Material {
     }
 
     /// Checks ranges; returns a message naming the offending field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), crate::ParameterError> {
         if !(self.density_kg_m3.is_finite() && self.density_kg_m3 > 0.0) {
-            return Err(format!(
-                "density_kg_m3 must be > 0, got {} (material '{}')",
-                self.density_kg_m3, self.name
+            return Err(crate::ParameterError::invalid(
+                "density_kg_m3",
+                format!(
+                    "density_kg_m3 must be > 0, got {} (material '{}')",
+                    self.density_kg_m3, self.name
+                ),
             ));
         }
         if !(self.youngs_modulus_pa.is_finite() && self.youngs_modulus_pa > 0.0) {
-            return Err(format!(
-                "youngs_modulus_pa must be > 0, got {} (material '{}')",
-                self.youngs_modulus_pa, self.name
+            return Err(crate::ParameterError::invalid(
+                "youngs_modulus_pa",
+                format!(
+                    "youngs_modulus_pa must be > 0, got {} (material '{}')",
+                    self.youngs_modulus_pa, self.name
+                ),
             ));
         }
         if !(self.poisson_ratio > -1.0 && self.poisson_ratio < 0.5) {
-            return Err(format!(
-                "poisson_ratio must lie in (-1, 0.5), got {} (material '{}')",
-                self.poisson_ratio, self.name
+            return Err(crate::ParameterError::invalid(
+                "poisson_ratio",
+                format!(
+                    "poisson_ratio must lie in (-1, 0.5), got {} (material '{}')",
+                    self.poisson_ratio, self.name
+                ),
             ));
         }
         Ok(())

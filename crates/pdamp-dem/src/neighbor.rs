@@ -40,12 +40,21 @@ fn top_two(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     }
 }
 
+/// A neighbour list read from a file does not fit its particles
+/// ([`NeighborList::check_consistency`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("neighbour list: {problem}")]
+pub struct NeighborListError {
+    /// What is wrong, e.g. `rows do not cover the pairs`.
+    pub problem: &'static str,
+}
+
 impl NeighborList {
     /// Checks the list against `n` particles (a list read from a file): finite skin and range,
     /// rows that cover the pairs in order, pairs `(i, j)` with `i < j < n` in the row of `i`,
     /// reference positions for all particles (or none). The error says what is wrong.
-    pub fn check_consistency(&self, n: usize) -> Result<(), String> {
-        let bad = |what: &str| Err(format!("neighbour list: {what}"));
+    pub fn check_consistency(&self, n: usize) -> Result<(), NeighborListError> {
+        let bad = |what: &'static str| Err(NeighborListError { problem: what });
         let finite_non_negative = |x: f64| x.is_finite() && x >= 0.0;
         if !(finite_non_negative(self.skin_m) && finite_non_negative(self.extra_range_m)) {
             return bad("skin or range not finite and non-negative");

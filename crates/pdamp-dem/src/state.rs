@@ -8,7 +8,7 @@ use crate::energy::EnergyLedger;
 use crate::forces::{PpContact, WallSlot};
 use crate::integrate::GearState;
 use crate::math::Vec3;
-use crate::neighbor::NeighborList;
+use crate::neighbor::{NeighborList, NeighborListError};
 use crate::world::{Counters, World};
 use serde::{Deserialize, Serialize};
 
@@ -111,12 +111,15 @@ impl World {
     /// elsewhere — by another process of a sweep — from its scenario's bodies and walls, so that
     /// the restored world continues bit for bit. A material index outside the world's table is
     /// refused.
-    pub fn set_particles_of(&mut self, s: &WorldState) -> Result<(), String> {
+    pub fn set_particles_of(&mut self, s: &WorldState) -> Result<(), StateError> {
         if s.material.len() != s.radius.len() || s.id.len() != s.radius.len() {
-            return Err("state: particle columns of different lengths".into());
+            return Err(StateError::ColumnLengths);
         }
         if let Some(i) = s.radius.iter().position(|r| !(r.is_finite() && *r > 0.0)) {
-            return Err(format!("state: particle {i} has radius {} m", s.radius[i]));
+            return Err(StateError::Radius {
+                particle: i,
+                radius_m: s.radius[i],
+            });
         }
         if let Some((i, &m)) = s
             .material
@@ -124,10 +127,11 @@ impl World {
             .enumerate()
             .find(|(_, m)| **m as usize >= self.materials.len())
         {
-            return Err(format!(
-                "state: particle {i} has material index {m}, the world has {} materials",
-                self.materials.len()
-            ));
+            return Err(StateError::Material {
+                particle: i,
+                material: m,
+                materials: self.materials.len(),
+            });
         }
         self.particles = crate::particles::ParticleSet::default();
         for (&r, &m) in s.radius.iter().zip(&s.material) {
@@ -143,7 +147,7 @@ impl World {
     /// ledger stay this world's; it initialises again at its next step (forces, wall contacts,
     /// ledger reset). A state whose contacts or neighbour pairs do not fit its particles is
     /// refused.
-    pub fn adopt_particles(&mut self, s: &WorldState) -> Result<(), String> {
+    pub fn adopt_particles(&mut self, s: &WorldState) -> Result<(), StateError> {
         let n = s.radius.len();
         if [
             s.position.len(),
@@ -160,13 +164,11 @@ impl World {
                 .chain(&s.neighbors.second)
                 .any(|&i| i as usize >= n)
         {
-            return Err(
-                "bed state: particle columns, contacts or neighbour pairs inconsistent".into(),
-            );
+            return Err(StateError::BedInconsistent);
         }
         s.neighbors
             .check_consistency(n)
-            .map_err(|e| format!("bed state: {e}"))?;
+            .map_err(StateError::BedNeighbors)?;
         self.set_particles_of(s)?;
         let p = &mut self.particles;
         p.position.clone_from(&s.position);
@@ -184,19 +186,16 @@ impl World {
     /// Puts a snapshot back. The world must have been built from the same scenario: same
     /// particles (radius, material, id) and the same bodies; otherwise an error says what differs
     /// and the world is left unchanged.
-    pub fn restore_state(&mut self, s: WorldState) -> Result<(), String> {
+    pub fn restore_state(&mut self, s: WorldState) -> Result<(), StateError> {
         let p = &self.particles;
         if s.radius.len() != p.len() {
-            return Err(format!(
-                "checkpoint has {} particles, the scenario builds {}",
-                s.radius.len(),
-                p.len()
-            ));
+            return Err(StateError::ParticleCount {
+                checkpoint: s.radius.len(),
+                scenario: p.len(),
+            });
         }
         if s.radius != p.radius || s.material != p.material || s.id != p.id {
-            return Err(
-                "checkpoint particles (radius, material or id) differ from the scenario's".into(),
-            );
+            return Err(StateError::ParticlesDiffer);
         }
         let n = p.len();
         for (k, v) in [
@@ -208,7 +207,11 @@ impl World {
             ("external_force", s.external_force.len()),
         ] {
             if v != n {
-                return Err(format!("checkpoint {k} has {v} entries, expected {n}"));
+                return Err(StateError::ColumnLength {
+                    column: k,
+                    len: v,
+                    expected: n,
+                });
             }
         }
         if s.bodies.len() != self.bodies.len()
@@ -217,7 +220,7 @@ impl World {
                 .zip(&self.bodies)
                 .any(|(a, b)| a.name != b.name)
         {
-            return Err("checkpoint bodies differ from the scenario's".into());
+            return Err(StateError::BodiesDiffer);
         }
         let np = s.neighbors.first.len();
         if s.neighbors.second.len() != np
@@ -232,14 +235,14 @@ impl World {
                 .any(|&i| i as usize >= n)
             || (s.initialized && s.wall_slots.len() != n)
         {
-            return Err("checkpoint neighbour list is inconsistent".into());
+            return Err(StateError::NeighborsInconsistent);
         }
         s.neighbors
             .check_consistency(n)
-            .map_err(|e| format!("checkpoint {e}"))?;
+            .map_err(StateError::CheckpointNeighbors)?;
         let clock_ok = s.dt_s.is_finite() && s.dt_s > 0.0 && s.time_s.is_finite();
         if !(clock_ok && s.gravity_m_s2.iter().all(|g| g.is_finite())) {
-            return Err("checkpoint time step, time or gravity not finite".into());
+            return Err(StateError::ClockNotFinite);
         }
         let walls_of = |b: u16| self.bodies.get(b as usize).map_or(0, |b| b.walls.len());
         if s.wall_slots
@@ -247,9 +250,7 @@ impl World {
             .flatten()
             .any(|w| w.wall as usize >= walls_of(w.body))
         {
-            return Err(
-                "checkpoint wall contacts refer to walls the scenario does not have".into(),
-            );
+            return Err(StateError::WallContacts);
         }
         let p = &mut self.particles;
         p.position = s.position;
@@ -277,6 +278,84 @@ impl World {
         self.gear = s.gear;
         self.initialized = s.initialized;
         Ok(())
+    }
+}
+
+/// A state or checkpoint does not fit the world it is put into ([`World::set_particles_of`],
+/// [`World::adopt_particles`], [`World::restore_state`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StateError {
+    /// Radius, material and id columns of different lengths.
+    #[error("state: particle columns of different lengths")]
+    ColumnLengths,
+    /// A radius is not finite or not positive.
+    #[error("state: particle {particle} has radius {radius_m} m")]
+    Radius {
+        /// Particle index.
+        particle: usize,
+        /// Its radius in m.
+        radius_m: f64,
+    },
+    /// A material index outside the world's table.
+    #[error(
+        "state: particle {particle} has material index {material}, the world has {materials} materials"
+    )]
+    Material {
+        /// Particle index.
+        particle: usize,
+        /// Its material index.
+        material: u16,
+        /// Materials of the world.
+        materials: usize,
+    },
+    /// A bed state whose columns, contacts or neighbour pairs do not fit its particles.
+    #[error("bed state: particle columns, contacts or neighbour pairs inconsistent")]
+    BedInconsistent,
+    /// A bed state's neighbour list is inconsistent.
+    #[error("bed state: {0}")]
+    BedNeighbors(#[source] NeighborListError),
+    /// The checkpoint has another number of particles than the scenario builds.
+    #[error("checkpoint has {checkpoint} particles, the scenario builds {scenario}")]
+    ParticleCount {
+        /// Particles in the checkpoint.
+        checkpoint: usize,
+        /// Particles of the scenario.
+        scenario: usize,
+    },
+    /// Radius, material or id differ from the scenario's particles.
+    #[error("checkpoint particles (radius, material or id) differ from the scenario's")]
+    ParticlesDiffer,
+    /// A checkpoint column has the wrong length.
+    #[error("checkpoint {column} has {len} entries, expected {expected}")]
+    ColumnLength {
+        /// The column, e.g. `velocity`.
+        column: &'static str,
+        /// Its length.
+        len: usize,
+        /// The number of particles.
+        expected: usize,
+    },
+    /// The checkpoint's bodies are not the scenario's.
+    #[error("checkpoint bodies differ from the scenario's")]
+    BodiesDiffer,
+    /// The checkpoint's contacts or neighbour pairs do not fit its particles.
+    #[error("checkpoint neighbour list is inconsistent")]
+    NeighborsInconsistent,
+    /// The checkpoint's neighbour list is inconsistent.
+    #[error("checkpoint {0}")]
+    CheckpointNeighbors(#[source] NeighborListError),
+    /// Time step, time or gravity not finite.
+    #[error("checkpoint time step, time or gravity not finite")]
+    ClockNotFinite,
+    /// Wall contacts that refer to walls the scenario does not have.
+    #[error("checkpoint wall contacts refer to walls the scenario does not have")]
+    WallContacts,
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<StateError> for String {
+    fn from(e: StateError) -> String {
+        e.to_string()
     }
 }
 
@@ -493,6 +572,10 @@ mod tests {
         let a = shaken_box(3);
         let mut b = shaken_box(4);
         let e = b.restore_state(a.save_state()).unwrap_err();
-        assert!(e.contains("27 particles"), "{e}");
+        assert!(e.to_string().contains("27 particles"), "{e}");
+        assert!(
+            matches!(e, super::StateError::ParticleCount { checkpoint: 27, .. }),
+            "{e:?}"
+        );
     }
 }

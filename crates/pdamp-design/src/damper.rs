@@ -475,6 +475,7 @@ impl Damper {
                             wall_time_s: wall_before + start.elapsed().as_secs_f64(),
                         };
                         ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
+                            .map_err(String::from)
                     });
                     if let Err(e) = r {
                         save_error = Some(e);

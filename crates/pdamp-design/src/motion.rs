@@ -353,6 +353,7 @@ impl PointObserver for MotionRecorder {
             fd_slot: self.fd_slot,
             fd_work: self.fd_work,
         })
+        .map_err(String::from)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {

@@ -52,6 +52,7 @@ fn a_saved_prepared_bed_continues_bit_for_bit() {
     else {
         panic!("another packing's scenario must be refused");
     };
+    let e = e.to_string();
     assert!(e.contains("different scenario"), "{e}");
     let path = prepared_bed_path(&dir, 1);
     let mut bytes = std::fs::read(&path).unwrap();

@@ -17,12 +17,12 @@
 //!
 //! A damaged or foreign file is refused with the reason (magic, digest, format, kind).
 
-use crate::checkpoint::{self, CheckpointHeader};
+use crate::checkpoint::{self, CheckpointError, CheckpointHeader};
 use pdamp_dem::bed_statistics::BedStatistics;
 use pdamp_dem::drop_down::DropDownReport;
 use pdamp_dem::{Bed, WorldState};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Kind tag of bed files in the checkpoint header.
 pub const BED_KIND: &str = "bed";
@@ -42,8 +42,45 @@ pub struct BedFile {
     pub state: Option<WorldState>,
 }
 
+/// Why a native bed file cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum BedFileError {
+    /// The file cannot be read.
+    #[error("cannot read bed '{}': {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file was read but is refused.
+    #[error("bed '{}': {source}", path.display())]
+    InFile {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: Box<BedFileError>,
+    },
+    /// No bed-file magic at the start.
+    #[error("not a pdamp bed file")]
+    NotBedFile,
+    /// Damaged, of another format version or of another kind.
+    #[error(transparent)]
+    Framing(CheckpointError),
+    /// The bed's columns are inconsistent.
+    #[error(transparent)]
+    Bed(#[from] pdamp_dem::bed::BedError),
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<BedFileError> for String {
+    fn from(e: BedFileError) -> String {
+        e.to_string()
+    }
+}
+
 /// Writes `file` to `path` atomically; `scenario_digest` names the scenario that made it.
-pub fn save_bed(path: &Path, file: &BedFile, scenario_digest: &str) -> Result<(), String> {
+pub fn save_bed(path: &Path, file: &BedFile, scenario_digest: &str) -> Result<(), CheckpointError> {
     checkpoint::save(
         path,
         &CheckpointHeader::new(BED_KIND, scenario_digest),
@@ -52,16 +89,23 @@ pub fn save_bed(path: &Path, file: &BedFile, scenario_digest: &str) -> Result<()
 }
 
 /// Reads a native bed file; the message says why a file is refused.
-pub fn load_bed(path: &Path) -> Result<BedFile, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read bed '{}': {e}", path.display()))?;
-    decode_bed(&bytes).map_err(|e| format!("bed '{}': {e}", path.display()))
+pub fn load_bed(path: &Path) -> Result<BedFile, BedFileError> {
+    let bytes = std::fs::read(path).map_err(|e| BedFileError::Read {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    decode_bed(&bytes).map_err(|e| BedFileError::InFile {
+        path: path.to_path_buf(),
+        source: Box::new(e),
+    })
 }
 
 /// Decodes the bytes of a native bed file (never panics, bounded allocation).
-pub fn decode_bed(bytes: &[u8]) -> Result<BedFile, String> {
-    let f: BedFile = checkpoint::decode(bytes, BED_KIND, None)
-        .map_err(|e| e.replace("pdamp checkpoint", "pdamp bed file"))?;
+pub fn decode_bed(bytes: &[u8]) -> Result<BedFile, BedFileError> {
+    let f: BedFile = checkpoint::decode(bytes, BED_KIND, None).map_err(|e| match e {
+        CheckpointError::NotCheckpoint => BedFileError::NotBedFile,
+        e => BedFileError::Framing(e),
+    })?;
     f.bed.validate()?;
     Ok(f)
 }

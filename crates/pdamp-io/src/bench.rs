@@ -24,9 +24,38 @@ pub struct BenchResult {
     pub settling_wall_time_s: f64,
 }
 
+/// Why the benchmark cannot run or write its peer case.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// The shaken box's world cannot be built.
+    #[error(transparent)]
+    Input(#[from] crate::InputError),
+    /// The settled bed cannot be stored.
+    #[error(transparent)]
+    Checkpoint(#[from] crate::checkpoint::CheckpointError),
+    /// The stored settled bed does not fit the box.
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
+    /// The `--settled` path holds a file that is not a settled bed of the bench.
+    #[error(
+        "--settled {}: the file exists and is not a settled bed of `pdamp bench`; it is left as \
+         it is: choose another path",
+        .0.display()
+    )]
+    NotSettledBed(std::path::PathBuf),
+    /// A file of the LIGGGHTS case cannot be written.
+    #[error("{}: {source}", dir.display())]
+    Write {
+        /// The case directory.
+        dir: std::path::PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+}
+
 /// Builds the shaken box with `n` particles, settles it for 20 ms (not timed), then times
 /// `steps` steps of shaking.
-pub fn shaken_box_bench(n: usize, steps: u64) -> Result<BenchResult, String> {
+pub fn shaken_box_bench(n: usize, steps: u64) -> Result<BenchResult, BenchError> {
     let sc = shaken_box(n, 1.0);
     let mut world = sc.build_world(Path::new("."))?;
     let settling = std::time::Instant::now();
@@ -59,7 +88,7 @@ pub const SETTLE_S: f64 = 0.02;
 /// The shaken box with `n` particles, settled for [`SETTLE_S`] with the box at rest and the clock
 /// restarted at 0. With `cache`, a settled bed stored there (for the same `n`) is reused, and a
 /// new one is stored there, so that repeated benchmarks start from one bed.
-pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, String> {
+pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, BenchError> {
     let sc = shaken_box(n, 1.0);
     let mut world = sc.build_world(Path::new("."))?;
     let kind = format!("bench-settled-{n}-layers");
@@ -74,11 +103,7 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Strin
         let ours =
             head.starts_with(b"PDAMPCK\0") && head.windows(14).any(|w| w == b"bench-settled-");
         if !ours {
-            return Err(format!(
-                "--settled {}: the file exists and is not a settled bed of `pdamp bench`; it is \
-                 left as it is: choose another path",
-                path.display()
-            ));
+            return Err(BenchError::NotSettledBed(path.to_path_buf()));
         }
     }
     let cached = match cache.map(|path| crate::checkpoint::load::<WorldState>(path, &kind, &digest))
@@ -202,9 +227,12 @@ pub const LIGGGHTS_INPUT: &str = include_str!("../../../bench/peers/in.shaken_bo
 /// `particles.data` (positions, velocities, spins), `box.stl` (the box as 12 triangles) and
 /// `in.shaken_box` (the script with `steps` and the domain bounds), plus `case.json`
 /// (amplitude, frequency, time step) for the driver that evaluates the run.
-pub fn write_liggghts_case(world: &World, steps: u64, dir: &Path) -> Result<(), String> {
+pub fn write_liggghts_case(world: &World, steps: u64, dir: &Path) -> Result<(), BenchError> {
     use std::fmt::Write;
-    let err = |e: std::io::Error| format!("{}: {e}", dir.display());
+    let err = |e: std::io::Error| BenchError::Write {
+        dir: dir.to_path_buf(),
+        source: e,
+    };
     std::fs::create_dir_all(dir).map_err(err)?;
     let n = world.particles.len();
     let side = crate::examples::shaken_box_side_m(n);

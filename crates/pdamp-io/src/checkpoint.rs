@@ -91,6 +91,8 @@ impl std::fmt::Display for Interrupted {
     }
 }
 
+impl std::error::Error for Interrupted {}
+
 /// 64-bit FNV-1a digest (stable across platforms and Rust versions), printed as 16 hex digits.
 pub fn digest(bytes: &[u8]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -140,15 +142,101 @@ struct InFile<T> {
 
 const MAGIC: &[u8; 8] = b"PDAMPCK\0";
 
+/// Why a checkpoint (or a bed file, which has the same framing) cannot be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    /// The file cannot be read or written.
+    #[error("checkpoint {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file was read but is refused.
+    #[error("checkpoint {}: {source}", path.display())]
+    InFile {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: Box<CheckpointError>,
+    },
+    /// No checkpoint magic at the start (or too short).
+    #[error("not a pdamp checkpoint")]
+    NotCheckpoint,
+    /// The trailing digest does not match the content.
+    #[error("damaged (digest mismatch)")]
+    Damaged,
+    /// The header or body does not decode.
+    #[error("unreadable ({0})")]
+    Unreadable(String),
+    /// Another file format version.
+    #[error(
+        "format {format} written by pdamp {pdamp_version}, this pdamp reads format {CHECKPOINT_FORMAT}"
+    )]
+    Format {
+        /// The file's format.
+        format: u32,
+        /// The pdamp version that wrote it.
+        pdamp_version: String,
+    },
+    /// Written by another kind of run.
+    #[error("written by a '{found}' run, not '{expected}'")]
+    Kind {
+        /// Kind in the file.
+        found: String,
+        /// Kind expected.
+        expected: String,
+    },
+    /// Written for another scenario (its digest differs).
+    #[error(
+        "written for a different scenario (the file changed since); start afresh without \
+         --resume or use another --out directory"
+    )]
+    OtherScenario,
+    /// The body does not encode.
+    #[error("{0}")]
+    Encode(String),
+    /// A part does not encode ([`encode_part`]).
+    #[error("checkpoint: {0}")]
+    EncodePart(String),
+    /// A part does not decode ([`decode_part`]).
+    #[error("checkpoint: unreadable part ({0})")]
+    UnreadablePart(String),
+}
+
+impl CheckpointError {
+    /// `why` about the file `path`.
+    pub fn in_file(path: &Path, why: CheckpointError) -> Self {
+        Self::InFile {
+            path: path.to_path_buf(),
+            source: Box::new(why),
+        }
+    }
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<CheckpointError> for String {
+    fn from(e: CheckpointError) -> String {
+        e.to_string()
+    }
+}
+
 /// Writes `body` with `header` to `path` atomically.
-pub fn save<T: Serialize>(path: &Path, header: &CheckpointHeader, body: &T) -> Result<(), String> {
+pub fn save<T: Serialize>(
+    path: &Path,
+    header: &CheckpointHeader,
+    body: &T,
+) -> Result<(), CheckpointError> {
     let mut bytes = MAGIC.to_vec();
     bincode::serialize_into(&mut bytes, &OutFile { header, body })
-        .map_err(|e| format!("checkpoint {}: {e}", path.display()))?;
+        .map_err(|e| CheckpointError::in_file(path, CheckpointError::Encode(e.to_string())))?;
     let sum = digest(&bytes);
     bytes.extend_from_slice(sum.as_bytes());
-    crate::atomic::write_atomic(path, &bytes)
-        .map_err(|e| format!("checkpoint {}: {e}", path.display()))
+    crate::atomic::write_atomic(path, &bytes).map_err(|e| CheckpointError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })
 }
 
 /// Reads a checkpoint written by [`save`]; checks the magic, the trailing digest, the format,
@@ -157,27 +245,32 @@ pub fn load<T: for<'de> Deserialize<'de>>(
     path: &Path,
     kind: &str,
     scenario_digest: &str,
-) -> Result<Option<T>, String> {
+) -> Result<Option<T>, CheckpointError> {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(format!("checkpoint {}: {e}", path.display())),
+        Err(e) => {
+            return Err(CheckpointError::Io {
+                path: path.to_path_buf(),
+                source: e,
+            });
+        }
     };
     decode(&bytes, kind, Some(scenario_digest))
         .map(Some)
-        .map_err(|why| format!("checkpoint {}: {why}", path.display()))
+        .map_err(|why| CheckpointError::in_file(path, why))
 }
 
 /// Checks only the framing of a checkpoint file — the magic and the trailing digest of
 /// everything before it — without decoding the body: a quick test that a stored file is
 /// complete and undamaged (a sweep's status over thousands of files).
-pub fn verify_framing(bytes: &[u8]) -> Result<(), String> {
+pub fn verify_framing(bytes: &[u8]) -> Result<(), CheckpointError> {
     if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
-        return Err("not a pdamp checkpoint".into());
+        return Err(CheckpointError::NotCheckpoint);
     }
     let (data, sum) = bytes.split_at(bytes.len() - 16);
     if digest(data).as_bytes() != sum {
-        return Err("damaged (digest mismatch)".into());
+        return Err(CheckpointError::Damaged);
     }
     Ok(())
 }
@@ -189,14 +282,14 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
     bytes: &[u8],
     kind: &str,
     scenario_digest: Option<&str>,
-) -> Result<T, String> {
+) -> Result<T, CheckpointError> {
     use bincode::Options;
     if bytes.len() < MAGIC.len() + 16 || &bytes[..MAGIC.len()] != MAGIC {
-        return Err("not a pdamp checkpoint".into());
+        return Err(CheckpointError::NotCheckpoint);
     }
     let (data, sum) = bytes.split_at(bytes.len() - 16);
     if digest(data).as_bytes() != sum {
-        return Err("damaged (digest mismatch)".into());
+        return Err(CheckpointError::Damaged);
     }
     let options = bincode::DefaultOptions::new()
         .with_fixint_encoding()
@@ -206,48 +299,47 @@ pub fn decode<T: for<'de> Deserialize<'de>>(
     let header: CheckpointHeader = options
         .allow_trailing_bytes()
         .deserialize(&data[MAGIC.len()..])
-        .map_err(|e| format!("unreadable ({e})"))?;
+        .map_err(|e| CheckpointError::Unreadable(e.to_string()))?;
     if header.format != CHECKPOINT_FORMAT {
-        return Err(format!(
-            "format {} written by pdamp {}, this pdamp reads format {CHECKPOINT_FORMAT}",
-            header.format, header.pdamp_version
-        ));
+        return Err(CheckpointError::Format {
+            format: header.format,
+            pdamp_version: header.pdamp_version,
+        });
     }
     // The kind too (before the body, whose layout is the kind's).
     if header.kind != kind {
-        return Err(format!("written by a '{}' run, not '{kind}'", header.kind));
+        return Err(CheckpointError::Kind {
+            found: header.kind,
+            expected: kind.to_string(),
+        });
     }
     let f: InFile<T> = options
         .deserialize(&data[MAGIC.len()..])
-        .map_err(|e| format!("unreadable ({e})"))?;
+        .map_err(|e| CheckpointError::Unreadable(e.to_string()))?;
     if scenario_digest.is_some_and(|d| d != f.header.scenario_digest) {
-        return Err(
-            "written for a different scenario (the file changed since); start afresh without \
-             --resume or use another --out directory"
-                .into(),
-        );
+        return Err(CheckpointError::OtherScenario);
     }
     Ok(f.body)
 }
 
 /// Encodes a value exactly (bincode, fixed-width integers) for embedding in a checkpoint body,
 /// e.g. the state of an observer behind a trait object.
-pub fn encode_part<T: Serialize>(value: &T) -> Result<Vec<u8>, String> {
+pub fn encode_part<T: Serialize>(value: &T) -> Result<Vec<u8>, CheckpointError> {
     use bincode::Options;
     bincode::DefaultOptions::new()
         .with_fixint_encoding()
         .serialize(value)
-        .map_err(|e| format!("checkpoint: {e}"))
+        .map_err(|e| CheckpointError::EncodePart(e.to_string()))
 }
 
 /// Decodes what [`encode_part`] wrote (never allocates more than the input suggests).
-pub fn decode_part<T: for<'de> Deserialize<'de>>(bytes: &[u8]) -> Result<T, String> {
+pub fn decode_part<T: for<'de> Deserialize<'de>>(bytes: &[u8]) -> Result<T, CheckpointError> {
     use bincode::Options;
     bincode::DefaultOptions::new()
         .with_fixint_encoding()
         .with_limit(bytes.len() as u64)
         .deserialize(bytes)
-        .map_err(|e| format!("checkpoint: unreadable part ({e})"))
+        .map_err(|e| CheckpointError::UnreadablePart(e.to_string()))
 }
 
 /// Decides when to write the next checkpoint: every `interval` of wall-clock time (checked
@@ -303,24 +395,34 @@ mod tests {
         save(&p, &h, &body).unwrap();
         let back: (f64, Vec<u32>, String) = load(&p, "run", "abc").unwrap().unwrap();
         assert_eq!(back, body);
-        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "other").unwrap_err();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "other")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("different scenario"), "{e}");
-        let e = load::<(f64, Vec<u32>, String)>(&p, "fields", "abc").unwrap_err();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "fields", "abc")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("not 'fields'"), "{e}");
         let mut bytes = std::fs::read(&p).unwrap();
         let k = bytes.len() / 2;
         bytes[k] ^= 0x55;
         std::fs::write(&p, &bytes).unwrap();
-        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("damaged"), "{e}");
         std::fs::write(&p, b"garbage").unwrap();
-        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("not a pdamp checkpoint"), "{e}");
         // A file of an older format whose body no longer parses is named by its format.
         let mut old = CheckpointHeader::new("run", "abc");
         old.format = CHECKPOINT_FORMAT - 1;
         save(&p, &old, &(7u8,)).unwrap();
-        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc").unwrap_err();
+        let e = load::<(f64, Vec<u32>, String)>(&p, "run", "abc")
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains(&format!(
                 "format {} written by pdamp",

@@ -149,19 +149,19 @@ impl Estimate {
     /// available now, more than [`MAX_VTK_FRAMES`] frames, [`MAX_ENERGY_ROWS`] rows,
     /// [`MAX_OUTPUT_BYTES`] of output or [`MAX_RUN_TIME_S`] of estimated run time. The message
     /// gives the figures, the keys that set them and `--force`.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), pdamp_dem::ParameterError> {
         let gb = |b: f64| b / 1e9;
         if self.particles > MAX_PARTICLES {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "particles: {} particles exceed the {MAX_PARTICLES} a world can hold",
                 self.particles
-            ));
+            )));
         }
         let (total, available) = memory_of_machine();
         if let Some(total) = total
             && self.memory_bytes > total
         {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "particles: the run needs about {:.1} GB of memory ({} particles × \
                  {BYTES_PER_PARTICLE} bytes, plus the force and velocity samples of the \
                  evaluated cycles of damper points); this process may use {:.1} GB in all. Use \
@@ -169,7 +169,7 @@ impl Estimate {
                 gb(self.memory_bytes),
                 self.particles,
                 gb(total)
-            ));
+            )));
         }
         if forced() {
             return Ok(());
@@ -178,39 +178,39 @@ impl Estimate {
         if let Some(avail) = available
             && self.memory_bytes > 0.9 * avail
         {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "particles: the run needs about {:.1} GB of memory ({} particles, plus the \
                  samples of damper points), {:.1} GB are available now {force}",
                 gb(self.memory_bytes),
                 self.particles,
                 gb(avail)
-            ));
+            )));
         }
         if self.vtk_frames > MAX_VTK_FRAMES {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "output: the run would write {:.0} VTK frames (limit {MAX_VTK_FRAMES}); raise \
                  output.vtk_interval_s (or lower damper.motion_output.vtk_frames_per_cycle) \
                  {force}",
                 self.vtk_frames
-            ));
+            )));
         }
         if self.energy_rows > MAX_ENERGY_ROWS {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "output.energy_interval_s: the run would write {:.3e} rows of energy.csv (limit \
                  {MAX_ENERGY_ROWS:e}); raise output.energy_interval_s {force}",
                 self.energy_rows
-            ));
+            )));
         }
         if self.output_bytes > MAX_OUTPUT_BYTES {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "output: the run would write about {:.1} GB (limit {:.0} GB); raise \
                  output.vtk_interval_s or output.energy_interval_s {force}",
                 gb(self.output_bytes),
                 gb(MAX_OUTPUT_BYTES)
-            ));
+            )));
         }
         if self.wall_time_s > MAX_RUN_TIME_S {
-            return Err(format!(
+            return Err(pdamp_dem::ParameterError::from_message(format!(
                 "simulation: {:.3e} particle-steps ({} particles, {:.3e} steps of {:.3e} s over \
                  {:.3e} s simulated) would take about {:.0} days on {} threads (estimate at \
                  {PARTICLE_STEPS_PER_S_PER_THREAD:e} particle-steps/s per thread); shorten \
@@ -222,7 +222,7 @@ impl Estimate {
                 self.simulated_time_s,
                 self.wall_time_s / 86_400.0,
                 self.threads
-            ));
+            )));
         }
         Ok(())
     }
@@ -286,14 +286,14 @@ mod tests {
         e.check().unwrap();
         let mut many = sc.clone();
         many.output.vtk_interval_s = many.simulation.time_step_s;
-        let err = Estimate::of(&many, 1, 2).check().unwrap_err();
+        let err = Estimate::of(&many, 1, 2).check().unwrap_err().to_string();
         assert!(
             err.contains("VTK frames") && err.contains("output.vtk_interval_s"),
             "{err}"
         );
         let mut long = sc.clone();
         long.simulation.duration_s = 1e9;
-        let err = Estimate::of(&long, 1, 2).check().unwrap_err();
+        let err = Estimate::of(&long, 1, 2).check().unwrap_err().to_string();
         assert!(err.contains("--force"), "{err}");
     }
 }

@@ -20,13 +20,13 @@ pub fn scenario(bytes: &[u8]) {
     match crate::scenario::Scenario::from_toml_in(&text, base) {
         Ok(s) => {
             if let Err(m) = s.validate() {
-                let _ = crate::scenario::locate_key(&text, crate::scenario::leading_key_path(&m));
+                let _ = crate::scenario::locate_key(&text, m.key());
             } else {
                 let _ = s.to_toml();
             }
         }
         Err(m) => {
-            let _ = crate::scenario::locate_key(&text, crate::scenario::leading_key_path(&m));
+            let _ = crate::scenario::locate_key(&text, m.key());
         }
     }
 }

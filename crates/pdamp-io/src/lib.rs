@@ -10,6 +10,7 @@ pub mod bed_formats;
 pub mod bench;
 pub mod checkpoint;
 pub mod csv;
+pub mod error;
 pub mod estimate;
 pub mod examples;
 pub mod fuzz;
@@ -21,3 +22,5 @@ pub mod run;
 pub mod scenario;
 pub mod stl;
 pub mod vtk;
+
+pub use error::InputError;

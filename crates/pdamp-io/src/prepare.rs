@@ -4,13 +4,57 @@
 //! ([`pdamp_dem::bed_statistics`]). Used by `pdamp settle`, damper points, effective fields and
 //! ensembles, so that every command makes its beds the same way.
 
+use crate::InputError;
 use crate::bed::{BedFile, save_bed};
+use crate::checkpoint::CheckpointError;
+use crate::error::Source;
 use crate::scenario::{Preparation, Scenario};
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::drop_down::DropDownReport;
 use pdamp_dem::{Bed, Vec3, World};
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Why a bed cannot be prepared, saved or read back.
+#[derive(Debug, thiserror::Error)]
+pub enum PrepareError {
+    /// The scenario's world cannot be built.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// A bed or prepared-bed file cannot be written, or is refused.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    /// A saved prepared bed cannot be used.
+    #[error("prepared bed {}: {source}", path.display())]
+    Prepared {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: Source,
+    },
+    /// An output file cannot be written.
+    #[error("output: {0}")]
+    Output(#[source] Source),
+    /// The summary does not serialise.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+impl PrepareError {
+    fn prepared(path: impl Into<PathBuf>, source: impl Into<Source>) -> Self {
+        Self::Prepared {
+            path: path.into(),
+            source: source.into(),
+        }
+    }
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<PrepareError> for String {
+    fn from(e: PrepareError) -> String {
+        e.to_string()
+    }
+}
 
 /// A settled bed in its world.
 #[derive(Debug, Clone)]
@@ -48,7 +92,7 @@ pub fn prepare_bed(
     scenario: &Scenario,
     base_dir: &Path,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<PreparedBed, String> {
+) -> Result<PreparedBed, PrepareError> {
     let (mut world, drop_down) =
         scenario.build_world_reporting(base_dir, Preparation::Full, progress)?;
     // A damper's bed is made in the container at rest (its excitation belongs to the points).
@@ -117,7 +161,7 @@ pub fn save_prepared(
     prepared: &PreparedBed,
     scenario: &Scenario,
     base_dir: &Path,
-) -> Result<(), String> {
+) -> Result<(), CheckpointError> {
     let digest = crate::run::scenario_content_digest(scenario, base_dir);
     crate::checkpoint::save(
         path,
@@ -140,10 +184,15 @@ pub fn load_prepared(
     path: &Path,
     scenario: &Scenario,
     base_dir: &Path,
-) -> Result<Option<PreparedBed>, String> {
+) -> Result<Option<PreparedBed>, PrepareError> {
     let digest = crate::run::scenario_content_digest(scenario, base_dir);
-    let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest)
-        .map_err(|e| e.replace("checkpoint ", "prepared bed "))?
+    let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest).map_err(
+        |e| match e {
+            CheckpointError::Io { path, source } => PrepareError::prepared(path, source),
+            CheckpointError::InFile { path, source } => PrepareError::prepared(path, *source),
+            e => PrepareError::Checkpoint(e),
+        },
+    )?
     else {
         return Ok(None);
     };
@@ -152,7 +201,7 @@ pub fn load_prepared(
         crate::scenario::Preparation::Check,
         &mut |_, _| {},
     )?;
-    let why = |e: String| format!("prepared bed {}: {e}", path.display());
+    let why = |e: pdamp_dem::state::StateError| PrepareError::prepared(path, e);
     world.set_particles_of(&f.state).map_err(why)?;
     world.restore_state(f.state).map_err(why)?;
     if let Some(d) = &scenario.damper
@@ -207,9 +256,9 @@ pub fn settle_scenario(
     base_dir: &Path,
     out: &Path,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<SettleSummary, String> {
+) -> Result<SettleSummary, PrepareError> {
     let start = std::time::Instant::now();
-    let io = |e: std::io::Error| format!("output: {e}");
+    let io = |e: std::io::Error| PrepareError::Output(e.into());
     let prepared = prepare_bed(scenario, base_dir, progress)?;
     let world = &prepared.world;
     crate::provenance::Provenance::of(scenario)
@@ -262,7 +311,7 @@ pub fn settle_scenario(
             ),
         ],
     )
-    .map_err(|e| format!("output: {e}"))?;
+    .map_err(|e| PrepareError::Output(e.into()))?;
     let summary = SettleSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: scenario.title.clone(),
@@ -283,7 +332,7 @@ pub fn settle_scenario(
         .map(String::from)
         .to_vec(),
     };
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string_pretty(&summary)?;
     crate::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
     Ok(summary)
 }

@@ -7,22 +7,64 @@
 /// Key of a contact `normal` table that names a restitution CSV.
 pub const TABLE_KEY: &str = "restitution_table_csv";
 
+/// A restitution table that cannot be used ([`parse_restitution_table`]); names the line.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    /// The CSV itself does not parse.
+    #[error(transparent)]
+    Csv(#[from] crate::csv::CsvError),
+    /// A required column is missing.
+    #[error(
+        "no column '{column}' (columns: {columns}); the table needs velocity_m_s and restitution"
+    )]
+    NoColumn {
+        /// The missing column.
+        column: String,
+        /// The columns the file has, comma separated.
+        columns: String,
+    },
+    /// Only a header.
+    #[error("the table has no rows")]
+    NoRows,
+    /// A value out of range.
+    #[error("row {line}: {column} {message}")]
+    Row {
+        /// 1-based line in the file (the header is line 1).
+        line: usize,
+        /// The column.
+        column: &'static str,
+        /// What is wrong, e.g. `must be > 0, got -1`.
+        message: String,
+    },
+}
+
+impl TableError {
+    fn row(line: usize, column: &'static str, message: String) -> Self {
+        Self::Row {
+            line,
+            column,
+            message,
+        }
+    }
+}
+
 /// Parses a restitution table: columns `velocity_m_s` and `restitution` (others are ignored),
 /// velocities > 0 and strictly increasing, restitutions in (0, 1]. Never panics; errors name
 /// the line.
-pub fn parse_restitution_table(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let (header, rows) = crate::csv::parse_csv_f64(text).map_err(|e| e.to_string())?;
+pub fn parse_restitution_table(text: &str) -> Result<(Vec<f64>, Vec<f64>), TableError> {
+    let (header, rows) = crate::csv::parse_csv_f64(text)?;
     let col = |name: &str| {
-        header.iter().position(|h| h == name).ok_or_else(|| {
-            format!(
-                "no column '{name}' (columns: {}); the table needs velocity_m_s and restitution",
-                header.join(", ")
-            )
-        })
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| TableError::NoColumn {
+                column: name.to_string(),
+                columns: header.join(", "),
+            })
     };
     let (iv, ie) = (col("velocity_m_s")?, col("restitution")?);
     if rows.is_empty() {
-        return Err("the table has no rows".into());
+        return Err(TableError::NoRows);
     }
     let (mut v, mut e) = (
         Vec::with_capacity(rows.len()),
@@ -32,19 +74,21 @@ pub fn parse_restitution_table(text: &str) -> Result<(Vec<f64>, Vec<f64>), Strin
         let line = k + 2;
         let (vel, eps) = (r[iv], r[ie]);
         if !(vel.is_finite() && vel > 0.0) {
-            return Err(format!("row {line}: velocity_m_s must be > 0, got {vel}"));
+            return Err(TableError::row(
+                line,
+                "velocity_m_s",
+                format!("must be > 0, got {vel}"),
+            ));
         }
         if let Some(&prev) = v.last()
             && vel <= prev
         {
-            return Err(format!(
-                "row {line}: velocity_m_s must increase strictly ({vel} after {prev})"
-            ));
+            let why = format!("must increase strictly ({vel} after {prev})");
+            return Err(TableError::row(line, "velocity_m_s", why));
         }
         if !(eps > 0.0 && eps <= 1.0) {
-            return Err(format!(
-                "row {line}: restitution must lie in (0, 1], got {eps}"
-            ));
+            let why = format!("must lie in (0, 1], got {eps}");
+            return Err(TableError::row(line, "restitution", why));
         }
         v.push(vel);
         e.push(eps);
@@ -55,7 +99,10 @@ pub fn parse_restitution_table(text: &str) -> Result<(Vec<f64>, Vec<f64>), Strin
 /// Replaces every `restitution_table_csv = "FILE"` in the contact normal tables of a parsed
 /// scenario (`contact.normal`, `contact.pairs[k].normal`) by the arrays read from FILE
 /// (relative to `base_dir`). Returns whether anything was replaced; errors name the key.
-pub fn inline_tables(doc: &mut toml::Table, base_dir: &std::path::Path) -> Result<bool, String> {
+pub fn inline_tables(
+    doc: &mut toml::Table,
+    base_dir: &std::path::Path,
+) -> Result<bool, crate::InputError> {
     let Some(toml::Value::Table(contact)) = doc.get_mut("contact") else {
         return Ok(false);
     };
@@ -83,18 +130,18 @@ pub fn inline_tables(doc: &mut toml::Table, base_dir: &std::path::Path) -> Resul
             continue;
         };
         let key = format!("{key}.{TABLE_KEY}");
-        let file = v
-            .as_str()
-            .ok_or_else(|| format!("{key} must be a file name (string)"))?;
+        let file = v.as_str().ok_or_else(|| {
+            crate::InputError::message(format!("{key} must be a file name (string)"))
+        })?;
         let path = base_dir.join(file);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| format!("{key}: cannot read {}: {e}", path.display()))?;
-        let (vel, eps) = parse_restitution_table(&text)
-            .map_err(|e| format!("{key}: {}: {e}", path.display()))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| crate::InputError::read(&key, &path, e))?;
+        let (vel, eps) =
+            parse_restitution_table(&text).map_err(|e| crate::InputError::file(&key, &path, e))?;
         if t.contains_key("impact_velocities_m_s") || t.contains_key("restitutions") {
-            return Err(format!(
+            return Err(crate::InputError::message(format!(
                 "{key}: give either the file or impact_velocities_m_s/restitutions, not both"
-            ));
+            )));
         }
         let arr = |x: Vec<f64>| toml::Value::Array(x.into_iter().map(toml::Value::Float).collect());
         t.insert("impact_velocities_m_s".into(), arr(vel));
@@ -116,14 +163,21 @@ mod tests {
         .unwrap();
         assert_eq!(v, vec![0.1, 1.0]);
         assert_eq!(e, vec![0.95, 0.7]);
-        let err =
-            parse_restitution_table("velocity_m_s,restitution\n1.0,0.7\n0.5,0.8\n").unwrap_err();
+        let err = parse_restitution_table("velocity_m_s,restitution\n1.0,0.7\n0.5,0.8\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("row 3") && err.contains("increase"), "{err}");
-        let err = parse_restitution_table("velocity_m_s,restitution\n1.0,1.7\n").unwrap_err();
+        let err = parse_restitution_table("velocity_m_s,restitution\n1.0,1.7\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("(0, 1]"), "{err}");
-        let err = parse_restitution_table("speed,restitution\n1.0,0.7\n").unwrap_err();
+        let err = parse_restitution_table("speed,restitution\n1.0,0.7\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("no column 'velocity_m_s'"), "{err}");
-        let err = parse_restitution_table("velocity_m_s,restitution\n1.0,NaN\n").unwrap_err();
+        let err = parse_restitution_table("velocity_m_s,restitution\n1.0,NaN\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("restitution"), "{err}");
     }
 }

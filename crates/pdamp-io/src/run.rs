@@ -1,6 +1,7 @@
 //! Running a scenario to files: settling, the main run, `energy.csv`, VTK snapshots with a
 //! `.pvd` series, and `summary.json`.
 
+use crate::checkpoint::CheckpointError;
 use crate::csv::CsvWriter;
 use crate::scenario::Scenario;
 use crate::vtk::{
@@ -350,7 +351,7 @@ impl SnapshotSeries {
 
     /// Continues a run resumed after step `step` (the frames of the steps `0, every, 2·every,
     /// … ≤ step`, at `k·every·dt_s`, were written by the interrupted run and must exist).
-    pub fn resume_after(&mut self, step: u64, dt_s: f64, world: &World) -> Result<(), String> {
+    pub fn resume_after(&mut self, step: u64, dt_s: f64, world: &World) -> Result<(), RunError> {
         let n = (step / self.every_steps + 1) as usize;
         let mut entries = Vec::new();
         for k in 0..n {
@@ -358,27 +359,30 @@ impl SnapshotSeries {
             let t = (t * 1e12).round() / 1e12;
             entries.extend(self.files(world, k).into_iter().map(|f| (t, f)));
         }
-        self.series =
-            PvdSeries::resume(self.series.path(), entries).map_err(|e| format!("output: {e}"))?;
+        self.series = PvdSeries::resume(self.series.path(), entries).map_err(RunError::output)?;
         self.next_index = n;
         Ok(())
     }
 
     /// Writes the frame of step `step` at time `time_s` if `step` is a multiple of the
     /// interval (call it for step 0 too).
-    pub fn on_step(&mut self, step: u64, time_s: f64, world: &World) -> Result<(), String> {
+    pub fn on_step(&mut self, step: u64, time_s: f64, world: &World) -> Result<(), RunError> {
         if !step.is_multiple_of(self.every_steps) {
             return Ok(());
         }
         let dir = self.out.join(&self.subdir);
-        std::fs::create_dir_all(&dir).map_err(|e| format!("output: {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir).map_err(|e| {
+            RunError::output(crate::csv::CsvError::Io {
+                path: dir.clone(),
+                source: e,
+            })
+        })?;
         let index = self.next_index;
-        write_snapshot_with(world, &dir, index, self.encoding)
-            .map_err(|e| format!("output: {e}"))?;
+        write_snapshot_with(world, &dir, index, self.encoding).map_err(RunError::output)?;
         let files = self.files(world, index);
         self.series
             .add_frame(time_s, &files)
-            .map_err(|e| format!("output: {e}"))?;
+            .map_err(RunError::output)?;
         self.next_index += 1;
         Ok(())
     }
@@ -532,9 +536,75 @@ impl RunCheckpoint {
     }
 }
 
+/// Why a run (or its settling) stopped without finishing; [`RunError::Interrupted`] is a stop
+/// on request after the checkpoint was written.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scenario's world cannot be built.
+    #[error(transparent)]
+    Input(#[from] crate::InputError),
+    /// A checkpoint cannot be written or read back.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    /// The checkpoint does not fit the scenario's world.
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
+    /// A checkpoint of a running phase without the world's state.
+    #[error("checkpoint without state")]
+    NoState,
+    /// An output file cannot be written.
+    #[error("output: {0}")]
+    Output(#[source] crate::error::Source),
+    /// A ParaView file or series cannot be written or continued.
+    #[error(transparent)]
+    Vtk(#[from] crate::vtk::VtkError),
+    /// The summary of a finished run cannot be read back.
+    #[error("summary.json: {0}")]
+    Summary(#[source] serde_json::Error),
+    /// A result does not serialise.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// Stopped on request; the checkpoint is on disk (the text starts with
+    /// [`crate::checkpoint::INTERRUPTED`]).
+    #[error(transparent)]
+    Interrupted(#[from] crate::checkpoint::Interrupted),
+    /// A health check failed; `failure.json` names the particle.
+    #[error(
+        "{health} (during {phase}; outputs written so far are kept in {}, see failure.json)",
+        out_dir.display()
+    )]
+    Failed {
+        /// What the check found.
+        health: pdamp_dem::health::HealthError,
+        /// `settling` or `running`.
+        phase: &'static str,
+        /// The output directory.
+        out_dir: PathBuf,
+    },
+}
+
+impl RunError {
+    /// [`RunError::Output`].
+    pub fn output(e: impl Into<crate::error::Source>) -> Self {
+        Self::Output(e.into())
+    }
+
+    /// Whether the run was stopped on request with its checkpoint written.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, Self::Interrupted(_))
+    }
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<RunError> for String {
+    fn from(e: RunError) -> String {
+        e.to_string()
+    }
+}
+
 /// Decodes a `run` checkpoint file of any scenario and returns its simulated time, s (for
 /// inspection and fuzzing; never panics).
-pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, String> {
+pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, CheckpointError> {
     let c: RunCheckpoint = crate::checkpoint::decode(bytes, RUN_KIND, None)?;
     Ok(c.world.map_or(0.0, |w| w.time_s()))
 }
@@ -542,8 +612,12 @@ pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, String> {
 /// Steps between numerical health checks ([`World::check_health`]).
 pub const HEALTH_CHECK_STEPS: u64 = 500;
 
-/// Writes `failure.json` next to the outputs written so far and returns the error text.
-fn report_failure(out_dir: &Path, phase: &str, h: &pdamp_dem::health::HealthError) -> String {
+/// Writes `failure.json` next to the outputs written so far and returns the error.
+fn report_failure(
+    out_dir: &Path,
+    phase: &'static str,
+    h: &pdamp_dem::health::HealthError,
+) -> RunError {
     let json = serde_json::json!({
         "pdamp_version": env!("CARGO_PKG_VERSION"),
         "phase": phase,
@@ -559,10 +633,11 @@ fn report_failure(out_dir: &Path, phase: &str, h: &pdamp_dem::health::HealthErro
             .unwrap_or_default()
             .as_bytes(),
     );
-    format!(
-        "{h} (during {phase}; outputs written so far are kept in {}, see failure.json)",
-        out_dir.display()
-    )
+    RunError::Failed {
+        health: h.clone(),
+        phase,
+        out_dir: out_dir.to_path_buf(),
+    }
 }
 
 /// Kind tag of `run` checkpoints.
@@ -611,9 +686,9 @@ pub fn run_scenario(
     out_dir: &Path,
     options: RunOptions,
     mut progress: impl FnMut(&str, f64),
-) -> Result<RunSummary, String> {
+) -> Result<RunSummary, RunError> {
     use crate::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
-    let io = |e: std::io::Error| format!("output: {e}");
+    let io = RunError::output;
     let mut world = scenario.build_world(base_dir)?;
     let digest = scenario_content_digest(scenario, base_dir);
     let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
@@ -627,7 +702,7 @@ pub fn run_scenario(
         && c.phase == RunPhase::Finished
     {
         let text = std::fs::read_to_string(out_dir.join("summary.json")).map_err(io)?;
-        return serde_json::from_str(&text).map_err(|e| format!("summary.json: {e}"));
+        return serde_json::from_str(&text).map_err(RunError::Summary);
     }
     crate::provenance::Provenance::of(scenario)
         .write(scenario, out_dir)
@@ -637,11 +712,10 @@ pub fn run_scenario(
     let wall = |start: &std::time::Instant| wall_before + start.elapsed().as_secs_f64();
     let mut timer = CheckpointTimer::new(options.checkpoint_interval_s);
     let interrupted = |t: f64| {
-        ck::Interrupted {
+        RunError::Interrupted(ck::Interrupted {
             time_s: t,
             path: ck_path.clone(),
-        }
-        .to_string()
+        })
     };
     let main_gravity = Vec3::from(scenario.simulation.gravity_m_s2);
     let _stoppable = ck::StoppableSection::enter();
@@ -650,11 +724,11 @@ pub fn run_scenario(
     // Settling (fresh, or resumed in the middle of it).
     let mut state = match resumed {
         Some(mut c) if c.phase == RunPhase::Running => {
-            world.restore_state(c.world.take().ok_or("checkpoint without state")?)?;
+            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
             Some(c)
         }
         Some(mut c) => {
-            world.restore_state(c.world.take().ok_or("checkpoint without state")?)?;
+            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
             world.gravity_m_s2 = main_gravity;
             None
         }
@@ -686,7 +760,7 @@ pub fn run_scenario(
                 ControlFlow::Continue(())
             });
             if let Some(e) = err {
-                return Err(e);
+                return Err(e.into());
             }
             if let Some(h) = health.take() {
                 return Err(report_failure(out_dir, "settling", &h));
@@ -704,7 +778,7 @@ pub fn run_scenario(
     let vtk_every = scenario.output.vtk_interval_s;
     let vtk_encoding: VtkEncoding = scenario.output.vtk_format.into();
     let e_every = scenario.output.energy_interval_s;
-    let csvio = |e: crate::csv::CsvError| format!("output: {e}");
+    let csvio = RunError::output;
     let pvd_path = out_dir.join("particles.pvd");
     let (mut csv, mut series, mut snap, mut next_e, mut next_v, steps0) = match state.take() {
         Some(c) => {
@@ -717,7 +791,7 @@ pub fn run_scenario(
             .map_err(csvio)?;
             let series = if vtk_every > 0.0 {
                 std::fs::create_dir_all(&vtk_dir).map_err(io)?;
-                Some(PvdSeries::resume(&pvd_path, c.pvd).map_err(|e| e.to_string())?)
+                Some(PvdSeries::resume(&pvd_path, c.pvd)?)
             } else {
                 None
             };
@@ -734,7 +808,7 @@ pub fn run_scenario(
             world.initialize();
             // The bed the main run starts from (measured once; a resumed run reads it back).
             let stats = bed_statistics(&world, crate::prepare::excitation_direction(scenario));
-            let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+            let json = serde_json::to_string_pretty(&stats)?;
             crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes())
                 .map_err(io)?;
             let mut series = if vtk_every > 0.0 {
@@ -748,17 +822,15 @@ pub fn run_scenario(
             csv.write_row(&ledger_row(&world)).map_err(csvio)?;
             let mut snap = 0usize;
             if let Some(s) = series.as_mut() {
-                write_snapshot_with(&world, &vtk_dir, snap, vtk_encoding)
-                    .map_err(|e| e.to_string())?;
-                s.add_frame(world.time_s, &snapshot_files(&world, snap))
-                    .map_err(|e| e.to_string())?;
+                write_snapshot_with(&world, &vtk_dir, snap, vtk_encoding)?;
+                s.add_frame(world.time_s, &snapshot_files(&world, snap))?;
                 snap += 1;
             }
             (csv, series, snap, e_every, vtk_every, world.counters.steps)
         }
     };
     let t_end = scenario.simulation.duration_s;
-    let mut err: Option<String> = None;
+    let mut err: Option<RunError> = None;
     let mut stopped = false;
     // Half kicks deferred (`World::step_deferred`: same results, one pass over the particles
     // less per step); the state is completed wherever it is read.
@@ -773,7 +845,7 @@ pub fn run_scenario(
         if w.time_s >= next_e - 1e-12 {
             w.complete_step();
             if let Err(e) = csv.write_row(&ledger_row(w)) {
-                err = Some(format!("output: {e}"));
+                err = Some(RunError::output(e));
                 return ControlFlow::Break(());
             }
             next_e += e_every;
@@ -786,12 +858,12 @@ pub fn run_scenario(
             match write_snapshot_with(w, &vtk_dir, snap, vtk_encoding) {
                 Ok(_) => {
                     if let Err(e) = s.add_frame(w.time_s, &snapshot_files(w, snap)) {
-                        err = Some(format!("output: {e}"));
+                        err = Some(RunError::output(e));
                         return ControlFlow::Break(());
                     }
                 }
                 Err(e) => {
-                    err = Some(format!("output: {e}"));
+                    err = Some(RunError::output(e));
                     return ControlFlow::Break(());
                 }
             }
@@ -815,7 +887,7 @@ pub fn run_scenario(
                     steps_at_start: steps0,
                     wall_time_s: wall(&start),
                 };
-                ck::save(&ck_path, &header, &c)
+                ck::save(&ck_path, &header, &c).map_err(RunError::from)
             });
             if let Err(e) = r {
                 err = Some(e);
@@ -867,7 +939,7 @@ pub fn run_scenario(
             .ok()
             .and_then(|t| serde_json::from_str(&t).ok()),
     };
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string_pretty(&summary)?;
     crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
     let done = RunCheckpoint {
         phase: RunPhase::Finished,

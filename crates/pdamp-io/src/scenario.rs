@@ -3,6 +3,8 @@
 //!
 //! Loading validates everything up front; every error names the key that is wrong.
 
+use crate::InputError;
+use pdamp_dem::ParameterError;
 use pdamp_dem::contact::ContactModel;
 use pdamp_dem::generate::{
     Layering, Region, SizeDistribution, grid_packing, random_insertion_clear_of, tight_packing,
@@ -55,6 +57,19 @@ fn at(line_col: Option<(usize, usize)>) -> String {
 }
 
 impl ScenarioError {
+    /// An [`ScenarioError::Invalid`] for `message` about `key` (its path, e.g.
+    /// `particles[0].size.radius_m`) in the scenario file `path` whose text is `text`: the key is
+    /// looked up in the text for its line and column (the deepest part of the path that is in
+    /// the file).
+    pub fn at_key(path: &Path, text: Option<&str>, key: &str, message: String) -> Self {
+        let line_col = text.and_then(|t| locate_key(t, key));
+        ScenarioError::Invalid {
+            path: path.to_path_buf(),
+            line_col,
+            message,
+        }
+    }
+
     /// An [`ScenarioError::Invalid`] for `message` about the scenario file `path` whose text is
     /// `text`: the key path the message starts with is looked up in the text for its line and
     /// column (the deepest part of the path that is in the file).
@@ -69,13 +84,7 @@ impl ScenarioError {
     }
 }
 
-/// The key path a validation message starts with: `a.b[2].c` of `a.b[2].c must be > 0`.
-pub fn leading_key_path(message: &str) -> &str {
-    let end = message
-        .find(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '[' | ']' | '-')))
-        .unwrap_or(message.len());
-    message[..end].trim_end_matches('.')
-}
+pub use pdamp_dem::error::leading_key_path;
 
 /// 1-based line and column of key path `key` (`particles[0].size.radius_m`) in TOML `text`: of
 /// the deepest prefix of the path present in the file (so a missing key points at its table).
@@ -400,18 +409,18 @@ impl AxisSpec {
         }
     }
 
-    fn validate(&self, key: &str) -> Result<(), String> {
+    fn validate(&self, key: &str) -> Result<(), ParameterError> {
         // The count first: `values` allocates it.
         if let AxisSpec::Range { count, .. } = self
             && *count > MAX_AXIS_VALUES
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.count must be at most {MAX_AXIS_VALUES}, got {count}"
-            ));
+            )));
         }
         let v = self.values();
         if v.is_empty() {
-            return Err(format!("{key}: no values"));
+            return Err(ParameterError::from_message(format!("{key}: no values")));
         }
         if let AxisSpec::Range {
             from,
@@ -421,10 +430,14 @@ impl AxisSpec {
         } = self
             && !(*from > 0.0 && *to > 0.0)
         {
-            return Err(format!("{key}: a log range needs from > 0 and to > 0"));
+            return Err(ParameterError::from_message(format!(
+                "{key}: a log range needs from > 0 and to > 0"
+            )));
         }
         if v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-            return Err(format!("{key}: all values must be finite and > 0"));
+            return Err(ParameterError::from_message(format!(
+                "{key}: all values must be finite and > 0"
+            )));
         }
         Ok(())
     }
@@ -720,7 +733,7 @@ fn check_array_lengths(
     original: &toml::Table,
     canonical: &toml::Table,
     key: &str,
-) -> Result<(), String> {
+) -> Result<(), ParameterError> {
     for (k, v) in original {
         let Some(c) = canonical.get(k) else { continue };
         let path = if key.is_empty() {
@@ -733,16 +746,16 @@ fn check_array_lengths(
     Ok(())
 }
 
-fn check_value_lengths(v: &toml::Value, c: &toml::Value, path: &str) -> Result<(), String> {
+fn check_value_lengths(v: &toml::Value, c: &toml::Value, path: &str) -> Result<(), ParameterError> {
     match (v, c) {
         (toml::Value::Table(a), toml::Value::Table(b)) => check_array_lengths(a, b, path),
         (toml::Value::Array(a), toml::Value::Array(b)) => {
             if a.len() != b.len() && a.iter().all(|x| x.is_float() || x.is_integer()) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{path} has {} components, {} expected (e.g. [x, y, z])",
                     a.len(),
                     b.len()
-                ));
+                )));
             }
             for (k, (x, y)) in a.iter().zip(b).enumerate() {
                 check_value_lengths(x, y, &format!("{path}[{k}]"))?;
@@ -773,38 +786,43 @@ pub struct FillingSpec {
 
 impl ParticleGroupSpec {
     /// Number of particles of the group from `count` or `filling`.
-    pub fn resolved_count(&self) -> Result<usize, String> {
+    pub fn resolved_count(&self) -> Result<usize, ParameterError> {
         match (&self.count, &self.filling) {
             (Some(n), None) => Ok(*n),
             (None, Some(f)) => {
                 if f.max_count == 0 {
-                    return Err("filling.max_count must be > 0".into());
+                    return Err(ParameterError::from_message(
+                        "filling.max_count must be > 0",
+                    ));
                 }
                 let ratio = match (f.ratio, f.clearance_m, f.container_length_m) {
                     (Some(r), None, None) => {
                         if !(r > 0.0 && r <= 1.0) {
-                            return Err(format!("filling.ratio must be in (0, 1], got {r}"));
+                            return Err(ParameterError::from_message(format!(
+                                "filling.ratio must be in (0, 1], got {r}"
+                            )));
                         }
                         r
                     }
                     (None, Some(h), Some(l)) => {
                         if !(l > 0.0 && h >= 0.0 && h < l) {
-                            return Err(format!(
+                            return Err(ParameterError::from_message(format!(
                                 "filling: need 0 <= clearance_m < container_length_m, got {h} and {l}"
-                            ));
+                            )));
                         }
                         1.0 - h / l
                     }
                     _ => {
-                        return Err(
-                            "filling: give either ratio, or clearance_m together with container_length_m"
-                                .into(),
-                        );
+                        return Err(ParameterError::from_message(
+                            "filling: give either ratio, or clearance_m together with container_length_m",
+                        ));
                     }
                 };
                 Ok((ratio * f.max_count as f64).round() as usize)
             }
-            _ => Err("count: give exactly one of `count` and `filling` in the group".into()),
+            _ => Err(ParameterError::from_message(
+                "count: give exactly one of `count` and `filling` in the group",
+            )),
         }
     }
 }
@@ -899,14 +917,14 @@ pub struct OpenLidSpec {
 
 impl OpenLidSpec {
     /// Checks ranges; the message names the key under `key`.
-    fn validate(&self, key: &str) -> Result<(), String> {
+    fn validate(&self, key: &str) -> Result<(), ParameterError> {
         let check = |name: &str, v: f64, hi: f64, unit: &str| {
             if v.is_finite() && v > 0.0 && v <= hi {
                 Ok(())
             } else {
-                Err(format!(
+                Err(ParameterError::from_message(format!(
                     "{key}.open_lid.{name} must be in (0, {hi}] {unit}, got {v}"
-                ))
+                )))
             }
         };
         check("headroom_m", self.headroom_m, 100.0, "m")?;
@@ -922,9 +940,9 @@ impl OpenLidSpec {
                 check("tap_intensity", i, 1e3, "(Γ = A/g)")
             }
             (None, None) => Ok(()),
-            _ => Err(format!(
+            _ => Err(ParameterError::from_message(format!(
                 "{key}.open_lid.tap_frequency_hz: give tap_frequency_hz and tap_intensity together (or neither)"
-            )),
+            ))),
         }
     }
 
@@ -996,7 +1014,7 @@ pub enum BedFormat {
 
 impl BedFormat {
     /// The format `format` says, or the one of the path's extension.
-    pub fn of(path: &Path, format: Option<BedFormat>) -> Result<BedFormat, String> {
+    pub fn of(path: &Path, format: Option<BedFormat>) -> Result<BedFormat, ParameterError> {
         if let Some(f) = format {
             return Ok(f);
         }
@@ -1009,11 +1027,11 @@ impl BedFormat {
             Some("pdbed") => Ok(BedFormat::Native),
             Some("data" | "lmp" | "lammps") => Ok(BedFormat::Lammps),
             Some("csv") => Ok(BedFormat::Csv),
-            _ => Err(format!(
+            _ => Err(ParameterError::from_message(format!(
                 "cannot tell the bed format of '{}' from its extension; name it *.pdbed, \
                  *.data or *.csv, or set placement.format = \"native\" | \"lammps\" | \"csv\"",
                 path.display()
-            )),
+            ))),
         }
     }
 }
@@ -1047,18 +1065,15 @@ impl Scenario {
             source,
         })?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
-        let s = Self::from_toml_in(&text, &base).map_err(|message| {
-            if message.starts_with("contact.") {
-                ScenarioError::invalid(path, Some(&text), message)
-            } else {
-                ScenarioError::Parse {
-                    path: path.to_path_buf(),
-                    message,
-                }
-            }
+        let s = Self::from_toml_in(&text, &base).map_err(|e| match e {
+            InputError::Toml(e) => ScenarioError::Parse {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            },
+            e => ScenarioError::at_key(path, Some(&text), e.key(), e.to_string()),
         })?;
         s.validate()
-            .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
+            .map_err(|e| ScenarioError::at_key(path, Some(&text), e.key(), e.to_string()))?;
         // Vectors are read into fixed-size arrays, which ignore extra components: compare
         // every array of the file with the scenario as read.
         if let (Ok(original), Ok(canonical)) = (
@@ -1066,7 +1081,7 @@ impl Scenario {
             s.to_toml().parse::<toml::Table>(),
         ) {
             check_array_lengths(&original, &canonical, "")
-                .map_err(|message| ScenarioError::invalid(path, Some(&text), message))?;
+                .map_err(|e| ScenarioError::at_key(path, Some(&text), e.key(), e.to_string()))?;
         }
         Ok(s)
     }
@@ -1088,30 +1103,28 @@ impl Scenario {
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         let world = s
             .build_world_with(&base, Preparation::Check, &mut |_, _| {})
-            .map_err(|m| {
+            .map_err(|e| {
                 let text = std::fs::read_to_string(path).ok();
-                ScenarioError::invalid(path, text.as_deref(), m)
+                ScenarioError::at_key(path, text.as_deref(), e.key(), e.to_string())
             })?;
         Ok((s, world))
     }
 
     /// Parses TOML text (no validation).
-    pub fn from_toml(text: &str) -> Result<Self, String> {
-        toml::from_str(text).map_err(|e| e.to_string())
+    pub fn from_toml(text: &str) -> Result<Self, toml::de::Error> {
+        toml::from_str(text)
     }
 
     /// Parses TOML text whose file lies in `base_dir`: restitution tables named by
     /// `restitution_table_csv` are read from CSV files relative to it
     /// ([`crate::restitution::inline_tables`]). No validation.
-    pub fn from_toml_in(text: &str, base_dir: &Path) -> Result<Self, String> {
+    pub fn from_toml_in(text: &str, base_dir: &Path) -> Result<Self, InputError> {
         if !text.contains(crate::restitution::TABLE_KEY) {
-            return Self::from_toml(text);
+            return Ok(Self::from_toml(text)?);
         }
-        let mut doc: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+        let mut doc: toml::Table = toml::from_str(text)?;
         crate::restitution::inline_tables(&mut doc, base_dir)?;
-        toml::Value::Table(doc)
-            .try_into()
-            .map_err(|e: toml::de::Error| e.to_string())
+        Ok(toml::Value::Table(doc).try_into()?)
     }
 
     /// Serialises to TOML.
@@ -1135,25 +1148,25 @@ impl Scenario {
     }
 
     /// Checks `damper.motion_output`: sizes that fit a cycle and the bed.
-    fn validate_motion_output(&self, d: &DamperSpec) -> Result<(), String> {
+    fn validate_motion_output(&self, d: &DamperSpec) -> Result<(), ParameterError> {
         let m = &d.motion_output;
         if m.phases_per_cycle > MAX_PHASES_PER_CYCLE {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "damper.motion_output.phases_per_cycle must lie in 0..={MAX_PHASES_PER_CYCLE} (0 = no velocity fields), got {}; 4 gives the phases 0, 90, 180 and 270°",
                 m.phases_per_cycle
-            ));
+            )));
         }
         if !(1..=MAX_FIELD_CELLS).contains(&m.field_cells) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "damper.motion_output.field_cells must lie in 1..={MAX_FIELD_CELLS}, got {}; e.g. 12",
                 m.field_cells
-            ));
+            )));
         }
         if m.vtk_frames_per_cycle > MAX_VTK_FRAMES_PER_CYCLE {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "damper.motion_output.vtk_frames_per_cycle must be at most {MAX_VTK_FRAMES_PER_CYCLE}, got {}; e.g. 8",
                 m.vtk_frames_per_cycle
-            ));
+            )));
         }
         if let Some(f) = d.frequency_hz {
             let steps_per_cycle = 1.0 / (f * self.simulation.time_step_s);
@@ -1162,10 +1175,10 @@ impl Scenario {
                 ("vtk_frames_per_cycle", m.vtk_frames_per_cycle),
             ] {
                 if f64::from(n) > steps_per_cycle {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.motion_output.{k} ({n}) exceeds the {steps_per_cycle:.0} time steps of a cycle at {f} Hz; use at most {}",
                         steps_per_cycle.floor().max(1.0)
-                    ));
+                    )));
                 }
             }
         }
@@ -1182,52 +1195,54 @@ impl Scenario {
         if let Some(n) = n
             && let Some(&i) = m.trajectory_particles.iter().find(|&&i| i >= n)
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "damper.motion_output.trajectory_particles: particle {i} does not exist (the bed has {n} particles, indices 0..={})",
                 n.saturating_sub(1)
-            ));
+            )));
         }
         if m.trajectory_particles.len() > MAX_TRAJECTORIES {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "damper.motion_output.trajectory_particles lists {} particles, at most {MAX_TRAJECTORIES}",
                 m.trajectory_particles.len()
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Checks the placement of group `g` (keys as `particles[g].placement.…`).
-    fn validate_placement(&self, g: usize, pl: &PlacementSpec) -> Result<(), String> {
+    fn validate_placement(&self, g: usize, pl: &PlacementSpec) -> Result<(), ParameterError> {
         let key = format!("particles[{g}].placement");
         let is_file = pl.method == PlacementMethod::File;
         match (&pl.region, is_file) {
-            (Some(r), false) => r.validate().map_err(|e| format!("{key}.region.{e}"))?,
+            (Some(r), false) => r
+                .validate()
+                .map_err(|e| e.under(&format!("{key}.region.")))?,
             (None, false) => {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{key}.region: missing; give the volume to fill, e.g. region = {{ type = \"box\", min_m = [..], max_m = [..] }}"
-                ));
+                )));
             }
             (Some(_), true) => {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{key}.region: a bed from a file has its own positions; remove region"
-                ));
+                )));
             }
             (None, true) => {}
         }
         if is_file && pl.path.is_none() {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.path: missing; method = \"file\" needs the bed file (from `pdamp settle`, LAMMPS write_data or CSV)"
-            ));
+            )));
         }
         if !is_file && (pl.path.is_some() || pl.format.is_some() || !pl.type_materials.is_empty()) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.path: path, format and type_materials belong to method = \"file\""
-            ));
+            )));
         }
         if is_file && self.particles.len() > 1 {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.method: a bed file holds the whole bed; it must be the only [[particles]] group"
-            ));
+            )));
         }
         for m in &pl.type_materials {
             self.material_index(m, &format!("{key}.type_materials"))?;
@@ -1240,55 +1255,57 @@ impl Scenario {
                 || pl.open_lid.is_some()
                 || pl.inlet.is_some())
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.max_rounds: max_rounds, max_round_duration_s, round_kinetic_energy_per_particle_j, open_lid and inlet belong to method = \"drop_down\""
-            ));
+            )));
         }
         if let Some(i) = &pl.inlet {
             i.region
                 .validate()
-                .map_err(|e| format!("{key}.inlet.region.{e}"))?;
+                .map_err(|e| e.under(&format!("{key}.inlet.region.")))?;
             if !(i.rate_per_s.is_finite() && i.rate_per_s > 0.0 && i.rate_per_s <= 1e9) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{key}.inlet.rate_per_s must be in (0, 1e9] particles per second, got {}",
                     i.rate_per_s
-                ));
+                )));
             }
             if !i
                 .velocity_m_s
                 .iter()
                 .all(|v| v.is_finite() && v.abs() <= 1e3)
             {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{key}.inlet.velocity_m_s must be finite and at most 1000 m/s, got {:?}",
                     i.velocity_m_s
-                ));
+                )));
             }
         }
         if let Some(l) = &pl.open_lid {
             l.validate(&key)?;
         }
         if pl.max_rounds == Some(0) {
-            return Err(format!("{key}.max_rounds must be >= 1"));
+            return Err(ParameterError::from_message(format!(
+                "{key}.max_rounds must be >= 1"
+            )));
         }
         if let Some(t) = pl.max_round_duration_s
             && !(t.is_finite() && t > 0.0 && t <= 1e3)
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.max_round_duration_s must be in (0, 1000] s, got {t}"
-            ));
+            )));
         }
         if let Some(e) = pl.round_kinetic_energy_per_particle_j
             && !(e.is_finite() && e >= 0.0)
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.round_kinetic_energy_per_particle_j must be finite and >= 0 (J), got {e}"
-            ));
+            )));
         }
         if is_drop && self.fill_gravity().norm() == 0.0 {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "{key}.method: drop_down lets the particles fall, but gravity is zero; set simulation.gravity_m_s2 or settle.gravity_m_s2, or use method = \"random\""
-            ));
+            )));
         }
         Ok(())
     }
@@ -1320,16 +1337,19 @@ impl Scenario {
             .collect()
     }
 
-    fn material_index(&self, name: &str, key: &str) -> Result<u16, String> {
+    fn material_index(&self, name: &str, key: &str) -> Result<u16, ParameterError> {
         self.materials
             .iter()
             .position(|m| m.name == name)
             .map(|i| i as u16)
             .ok_or_else(|| {
                 let known: Vec<&str> = self.materials.iter().map(|m| m.name.as_str()).collect();
-                format!(
-                    "{key}: unknown material '{name}' (defined: {})",
-                    known.join(", ")
+                ParameterError::invalid(
+                    key,
+                    format!(
+                        "{key}: unknown material '{name}' (defined: {})",
+                        known.join(", ")
+                    ),
                 )
             })
     }
@@ -1337,92 +1357,92 @@ impl Scenario {
     /// Checks ranges and references. Every message starts with the path of the offending key
     /// (`particles[0].size.radius_m …`, located by [`ScenarioError::invalid`]) and says how
     /// to fix it.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParameterError> {
         let s = &self.simulation;
         let finite_pos = |v: f64| v.is_finite() && v > 0.0;
         if !(s.duration_s.is_finite() && s.duration_s >= 0.0) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.duration_s must be a finite time >= 0 in seconds, got {}",
                 s.duration_s
-            ));
+            )));
         }
         if !finite_pos(s.time_step_s) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.time_step_s must be > 0 (seconds), got {}; a safe value is about 1/20 \
                  of the contact time (`pdamp check` prints it)",
                 s.time_step_s
-            ));
+            )));
         }
         if s.duration_s > 0.0 && s.time_step_s > s.duration_s {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.time_step_s ({}) exceeds simulation.duration_s ({}); check the units \
                  (both in seconds)",
                 s.time_step_s, s.duration_s
-            ));
+            )));
         }
         if let Integrator::Gear(g) = &s.integrator {
             g.validate(s.time_step_s)
-                .map_err(|e| format!("simulation.integrator.{e}"))?;
+                .map_err(|e| e.under("simulation.integrator."))?;
         }
         if s.gravity_m_s2.iter().any(|g| !g.is_finite()) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.gravity_m_s2 must be finite, got {:?}; e.g. [0.0, 0.0, -9.81]",
                 s.gravity_m_s2
-            ));
+            )));
         }
         if let Some(skin) = s.skin_m
             && !finite_pos(skin)
         {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.skin_m must be > 0 (metres), got {skin}; leave it out for the default \
                  0.2 × smallest radius"
-            ));
+            )));
         }
         if !(s.max_time_step_ratio > 0.0 && s.max_time_step_ratio <= 1.0) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.max_time_step_ratio must lie in (0, 1], got {}; 0.1 is the default",
                 s.max_time_step_ratio
-            ));
+            )));
         }
         if !finite_pos(s.check_impact_velocity_m_s) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "simulation.check_impact_velocity_m_s must be > 0 (m/s), got {}",
                 s.check_impact_velocity_m_s
-            ));
+            )));
         }
         if !finite_pos(self.output.energy_interval_s) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "output.energy_interval_s must be > 0 (seconds), got {}",
                 self.output.energy_interval_s
-            ));
+            )));
         }
         if !(self.output.vtk_interval_s.is_finite() && self.output.vtk_interval_s >= 0.0) {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "output.vtk_interval_s must be >= 0 (seconds; 0 switches VTK off), got {}",
                 self.output.vtk_interval_s
-            ));
+            )));
         }
         if self.materials.is_empty() {
-            return Err(
+            return Err(ParameterError::from_message(
                 "materials: at least one material is needed; add a [[materials]] table with name, \
-                 density_kg_m3, youngs_modulus_pa and poisson_ratio"
-                    .into(),
-            );
+                 density_kg_m3, youngs_modulus_pa and poisson_ratio",
+            ));
         }
         for (k, m) in self.materials.iter().enumerate() {
-            m.validate().map_err(|e| format!("materials[{k}].{e}"))?;
+            m.validate()
+                .map_err(|e| e.under(&format!("materials[{k}].")))?;
             if self.materials[..k].iter().any(|o| o.name == m.name) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "materials[{k}].name: duplicate material name '{}'; give every material its \
                      own name",
                     m.name
-                ));
+                )));
             }
         }
         self.contact
             .default
             .validate()
-            .map_err(|e| format!("contact.{e}"))?;
+            .map_err(|e| e.under("contact."))?;
         for (k, p) in self.contact.pairs.iter().enumerate() {
             let key = format!("contact.pairs[{k}].materials");
             let a = self.material_index(&p.materials[0], &key)?;
@@ -1434,31 +1454,33 @@ impl Scenario {
                 );
                 (a, b) == (c, d) || (a, b) == (d, c)
             }) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "{key}: the pair {:?} has a contact model already; keep one [[contact.pairs]] \
                      entry per material pair",
                     p.materials
-                ));
+                )));
             }
             p.model
                 .validate()
-                .map_err(|e| format!("contact.pairs[{k}].{e}"))?;
+                .map_err(|e| e.under(&format!("contact.pairs[{k}].")))?;
         }
         for (b, body) in self.bodies.iter().enumerate() {
             if self.bodies[..b].iter().any(|o| o.name == body.name) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "bodies[{b}].name: duplicate body name '{}'; give every body its own name",
                     body.name
-                ));
+                )));
             }
             if body.position_m.iter().any(|x| !x.is_finite()) {
-                return Err(format!("bodies[{b}].position_m must be finite"));
+                return Err(ParameterError::from_message(format!(
+                    "bodies[{b}].position_m must be finite"
+                )));
             }
             if body.walls.is_empty() {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "bodies[{b}].walls: body '{}' has no walls; add a [[bodies.walls]] table",
                     body.name
-                ));
+                )));
             }
             for (w, wall) in body.walls.iter().enumerate() {
                 self.material_index(&wall.material, &format!("bodies[{b}].walls[{w}].material"))?;
@@ -1467,68 +1489,68 @@ impl Scenario {
                 if !Vec3::from(h.direction).norm().is_finite()
                     || Vec3::from(h.direction).norm() == 0.0
                 {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "bodies[{b}].motion.direction must be a finite non-zero vector, got {:?}; \
                          e.g. [1.0, 0.0, 0.0] for horizontal shaking",
                         h.direction
-                    ));
+                    )));
                 }
                 if !finite_pos(h.frequency_hz) {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "bodies[{b}].motion.frequency_hz must be > 0 (Hz), got {}",
                         h.frequency_hz
-                    ));
+                    )));
                 }
                 if !(h.amplitude_m.is_finite() && h.amplitude_m >= 0.0 && h.amplitude_m <= 1.0) {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "bodies[{b}].motion.amplitude_m must lie in [0, 1] m, got {}; check the unit",
                         h.amplitude_m
-                    ));
+                    )));
                 }
                 if h.frequency_hz > 1e5 {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "bodies[{b}].motion.frequency_hz must be at most 1e5 Hz, got {}",
                         h.frequency_hz
-                    ));
+                    )));
                 }
                 if !h.phase_rad.is_finite() {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "bodies[{b}].motion.phase_rad must be finite (radians), got {}",
                         h.phase_rad
-                    ));
+                    )));
                 }
             }
         }
         if let Some(d) = &self.damper {
             if !self.bodies.iter().any(|b| b.name == d.container_body) {
                 let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.container_body: no body named '{}'; use one of: {}",
                     d.container_body,
                     known.join(", ")
-                ));
+                )));
             }
             if !(1..=MAX_PACKINGS).contains(&d.packings) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.packings must be in 1..={MAX_PACKINGS} (independently prepared beds), got {}",
                     d.packings
-                ));
+                )));
             }
             if !(d.container_mass_kg.is_finite()
                 && d.container_mass_kg >= 0.0
                 && d.container_mass_kg <= 1e6)
             {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.container_mass_kg must lie in [0, 1e6] kg, got {}; check the unit",
                     d.container_mass_kg
-                ));
+                )));
             }
             if Vec3::from(d.direction).norm() == 0.0 || !Vec3::from(d.direction).norm().is_finite()
             {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.direction must be a finite non-zero vector, got {:?}; e.g. [1.0, 0.0, 0.0]",
                     d.direction
-                ));
+                )));
             }
             let given = [
                 d.amplitude_m.is_some(),
@@ -1539,17 +1561,15 @@ impl Scenario {
             .filter(|x| **x)
             .count();
             if given > 1 {
-                return Err(
+                return Err(ParameterError::from_message(
                     "damper: give only one of amplitude_m, acceleration_m_s2, intensity (they \
-                     describe the same amplitude); delete the others"
-                        .into(),
-                );
+                     describe the same amplitude); delete the others",
+                ));
             }
             if self.fields.is_none() && given == 0 {
-                return Err(
-                    "damper: give one of amplitude_m, acceleration_m_s2 or intensity (or a [fields] grid)"
-                        .into(),
-                );
+                return Err(ParameterError::from_message(
+                    "damper: give one of amplitude_m, acceleration_m_s2 or intensity (or a [fields] grid)",
+                ));
             }
             for (k, v) in [
                 ("amplitude_m", d.amplitude_m),
@@ -1560,11 +1580,15 @@ impl Scenario {
                 if let Some(v) = v
                     && !finite_pos(v)
                 {
-                    return Err(format!("damper.{k} must be > 0, got {v}"));
+                    return Err(ParameterError::from_message(format!(
+                        "damper.{k} must be > 0, got {v}"
+                    )));
                 }
             }
             if self.fields.is_none() && d.frequency_hz.is_none() {
-                return Err("damper.frequency_hz is needed (or a [fields] grid)".into());
+                return Err(ParameterError::from_message(
+                    "damper.frequency_hz is needed (or a [fields] grid)",
+                ));
             }
             // Physical ranges (a finite but absurd number gives finite nonsense downstream).
             for (k, v, max, unit) in [
@@ -1576,77 +1600,76 @@ impl Scenario {
                 if let Some(v) = v
                     && !(finite_pos(v) && v <= max)
                 {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.{k} must lie in (0, {max:e}] {unit}, got {v}; check the unit"
-                    ));
+                    )));
                 }
             }
             if d.cycles > MAX_DAMPER_CYCLES {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.cycles must be at most {MAX_DAMPER_CYCLES}, got {}; use [damper.convergence] to stop when the result has settled",
                     d.cycles
-                ));
+                )));
             }
             self.validate_motion_output(d)?;
             if d.cycles <= d.transient_cycles {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "damper.cycles ({}) must exceed damper.transient_cycles ({}); e.g. cycles = {}",
                     d.cycles,
                     d.transient_cycles,
                     d.transient_cycles + 15
-                ));
+                )));
             }
             if let Some(c) = &d.convergence {
                 if !(c.relative_tolerance.is_finite()
                     && c.relative_tolerance > 0.0
                     && c.relative_tolerance < 1.0)
                 {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.convergence.relative_tolerance must be in (0, 1), got {}; e.g. 0.02",
                         c.relative_tolerance
-                    ));
+                    )));
                 }
                 if c.window_cycles == 0 {
-                    return Err(
-                        "damper.convergence.window_cycles must be >= 1, got 0; e.g. 2".into(),
-                    );
+                    return Err(ParameterError::from_message(
+                        "damper.convergence.window_cycles must be >= 1, got 0; e.g. 2",
+                    ));
                 }
                 if c.min_evaluated_cycles <= c.window_cycles {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.convergence.min_evaluated_cycles ({}) must exceed \
                          damper.convergence.window_cycles ({}): the first estimate compared needs \
                          window_cycles earlier ones; e.g. min_evaluated_cycles = {}",
                         c.min_evaluated_cycles,
                         c.window_cycles,
                         c.window_cycles + 2
-                    ));
+                    )));
                 }
                 if d.transient_cycles + c.min_evaluated_cycles > d.cycles {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.convergence.min_evaluated_cycles ({}) plus damper.transient_cycles \
                          ({}) exceeds damper.cycles ({}), the maximum; raise cycles to at least {}",
                         c.min_evaluated_cycles,
                         d.transient_cycles,
                         d.cycles,
                         d.transient_cycles + c.min_evaluated_cycles
-                    ));
+                    )));
                 }
                 if !(c.absolute_floor.is_finite() && c.absolute_floor >= 0.0) {
-                    return Err(format!(
+                    return Err(ParameterError::from_message(format!(
                         "damper.convergence.absolute_floor must be >= 0 (in units of the bed mass), \
                          got {}; e.g. 0.1",
                         c.absolute_floor
-                    ));
+                    )));
                 }
             }
         }
         if let Some(f) = &self.fields {
             if self.damper.is_none() {
-                return Err(
+                return Err(ParameterError::from_message(
                     "fields: a [damper] section is needed; add one with container_body, \
-                     container_mass_kg and direction"
-                        .into(),
-                );
+                     container_mass_kg and direction",
+                ));
             }
             f.frequencies_hz.validate("fields.frequencies_hz")?;
             match f.amplitude_axis() {
@@ -1656,70 +1679,71 @@ impl Scenario {
                 }
                 Some((AmplitudeAxis::Intensity, a)) => a.validate("fields.intensities")?,
                 None => {
-                    return Err(
-                        "fields: give exactly one of amplitudes_m, accelerations_m_s2, intensities"
-                            .into(),
-                    );
+                    return Err(ParameterError::from_message(
+                        "fields: give exactly one of amplitudes_m, accelerations_m_s2, intensities",
+                    ));
                 }
             }
         }
         if let Some(st) = &self.settle {
             if !(st.max_duration_s.is_finite() && st.max_duration_s >= 0.0) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "settle.max_duration_s must be >= 0 (seconds), got {}",
                     st.max_duration_s
-                ));
+                )));
             }
             if !(st.kinetic_energy_per_particle_j.is_finite()
                 && st.kinetic_energy_per_particle_j >= 0.0)
             {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "settle.kinetic_energy_per_particle_j must be >= 0 (J), got {}",
                     st.kinetic_energy_per_particle_j
-                ));
+                )));
             }
             if let Some(t) = st.turn_max_duration_s
                 && !(t.is_finite() && t >= 0.0)
             {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "settle.turn_max_duration_s must be >= 0 (seconds), got {t}"
-                ));
+                )));
             }
             if let Some(g) = st.gravity_m_s2
                 && g.iter().any(|x| !x.is_finite())
             {
-                return Err(format!("settle.gravity_m_s2 must be finite, got {g:?}"));
+                return Err(ParameterError::from_message(format!(
+                    "settle.gravity_m_s2 must be finite, got {g:?}"
+                )));
             }
         }
         if self.particles.is_empty() && (self.damper.is_some() || self.settle.is_some()) {
-            return Err(
-                "particles: no [[particles]] group; a damper or settling needs particles".into(),
-            );
+            return Err(ParameterError::from_message(
+                "particles: no [[particles]] group; a damper or settling needs particles",
+            ));
         }
         for (g, grp) in self.particles.iter().enumerate() {
             self.material_index(&grp.material, &format!("particles[{g}].material"))?;
             let n = grp
                 .resolved_count()
-                .map_err(|e| format!("particles[{g}].{e}"))?;
+                .map_err(|e| e.under(&format!("particles[{g}].")))?;
             if n == 0 {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "particles[{g}].count: the group has no particles; give count >= 1 or remove it"
-                ));
+                )));
             }
             grp.size
                 .validate()
-                .map_err(|e| format!("particles[{g}].size.{e}"))?;
+                .map_err(|e| e.under(&format!("particles[{g}].size.")))?;
             self.validate_placement(g, &grp.placement)?;
             if !(grp.placement.gap_m.is_finite() && grp.placement.gap_m >= 0.0) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "particles[{g}].placement.gap_m must be >= 0 (metres), got {}",
                     grp.placement.gap_m
-                ));
+                )));
             }
             if grp.initial_velocity_m_s.iter().any(|v| !v.is_finite()) {
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "particles[{g}].initial_velocity_m_s must be finite"
-                ));
+                )));
             }
         }
         Ok(())
@@ -1729,7 +1753,7 @@ impl Scenario {
     /// and checked for overlaps, and the time step checked against the contact time. A
     /// `drop_down` group is dropped here (its falls are simulated: see
     /// [`Scenario::build_world_with`] for progress and a quick check without it).
-    pub fn build_world(&self, base_dir: &Path) -> Result<World, String> {
+    pub fn build_world(&self, base_dir: &Path) -> Result<World, InputError> {
         self.build_world_with(base_dir, Preparation::Full, &mut |_, _| {})
     }
 
@@ -1741,7 +1765,7 @@ impl Scenario {
         base_dir: &Path,
         mode: Preparation,
         progress: &mut dyn FnMut(&str, f64),
-    ) -> Result<World, String> {
+    ) -> Result<World, InputError> {
         self.build_world_reporting(base_dir, mode, progress)
             .map(|(w, _)| w)
     }
@@ -1753,7 +1777,7 @@ impl Scenario {
         base_dir: &Path,
         mode: Preparation,
         progress: &mut dyn FnMut(&str, f64),
-    ) -> Result<(World, Vec<pdamp_dem::drop_down::DropDownReport>), String> {
+    ) -> Result<(World, Vec<pdamp_dem::drop_down::DropDownReport>), InputError> {
         let mut reports = Vec::new();
         let mut model = self.contact.default.clone();
         model.prepare();
@@ -1788,10 +1812,10 @@ impl Scenario {
                             .iter()
                             .any(|h| !(*h > 0.0 && h.is_finite()))
                         {
-                            return Err(format!(
+                            return Err(InputError::message(format!(
                                 "bodies[{bi}].walls[{wi}].geometry.half_extents_m must be > 0, got {:?}",
                                 b.half_extents_m
-                            ));
+                            )));
                         }
                         let mut m = pdamp_dem::walls::TriMesh::box_inside(
                             Vec3::from(b.center_m),
@@ -1802,11 +1826,17 @@ impl Scenario {
                     }
                     GeometrySpec::Stl(s) => {
                         let path = base_dir.join(&s.path);
-                        let mut mesh = crate::stl::read_stl(&path)
-                            .map_err(|e| format!("bodies[{bi}].walls[{wi}].geometry.path: {e}"))?;
+                        let mut mesh = crate::stl::read_stl(&path).map_err(|e| {
+                            InputError::at(format!("bodies[{bi}].walls[{wi}].geometry.path"), e)
+                        })?;
                         mesh = mesh
                             .transformed(s.scale, Vec3::from(s.translation_m))
-                            .map_err(|e| format!("bodies[{bi}].walls[{wi}].geometry.scale: {e}"))?;
+                            .map_err(|e| {
+                                InputError::at(
+                                    format!("bodies[{bi}].walls[{wi}].geometry.scale"),
+                                    e,
+                                )
+                            })?;
                         if s.flip_normals {
                             mesh.flip_normals();
                         }
@@ -1836,10 +1866,13 @@ impl Scenario {
             let mat = self.material_index(&grp.material, "particles")?;
             let count = grp
                 .resolved_count()
-                .map_err(|e| format!("particles[{g}].{e}"))?;
+                .map_err(|e| e.under(&format!("particles[{g}].")))?;
             let pl = &grp.placement;
             if pl.method == PlacementMethod::File {
-                let path = base_dir.join(pl.path.as_ref().ok_or("placement.path missing")?);
+                let path = base_dir.join(pl.path.as_ref().ok_or(ParameterError::invalid(
+                    "placement.path",
+                    "placement.path missing",
+                ))?);
                 let (bed, state) = self.read_bed_for_group(g, &path, pl, &grp.material)?;
                 self.check_bed_against_group(g, &path, &bed, count, grp)?;
                 for i in 0..bed.len() {
@@ -1863,12 +1896,17 @@ impl Scenario {
             let radii = grp
                 .size
                 .sample_n(count, self.simulation.seed.wrapping_add(g as u64));
-            let region = pl.region.as_ref().ok_or("placement.region missing")?;
+            let region = pl.region.as_ref().ok_or(ParameterError::invalid(
+                "placement.region",
+                "placement.region missing",
+            ))?;
             let seed = self.simulation.seed.wrapping_add(1000 + g as u64);
-            let fix = |e: String| {
-                format!(
-                    "particles[{g}].placement.region: {e}; enlarge the region, or lower the \
-                     particle count, the radius or placement.gap_m"
+            let fix = |e: pdamp_dem::generate::PackingError| {
+                InputError::at_with_hint(
+                    format!("particles[{g}].placement.region"),
+                    e,
+                    "; enlarge the region, or lower the particle count, the radius or \
+                     placement.gap_m",
                 )
             };
             if pl.method == PlacementMethod::DropDown {
@@ -1979,7 +2017,7 @@ impl Scenario {
             if matches!(world.integrator, Integrator::VelocityVerlet)
                 && ratio > self.simulation.max_time_step_ratio
             {
-                return Err(format!(
+                return Err(InputError::message(format!(
                     "simulation.time_step_s = {:.3e} s is {:.2} of the shortest contact time {:.3e} s (impact at {} m/s); \
                      use at most {:.3e} s (max_time_step_ratio = {})",
                     self.simulation.time_step_s,
@@ -1988,7 +2026,7 @@ impl Scenario {
                     self.simulation.check_impact_velocity_m_s,
                     self.simulation.max_time_step_ratio * tc,
                     self.simulation.max_time_step_ratio
-                ));
+                )));
             }
         }
         Ok((world, reports))
@@ -2016,21 +2054,18 @@ impl Scenario {
         path: &Path,
         pl: &PlacementSpec,
         material: &str,
-    ) -> Result<(pdamp_dem::Bed, Option<pdamp_dem::WorldState>), String> {
+    ) -> Result<(pdamp_dem::Bed, Option<pdamp_dem::WorldState>), InputError> {
         let key = format!("particles[{g}].placement.path");
-        let format = BedFormat::of(path, pl.format).map_err(|e| format!("{key}: {e}"))?;
-        let read = || {
-            std::fs::read_to_string(path)
-                .map_err(|e| format!("{key}: cannot read '{}': {e}", path.display()))
-        };
+        let format = BedFormat::of(path, pl.format).map_err(|e| InputError::at(&key, e))?;
+        let read = || std::fs::read_to_string(path).map_err(|e| InputError::read(&key, path, e));
         let (bed, state) = match format {
             BedFormat::Native => {
-                let f = crate::bed::load_bed(path).map_err(|e| format!("{key}: {e}"))?;
+                let f = crate::bed::load_bed(path).map_err(|e| InputError::at(&key, e))?;
                 (f.bed, f.state)
             }
             BedFormat::Lammps => {
                 let mut bed = crate::bed_formats::read_lammps_data(&read()?, &pl.type_materials)
-                    .map_err(|e| format!("{key}: '{}': {e}", path.display()))?;
+                    .map_err(|e| InputError::file(&key, path, e))?;
                 if pl.type_materials.is_empty() {
                     bed.materials = vec![material.to_string()];
                     bed.material.iter_mut().for_each(|m| *m = 0);
@@ -2039,12 +2074,12 @@ impl Scenario {
             }
             BedFormat::Csv => (
                 crate::bed_formats::read_bed_csv(&read()?, material)
-                    .map_err(|e| format!("{key}: '{}': {e}", path.display()))?,
+                    .map_err(|e| InputError::file(&key, path, e))?,
                 None,
             ),
         };
         bed.validate()
-            .map_err(|e| format!("{key}: '{}': {e}", path.display()))?;
+            .map_err(|e| InputError::file(&key, path, e))?;
         Ok((bed, state))
     }
 
@@ -2056,14 +2091,14 @@ impl Scenario {
         bed: &pdamp_dem::Bed,
         count: usize,
         grp: &ParticleGroupSpec,
-    ) -> Result<(), String> {
+    ) -> Result<(), InputError> {
         if bed.len() != count {
-            return Err(format!(
+            return Err(InputError::message(format!(
                 "particles[{g}].count: the scenario asks for {count} particles, the bed '{}' has {}; set count = {}",
                 path.display(),
                 bed.len(),
                 bed.len()
-            ));
+            )));
         }
         let (lo, hi) = (grp.size.min_radius_m(), grp.size.max_radius_m());
         if let Some(i) = bed
@@ -2071,28 +2106,33 @@ impl Scenario {
             .iter()
             .position(|&r| r < lo * (1.0 - 1e-9) || r > hi * (1.0 + 1e-9))
         {
-            return Err(format!(
+            return Err(InputError::message(format!(
                 "particles[{g}].size: particle {i} of the bed '{}' has radius {:.6e} m, outside the group's size range [{lo:.6e}, {hi:.6e}] m; make the size match the bed",
                 path.display(),
                 bed.radius_m[i]
-            ));
+            )));
         }
         Ok(())
     }
 
     /// A drop-down cannot pack denser than random close packing: refuse a group whose solid
     /// volume exceeds 0.64 of the region's volume.
-    fn check_drop_down_fits(&self, g: usize, region: &Region, radii: &[f64]) -> Result<(), String> {
+    fn check_drop_down_fits(
+        &self,
+        g: usize,
+        region: &Region,
+        radii: &[f64],
+    ) -> Result<(), ParameterError> {
         let solid: f64 = radii
             .iter()
             .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
             .sum();
         let v = region.volume_m3();
         if solid > RANDOM_CLOSE_PACKING * v {
-            return Err(format!(
+            return Err(ParameterError::from_message(format!(
                 "particles[{g}].placement.region: the particles' volume {solid:.4e} m³ is {:.2} of the region's {v:.4e} m³, more than a random packing holds ({RANDOM_CLOSE_PACKING}); enlarge the region or lower the count",
                 solid / v
-            ));
+            )));
         }
         Ok(())
     }
@@ -2108,7 +2148,7 @@ impl Scenario {
         radii: &[f64],
         seed: u64,
         progress: &mut dyn FnMut(&str, f64),
-    ) -> Result<pdamp_dem::drop_down::DroppedParticles, String> {
+    ) -> Result<pdamp_dem::drop_down::DroppedParticles, InputError> {
         self.check_drop_down_fits(g, region, radii)?;
         let pl = &self.particles[g].placement;
         let gravity = self.fill_gravity();
@@ -2142,12 +2182,16 @@ impl Scenario {
                 std::ops::ControlFlow::Continue(())
             }
         })
-        .map_err(|e| format!("particles[{g}].placement: {e}"))
+        .map_err(|e| InputError::at(format!("particles[{g}].placement"), e))
     }
 }
 
 /// Fails if two particles overlap by more than 1e-9 of the smaller radius at the start.
-fn check_initial_overlaps(world: &World, group_of: &[usize], tolerance: f64) -> Result<(), String> {
+fn check_initial_overlaps(
+    world: &World,
+    group_of: &[usize],
+    tolerance: f64,
+) -> Result<(), ParameterError> {
     let p = &world.particles;
     let n = p.len();
     if n < 2 {
@@ -2175,14 +2219,14 @@ fn check_initial_overlaps(world: &World, group_of: &[usize], tolerance: f64) -> 
                 } else {
                     "increase placement.gap_m or use another placement method".to_string()
                 };
-                return Err(format!(
+                return Err(ParameterError::from_message(format!(
                     "particles[{gj}].placement: initial overlap of {:.3e} m between particle {} at {:?} and particle {} at {:?}; {fix}",
                     ov,
                     i,
                     p.position[i].as_slice(),
                     j,
                     p.position[j].as_slice()
-                ));
+                )));
             }
         }
     }
@@ -2200,7 +2244,7 @@ fn check_inside_walls(
     sc: &Scenario,
     tolerance: f64,
     health_limits: bool,
-) -> Result<(), String> {
+) -> Result<(), InputError> {
     let p = &world.particles;
     let mut contacts = Vec::new();
     for (bi, b) in world.bodies.iter().enumerate() {
@@ -2221,7 +2265,7 @@ fn check_inside_walls(
                 };
                 if let Some(c) = contacts.iter().find(|c| c.overlap_m > limit * p.radius[i]) {
                     let outside = c.overlap_m > p.radius[i];
-                    return Err(format!(
+                    return Err(InputError::message(format!(
                         "particles[{g}].placement.region: particle {i} at {:?} m {} wall '{}' of body '{}' (bodies[{bi}].walls[{wi}]) by {:.3e} m; \
                          keep the region inside the container, at least one radius ({:.3e} m) away from its walls",
                         p.position[i].as_slice(),
@@ -2230,7 +2274,7 @@ fn check_inside_walls(
                         b.name,
                         c.overlap_m,
                         p.radius[i]
-                    ));
+                    )));
                 }
             }
         }

@@ -323,7 +323,8 @@ fn mismatched_bed_is_refused() {
     let e = Scenario::from_toml(&wrong_count)
         .unwrap()
         .build_world(Path::new("."))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("particles[0].count") && e.contains("has 1000"),
         "{e}"
@@ -332,7 +333,8 @@ fn mismatched_bed_is_refused() {
     let e = Scenario::from_toml(&wrong_size)
         .unwrap()
         .build_world(Path::new("."))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("particles[0].size") && e.contains("particle 0"),
         "{e}"
@@ -345,7 +347,8 @@ fn mismatched_bed_is_refused() {
     let e = Scenario::from_toml(&small)
         .unwrap()
         .build_world(Path::new("."))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("wall 'box'") && e.contains("particle"), "{e}");
     // Damaged file.
     let mut bytes = std::fs::read(dir.join("bed.pdbed")).unwrap();
@@ -354,14 +357,16 @@ fn mismatched_bed_is_refused() {
     let e = Scenario::from_toml(&cube(&file, false))
         .unwrap()
         .build_world(Path::new("."))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("damaged"), "{e}");
     // A drop-down that cannot fit.
     let full = cube(CUBE_DROP, true).replace("count = 1000", "count = 2500");
     let e = Scenario::from_toml(&full)
         .unwrap()
         .build_world(Path::new("."))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("more than a random packing holds"), "{e}");
 }
 
@@ -429,6 +434,7 @@ fn open_lid_fills_a_cube_with_less_than_a_diameter_of_clearance() {
     let Err(err) = prepare_bed(&closed, Path::new("."), &mut |_, _| {}) else {
         panic!("the closed cube cannot be filled")
     };
+    let err = err.to_string();
     assert!(err.contains("drop-down placed only"), "{err}");
 
     let open = format!(
@@ -500,6 +506,7 @@ fn open_lid_cylinder_and_errors() {
     let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
         panic!("no lid wall")
     };
+    let err = err.to_string();
     assert!(err.contains("no wall ends at the region's top"), "{err}");
 
     // Too many spheres to press in without tapping in 20 ms.
@@ -511,6 +518,7 @@ fn open_lid_cylinder_and_errors() {
     let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
         panic!("the lid cannot close")
     };
+    let err = err.to_string();
     assert!(
         err.contains("the lid is still") && err.contains("held up by particle"),
         "{err}"
@@ -567,6 +575,7 @@ fn pouring_from_an_inlet() {
     let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
         panic!("the pile blocks an inlet at the floor")
     };
+    let err = err.to_string();
     assert!(
         err.contains("drop-down from the inlet placed only"),
         "{err}"

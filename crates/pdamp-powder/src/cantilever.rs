@@ -723,7 +723,7 @@ struct Checkpointing {
 
 impl Checkpointing {
     fn save(&self, phase: &Phase) -> Result<(), String> {
-        ck::save(&self.path, &self.header, phase)
+        ck::save(&self.path, &self.header, phase).map_err(String::from)
     }
     fn interrupted(&self, time_s: f64) -> String {
         ck::Interrupted {
@@ -1248,9 +1248,13 @@ mod tests {
         // another scenario, another kind, damage and truncation are refused with a message
         let e = ck::load::<Phase>(&path, CHECKPOINT_KIND, "other")
             .err()
-            .unwrap();
+            .unwrap()
+            .to_string();
         assert!(e.contains("different scenario"), "{e}");
-        let e = ck::load::<Phase>(&path, "run", "digest").err().unwrap();
+        let e = ck::load::<Phase>(&path, "run", "digest")
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("not 'run'"), "{e}");
         let mut bad = bytes.clone();
         bad[bytes.len() / 2] ^= 1;

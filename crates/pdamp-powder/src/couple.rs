@@ -327,7 +327,7 @@ impl Coupled {
         )?;
         world
             .adopt_particles(&bed.world.save_state())
-            .map_err(CoupleError::State)?;
+            .map_err(|e| CoupleError::State(e.to_string()))?;
         world.initialize();
         let mut c = Self::assemble(
             structure,
@@ -444,7 +444,7 @@ impl Coupled {
             .map_err(|e| CoupleError::State(e.to_string()))?;
         st.law
             .validate("coupling state: law.")
-            .map_err(CoupleError::State)?;
+            .map_err(|e| CoupleError::State(e.to_string()))?;
         let ndof = structure.n_dof();
         if [&st.f_ps, &st.dk, &st.f_trial]
             .iter()
@@ -472,8 +472,10 @@ impl Coupled {
         }
         world
             .set_particles_of(&st.world)
-            .map_err(CoupleError::State)?;
-        world.restore_state(st.world).map_err(CoupleError::State)?;
+            .map_err(|e| CoupleError::State(e.to_string()))?;
+        world
+            .restore_state(st.world)
+            .map_err(|e| CoupleError::State(e.to_string()))?;
         let mut c = Self::assemble(
             structure,
             dynamics,

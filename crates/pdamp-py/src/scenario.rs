@@ -31,9 +31,9 @@ fn scenario_error(path: &Path, text: Option<&str>, message: String) -> PyErr {
 /// Parses and validates TOML text as the command line does (`source` names it in messages).
 fn parse(text: &str, base_dir: &Path, source: &Path) -> PyResult<pdamp_io::scenario::Scenario> {
     let sc = pdamp_io::scenario::Scenario::from_toml_in(text, base_dir)
-        .map_err(|m| scenario_error(source, Some(text), m))?;
+        .map_err(|m| scenario_error(source, Some(text), m.to_string()))?;
     sc.validate()
-        .map_err(|m| scenario_error(source, Some(text), m))?;
+        .map_err(|m| scenario_error(source, Some(text), m.to_string()))?;
     Ok(sc)
 }
 

@@ -224,7 +224,7 @@ fn open(dir: &Path, m: &SweepManifest) -> Result<Opened> {
     match m.kind.as_str() {
         FIELDS_KIND => {
             let sc = Scenario::from_toml_in(&text, &m.base_dir)
-                .and_then(|s| s.validate().map(|_| s))
+                .and_then(|s| s.validate().map(|_| s).map_err(Into::into))
                 .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
             let digest = pdamp_io::run::scenario_content_digest(&sc, &m.base_dir);
             if digest != m.scenario_digest {

@@ -15,10 +15,12 @@ use super::{ContactModel, NormalLaw};
 impl ContactModel {
     /// The model for particles `f` times the size of the real ones (see the module docs).
     /// `f` must be positive and finite.
-    pub fn coarse_grained(&self, f: f64) -> Result<ContactModel, String> {
+    pub fn coarse_grained(&self, f: f64) -> Result<ContactModel, crate::ParameterError> {
         if !(f.is_finite() && f > 0.0) {
-            return Err(format!(
-                "coarse-graining factor must be positive and finite, got {f}"
+            return Err(crate::ParameterError::out_of_range(
+                "coarse-graining factor",
+                "be positive and finite",
+                f,
             ));
         }
         let mut m = self.clone();

@@ -12,6 +12,7 @@
 
 use super::{ContactForce, ContactHistory, ContactKinematics, PairProps};
 use super::{hertz, normal};
+use crate::ParameterError;
 use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -190,12 +191,8 @@ pub(crate) fn interpolate_clamped(x: &[f64], y: &[f64], v: f64) -> f64 {
     y[k - 1] + t * (y[k] - y[k - 1])
 }
 
-fn check(ok: bool, field: &str, range: &str, value: f64) -> Result<(), String> {
-    if ok {
-        Ok(())
-    } else {
-        Err(format!("{field} must {range}, got {value}"))
-    }
+fn check(ok: bool, field: &str, range: &str, value: f64) -> Result<(), ParameterError> {
+    ParameterError::check(ok, field, range, value)
 }
 
 impl NormalLaw {
@@ -260,7 +257,7 @@ impl NormalLaw {
         !matches!(self, NormalLaw::Linear { .. })
     }
 
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), ParameterError> {
         if let NormalLaw::GonthierTable {
             impact_velocities_m_s: x,
             restitutions: y,
@@ -268,10 +265,13 @@ impl NormalLaw {
         } = self
         {
             if x.is_empty() || x.len() != y.len() {
-                return Err(format!(
-                    "normal.impact_velocities_m_s ({} values) and normal.restitutions ({} values) must be non-empty and of equal length",
-                    x.len(),
-                    y.len()
+                return Err(ParameterError::invalid(
+                    "normal.impact_velocities_m_s",
+                    format!(
+                        "normal.impact_velocities_m_s ({} values) and normal.restitutions ({} values) must be non-empty and of equal length",
+                        x.len(),
+                        y.len()
+                    ),
                 ));
             }
             for (k, v) in x.iter().enumerate() {
@@ -349,7 +349,7 @@ impl NormalLaw {
 }
 
 impl FrictionLaw {
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), ParameterError> {
         let mu_ok = |mu: f64| {
             check(
                 mu >= 0.0 && mu.is_finite(),
@@ -403,7 +403,7 @@ impl FrictionLaw {
 impl ContactModel {
     /// Checks parameter ranges; the error message names the offending field, e.g.
     /// `normal.restitution must lie in (0, 1], got 1.3`.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParameterError> {
         self.normal.validate()?;
         self.friction.validate()?;
         if let Some(r) = &self.rolling {

@@ -850,10 +850,12 @@ fn validation_messages_name_the_field() {
         restitution: 1.3,
         min_impact_velocity_m_s: 1e-3,
     };
+    let e = m.validate().unwrap_err();
     assert_eq!(
-        m.validate().unwrap_err(),
+        e.to_string(),
         "normal.restitution must lie in (0, 1], got 1.3"
     );
+    assert_eq!(e.key(), "normal.restitution");
     m.normal = NormalLaw::Linear {
         stiffness_n_m: 1e5,
         restitution: 1.0,
@@ -868,6 +870,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("normal.restitution must lie in (0, 1]")
     );
     m.normal = NormalLaw::Linear {
@@ -878,6 +881,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("normal.stiffness_n_m")
     );
     m.normal = NormalLaw::LankaraniNikravesh {
@@ -887,6 +891,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("normal.min_impact_velocity_m_s")
     );
     m.normal = NormalLaw::Hertz;
@@ -897,6 +902,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("friction.friction_coefficient")
     );
     m.friction = FrictionLaw::RegularizedSliding {
@@ -906,6 +912,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("friction.regularization_s_m")
     );
     m.friction = FrictionLaw::CoulombSpring {
@@ -916,6 +923,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("friction.stiffness_ratio")
     );
     m.friction = FrictionLaw::Frictionless;
@@ -926,6 +934,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("rolling.regularization_s")
     );
     m.rolling = None;
@@ -936,6 +945,7 @@ fn validation_messages_name_the_field() {
     assert!(
         m.validate()
             .unwrap_err()
+            .to_string()
             .starts_with("adhesion.cutoff_ratio")
     );
     m.adhesion = Some(dmt());

@@ -67,15 +67,18 @@ fn default_true() -> bool {
 }
 
 impl CylSpec {
-    fn check(&self) -> Result<Vec3, String> {
+    fn check(&self) -> Result<Vec3, crate::ParameterError> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !(self.base_center_m.iter().all(|c| c.is_finite())
             && positive(self.radius_m)
             && positive(self.length_m))
         {
-            return Err(format!(
-                "cylinder needs a finite base centre and positive radius/length, got {:?}, {}, {}",
-                self.base_center_m, self.radius_m, self.length_m
+            return Err(crate::ParameterError::invalid(
+                "cylinder",
+                format!(
+                    "cylinder needs a finite base centre and positive radius/length, got {:?}, {}, {}",
+                    self.base_center_m, self.radius_m, self.length_m
+                ),
             ));
         }
         unit(self.axis, "cylinder axis")
@@ -105,8 +108,8 @@ pub struct CylinderInside {
 }
 
 impl TryFrom<CylSpec> for CylinderInside {
-    type Error = String;
-    fn try_from(s: CylSpec) -> Result<Self, String> {
+    type Error = crate::ParameterError;
+    fn try_from(s: CylSpec) -> Result<Self, crate::ParameterError> {
         let axis = s.check()?;
         Ok(CylinderInside {
             base_center_m: s.base_center_m,
@@ -220,8 +223,8 @@ pub struct CylinderOutside {
 }
 
 impl TryFrom<CylSpec> for CylinderOutside {
-    type Error = String;
-    fn try_from(s: CylSpec) -> Result<Self, String> {
+    type Error = crate::ParameterError;
+    fn try_from(s: CylSpec) -> Result<Self, crate::ParameterError> {
         let axis = s.check()?;
         Ok(CylinderOutside {
             base_center_m: s.base_center_m,

@@ -14,11 +14,12 @@ use serde::{Deserialize, Serialize};
 /// unit vector to round-off (|v| within 4 ε of 1) is returned unchanged, so that normalising is
 /// idempotent: a scenario written with its normalised vectors reads back to the same bits (and
 /// the same digest).
-pub(super) fn unit(v: Vec3, what: &str) -> Result<Vec3, String> {
+pub(super) fn unit(v: Vec3, what: &str) -> Result<Vec3, crate::ParameterError> {
     let n = v.norm();
     if !(n.is_finite() && n > 0.0) {
-        return Err(format!(
-            "{what} must be a finite non-zero vector, got {v:?}"
+        return Err(crate::ParameterError::invalid(
+            what,
+            format!("{what} must be a finite non-zero vector, got {v:?}"),
         ));
     }
     if (n - 1.0).abs() <= 4.0 * f64::EPSILON {
@@ -60,10 +61,13 @@ struct PlaneSpec {
 }
 
 impl TryFrom<PlaneSpec> for Plane {
-    type Error = String;
-    fn try_from(s: PlaneSpec) -> Result<Self, String> {
+    type Error = crate::ParameterError;
+    fn try_from(s: PlaneSpec) -> Result<Self, crate::ParameterError> {
         if !s.point_m.iter().all(|c| c.is_finite()) {
-            return Err(format!("plane point must be finite, got {:?}", s.point_m));
+            return Err(crate::ParameterError::invalid(
+                "point_m",
+                format!("plane point must be finite, got {:?}", s.point_m),
+            ));
         }
         Ok(Plane {
             point_m: s.point_m,
@@ -139,14 +143,17 @@ struct BoxSpec {
 }
 
 impl TryFrom<BoxSpec> for BoxInside {
-    type Error = String;
-    fn try_from(s: BoxSpec) -> Result<Self, String> {
+    type Error = crate::ParameterError;
+    fn try_from(s: BoxSpec) -> Result<Self, crate::ParameterError> {
         if !s.center_m.iter().all(|c| c.is_finite())
             || !s.half_extents_m.iter().all(|h| h.is_finite() && *h > 0.0)
         {
-            return Err(format!(
-                "box needs a finite centre and positive half extents, got {:?} / {:?}",
-                s.center_m, s.half_extents_m
+            return Err(crate::ParameterError::invalid(
+                "box",
+                format!(
+                    "box needs a finite centre and positive half extents, got {:?} / {:?}",
+                    s.center_m, s.half_extents_m
+                ),
             ));
         }
         Ok(BoxInside {

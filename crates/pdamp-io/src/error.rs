@@ -1,0 +1,118 @@
+//! Errors of a scenario's inputs that name the key they come from: a value out of range
+//! ([`pdamp_dem::ParameterError`]) or a file a key names that cannot be read or used. File-level
+//! errors (which scenario file, which line) are [`crate::scenario::ScenarioError`].
+
+use pdamp_dem::ParameterError;
+use std::path::PathBuf;
+
+/// A boxed error of another kind (CSV, STL, bed format, packing, …) kept as the source.
+pub type Source = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// An input of a scenario cannot be used; the message starts with the key.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    /// A value out of range or not fitting the others.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// The TOML text does not parse or does not fit the schema (serde names key, line, column).
+    #[error(transparent)]
+    Toml(#[from] toml::de::Error),
+    /// The file a key names cannot be read.
+    #[error("{key}: cannot read '{}': {source}", path.display())]
+    Read {
+        /// The key that names the file.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file a key names was read but cannot be used.
+    #[error("{key}: '{}': {source}", path.display())]
+    File {
+        /// The key that names the file.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        source: Source,
+    },
+    /// What a key describes cannot be built (a packing that does not fit, a bed that does not
+    /// match its group, …).
+    #[error("{key}: {source}{hint}")]
+    At {
+        /// The key.
+        key: String,
+        /// Cause.
+        source: Source,
+        /// How to fix it (empty, or starting with `; `).
+        hint: String,
+    },
+}
+
+impl InputError {
+    /// [`InputError::At`].
+    pub fn at(key: impl Into<String>, source: impl Into<Source>) -> Self {
+        Self::At {
+            key: key.into(),
+            source: source.into(),
+            hint: String::new(),
+        }
+    }
+
+    /// [`InputError::At`] with a hint how to fix it (`; enlarge the region, …`).
+    pub fn at_with_hint(
+        key: impl Into<String>,
+        source: impl Into<Source>,
+        hint: impl Into<String>,
+    ) -> Self {
+        Self::At {
+            key: key.into(),
+            source: source.into(),
+            hint: hint.into(),
+        }
+    }
+
+    /// [`InputError::File`].
+    pub fn file(
+        key: impl Into<String>,
+        path: impl Into<PathBuf>,
+        source: impl Into<Source>,
+    ) -> Self {
+        Self::File {
+            key: key.into(),
+            path: path.into(),
+            source: source.into(),
+        }
+    }
+
+    /// [`InputError::Read`].
+    pub fn read(key: impl Into<String>, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Self::Read {
+            key: key.into(),
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// A message that starts with the key it is about ([`ParameterError::from_message`]).
+    pub fn message(message: impl Into<String>) -> Self {
+        Self::Parameter(ParameterError::from_message(message))
+    }
+
+    /// The key the error is about (empty for a TOML error, whose message has line and column).
+    pub fn key(&self) -> &str {
+        match self {
+            Self::Parameter(e) => e.key(),
+            Self::Toml(_) => "",
+            Self::Read { key, .. } | Self::File { key, .. } | Self::At { key, .. } => key,
+        }
+    }
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<InputError> for String {
+    fn from(e: InputError) -> String {
+        e.to_string()
+    }
+}
