@@ -2,7 +2,10 @@
 //! so results do not depend on it), each summing the forces of its own particles in pair-loop
 //! order; the shares of second partners in later blocks are added after the pass.
 
-use super::*;
+use super::contacts::PpChunk;
+use super::prefetch::prefetch;
+use super::state::{PP_CHUNK, WallSlot};
+use crate::math::Vec3;
 
 /// What the second partner of a contact gathers from one pair evaluation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

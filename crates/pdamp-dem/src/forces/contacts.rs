@@ -2,7 +2,8 @@
 //! 128-byte contact states addressed from the pair list, plus orphans carried over a rebuild
 //! of the neighbour list; collecting and restoring them for checkpoints.
 
-use super::*;
+use super::state::{NO_CONTACT, PP_CHUNK, PairState};
+use crate::world::World;
 
 /// A particle–particle contact that was active (touching, or within the adhesion range) at the
 /// last force evaluation: the partners `i < j` and the contact state.
@@ -31,26 +32,6 @@ pub(crate) struct PpChunk {
     /// Contacts that are not in the neighbour list (any more): closed by the next evaluation.
     pub(super) orphans: Vec<PpContact>,
     pub(super) sums: (f64, f64, f64),
-}
-
-/// Scratch of the pair loop, one per worker thread (kept between steps: no allocation once
-/// grown, and it stays in that core's cache).
-#[derive(Debug, Default)]
-pub(crate) struct PairScratch {
-    /// The pairs of a chunk that touch or had a contact (index within the chunk's pair range)
-    /// and their first partners.
-    pub(super) scan_pair: Vec<u32>,
-    pub(super) scan_first: Vec<u32>,
-    /// Hertz–Mindlin contacts gathered for block evaluation.
-    pub(super) batch: HmBatch,
-    /// Wall contacts found for one particle, and its new wall slots.
-    pub(crate) wall_contacts: Vec<WallContact>,
-    pub(crate) wall_fresh: Vec<WallSlot>,
-}
-
-thread_local! {
-    pub(crate) static PAIR_SCRATCH: std::cell::RefCell<PairScratch> =
-        std::cell::RefCell::new(PairScratch::default());
 }
 
 /// The state of one contact in a slab: 128 bytes aligned to a cache line, so that the pair loop

@@ -2,29 +2,28 @@
 //! gravity, loads on rigid bodies, and the per-contact work that feeds the energy ledger.
 
 use crate::body::BodyState;
-use crate::contact::{ContactForce, ContactHistory, ContactKinematics, PairProps};
 use crate::energy::EnergyIncrements;
-use crate::hm_block::{HmInput, HmOutput, HmState, LANES};
-use crate::material::{effective_mass, effective_radius};
-use crate::math::{Vec3, tangential_part};
-use crate::walls::WallContact;
+use crate::math::Vec3;
 use crate::world::World;
+use blocks::{BlockAcc, BlockParts, BlockSlices, force_blocks, split_blocks};
+use contacts::fit_contact_store;
+use pair_pass::{PairContext, PairRows};
+use prefetch::prefetch_at;
 use rayon::prelude::*;
+use state::pack_kinematics;
 
 mod blocks;
 mod contacts;
 mod pair_pass;
+mod prefetch;
 mod state;
 mod wall_pass;
 
-use blocks::*;
 pub(crate) use blocks::{SecondOutput, SecondShares};
+pub(crate) use contacts::PpChunk;
 pub use contacts::PpContact;
-use contacts::*;
-pub(crate) use contacts::{PAIR_SCRATCH, PpChunk};
-use pair_pass::*;
-use state::*;
-pub(crate) use state::{Kin, NO_CONTACT, PP_CHUNK};
+pub(crate) use pair_pass::PAIR_SCRATCH;
+pub(crate) use state::{Kin, PP_CHUNK};
 pub use state::{PairState, WallSlot};
 pub(crate) use wall_pass::{add_wall_loads, refresh_wall_candidates, wall_contacts_of};
 

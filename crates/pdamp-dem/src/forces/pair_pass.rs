@@ -2,7 +2,35 @@
 //! contact law through the general pipeline [D Eq. 2.12–2.27] or the Hertz–Mindlin block kernel
 //! (`hm_block`), and the contact's work for the energy ledger.
 
-use super::*;
+use super::blocks::BlockAcc;
+use super::contacts::{PpChunk, PpContact, SlabState, slab_alloc};
+use super::prefetch::{prefetch, prefetch_at};
+use super::state::{Kin, NO_CONTACT, PairState, WallSlot, account};
+use crate::contact::{ContactForce, ContactHistory, ContactKinematics, PairProps};
+use crate::hm_block::{HmInput, HmOutput, HmState, LANES};
+use crate::material::{effective_mass, effective_radius};
+use crate::math::{Vec3, tangential_part};
+use crate::walls::WallContact;
+
+/// Scratch of the pair loop, one per worker thread (kept between steps: no allocation once
+/// grown, and it stays in that core's cache).
+#[derive(Debug, Default)]
+pub(crate) struct PairScratch {
+    /// The pairs of a chunk that touch or had a contact (index within the chunk's pair range)
+    /// and their first partners.
+    pub(super) scan_pair: Vec<u32>,
+    pub(super) scan_first: Vec<u32>,
+    /// Hertz–Mindlin contacts gathered for block evaluation.
+    pub(super) batch: HmBatch,
+    /// Wall contacts found for one particle, and its new wall slots.
+    pub(crate) wall_contacts: Vec<WallContact>,
+    pub(crate) wall_fresh: Vec<WallSlot>,
+}
+
+thread_local! {
+    pub(crate) static PAIR_SCRATCH: std::cell::RefCell<PairScratch> =
+        std::cell::RefCell::new(PairScratch::default());
+}
 
 /// How many pairs ahead the pair loop prefetches partner data.
 pub(super) const PREFETCH_AHEAD: usize = 8;
@@ -10,26 +38,6 @@ pub(super) const PREFETCH_AHEAD: usize = 8;
 /// Hertz–Mindlin contacts gathered before a block evaluation (a multiple of [`LANES`]; the
 /// gathered lanes stay in the L1 cache until the kernel and the hand-out read them).
 pub(super) const BATCH_FLUSH: usize = 2 * LANES;
-
-/// Hints the processor to load the cache line of `x` (no effect on other targets).
-#[inline(always)]
-pub(super) fn prefetch<T>(x: &T) {
-    prefetch_at((x as *const T).cast::<u8>());
-}
-
-/// Hints the processor to load the cache line at `p` (never dereferenced).
-#[inline(always)]
-pub(super) fn prefetch_at(p: *const u8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch is only a hint; it never faults, whatever the address.
-    #[allow(unused_unsafe)]
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
 
 /// Evaluates the contact of the pair (`i`, `j`) at distance vector `d = x_i − x_j`: the law if the
 /// partners interact (`touching`), or the closing of the work integral of a contact that ended.

@@ -2,7 +2,9 @@
 //! energies for the trapezoidal work integral), the wall-contact slot of a particle, the packed
 //! kinematics of a particle, and the work bookkeeping of one contact evaluation.
 
-use super::*;
+use crate::contact::{ContactForce, ContactHistory};
+use crate::math::Vec3;
+use rayon::prelude::*;
 
 /// State of one contact carried from step to step: the law's history plus the forces and stored
 /// energies of the previous evaluation (for trapezoidal work integration).

@@ -1,3 +1,5 @@
+use super::contacts::SlabState;
+use super::pair_pass::{HmBatch, PairEval, evaluate_pair};
 use super::*;
 use crate::contact::{ContactModel, FrictionLaw, NormalLaw};
 use crate::interaction::InteractionTable;

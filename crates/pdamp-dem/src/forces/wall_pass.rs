@@ -1,7 +1,14 @@
 //! The particle–wall pass: which particles may touch a wall before the next refresh, their
 //! wall contacts with history kept per slot [D Eq. 2.17–2.33], and the loads on the bodies.
 
-use super::*;
+use super::state::{CHUNK, Kin, PairState, WallSlot, account};
+use crate::body::BodyState;
+use crate::contact::{ContactForce, ContactKinematics, PairProps};
+use crate::energy::EnergyIncrements;
+use crate::material::effective_radius;
+use crate::math::{Vec3, tangential_part};
+use crate::walls::WallContact;
+use rayon::prelude::*;
 
 /// Marks the particles that may touch a wall before the next refresh: those that touch a wall
 /// with their radius and interaction range both grown by `3 × skin`. A particle moves less than one skin
