@@ -137,7 +137,6 @@ impl World {
         cross_out.resize_with(nblocks * nchunks, Vec::new);
         block_loads.resize_with(nblocks, Vec::new);
         let block_start = &*block_start;
-        let chunk_block = &*chunk_block;
         let bodies_ref = &*bodies;
         let wall_list_ref = &*wall_list;
         block_out.clear();
@@ -188,16 +187,29 @@ impl World {
                     *result = pass.run(b, part);
                 });
         }
+        self.finish_force_pass(force, torque, nblocks, defer_shares, t_pairs)
+    }
+
+    /// After the block tasks: the shares of second partners from earlier blocks, the earliest
+    /// first (or, with `defer_shares`, by the caller, see [`SecondShares`]); the new forces and
+    /// torques swapped in (the old ones kept as scratch); the loads on the bodies and the
+    /// energy increments summed in block order.
+    fn finish_force_pass(
+        &mut self,
+        mut force: Vec<Vec3>,
+        mut torque: Vec<Vec3>,
+        nblocks: usize,
+        defer_shares: bool,
+        t_pairs: Option<std::time::Instant>,
+    ) -> EnergyIncrements {
         let t_particles = self.profile.map(|_| std::time::Instant::now());
         if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
             pr.pair_forces_s += t.elapsed().as_secs_f64();
         }
-        // Shares of second partners from earlier blocks, the earliest first (or, with
-        // `defer_shares`, by the caller, see [`SecondShares`]).
         if !defer_shares {
             let shares = SecondShares {
-                lists: cross_out,
-                chunk_block,
+                lists: &self.cross_out,
+                chunk_block: &self.chunk_block,
             };
             force
                 .par_chunks_mut(PP_CHUNK)
