@@ -716,7 +716,7 @@ fn damping_decays(
     };
     result.objective = "mean_damping_ratio";
     result.time_simulation = -level1.cost;
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     let structure = space.structure(d.choice);
     let plans = modes
         .iter()
@@ -851,7 +851,7 @@ fn resonance_sweeps(
     } else {
         -level1.cost
     };
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     let structure = space.structure(d.choice);
     let mut plans = Vec::new();
     let mut level1_modes = Vec::new();

@@ -22,6 +22,9 @@ pub enum DesignError {
     /// The structure or a solver refused a design (unknown point, unstable step, …).
     #[error("{0}")]
     Solver(String),
+    /// The structure level refused a design or its input.
+    #[error(transparent)]
+    Structure(#[from] pdamp_structure::StructureError),
     /// No design satisfies the constraints.
     #[error("no design satisfies the constraints: {0}")]
     Empty(String),

@@ -98,11 +98,11 @@ impl DesignStudy {
         } else {
             base.join(&file.scenario)
         };
-        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::Load)?;
+        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::Structure)?;
         let structure = spec
             .build(scenario_path.parent().unwrap_or(Path::new(".")))
             .map_err(|m| {
-                DesignError::Load(pdamp_structure::scenario::locate(
+                DesignError::Structure(pdamp_structure::scenario::locate_error(
                     &scn.structure_source(&scenario_path),
                     m,
                 ))

@@ -20,7 +20,8 @@ fn dir(name: &str) -> PathBuf {
     d
 }
 
-fn has_all(msg: &str, parts: &[&str]) {
+fn has_all(msg: impl std::fmt::Display, parts: &[&str]) {
+    let msg = msg.to_string();
     for p in parts {
         assert!(msg.contains(p), "message lacks {p:?}: {msg}");
     }
@@ -297,7 +298,7 @@ position_m = 0.5
 fn structure_error(d: &Path, text: &str) -> String {
     let f = d.join("s.toml");
     std::fs::write(&f, text).unwrap();
-    load_structure(&f).map(|_| ()).unwrap_err()
+    load_structure(&f).map(|_| ()).unwrap_err().to_string()
 }
 
 #[test]
