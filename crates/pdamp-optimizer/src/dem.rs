@@ -567,7 +567,10 @@ fn run_one(
         },
         &mut |_| {},
     )
-    .map_err(|e| DesignError::Solver(format!("{}: {e}", cscn.display())))?;
+    .map_err(|source| DesignError::StructureFile {
+        path: cscn.clone(),
+        source,
+    })?;
     let sp = run_out.join("summary.json");
     let summary: serde_json::Value = std::fs::read_to_string(&sp)
         .map_err(|e| DesignError::output(&sp, e))

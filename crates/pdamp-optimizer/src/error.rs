@@ -25,6 +25,14 @@ pub enum DesignError {
     /// The structure level refused a design or its input.
     #[error(transparent)]
     Structure(#[from] pdamp_structure::StructureError),
+    /// The structure level refused the scenario file `path` (or a run of it).
+    #[error("{}: {source}", path.display())]
+    StructureFile {
+        /// The scenario file.
+        path: PathBuf,
+        /// The structure level's error.
+        source: pdamp_structure::StructureError,
+    },
     /// No design satisfies the constraints.
     #[error("no design satisfies the constraints: {0}")]
     Empty(String),

@@ -360,8 +360,7 @@ pub fn write_outputs(
             mm(&bh.displacement_m),
         ));
         for (i, c) in verified.iter().take(3).enumerate() {
-            let dm = space
-                .coupled_dampers(&c.design)?;
+            let dm = space.coupled_dampers(&c.design)?;
             if let (_, Some(h)) = time_evaluation(st, space.structure(c.design.choice), &dm)? {
                 p.series.push(Series::new(
                     format!("design {}", i + 1),
@@ -507,8 +506,7 @@ fn frf_plots(
             &freqs,
         )?];
         for c in &top {
-            let dm = space
-                .coupled_dampers(&c.design)?;
+            let dm = space.coupled_dampers(&c.design)?;
             columns.push(crate::fidelity::steady_frf_at_output(
                 st,
                 space.structure(c.design.choice),
@@ -620,8 +618,7 @@ fn level1_damping_curves(
     for &m in &curve_modes {
         let grid = amplitude_grid(lo, hi, 16);
         for (label, c) in verified.iter().take(3).enumerate() {
-            let dm = space
-                .coupled_dampers(&c.design)?;
+            let dm = space.coupled_dampers(&c.design)?;
             let curve =
                 simulated_damping_curve(st, space.structure(c.design.choice), &dm, m - 1, lo, hi)?;
             let ys: Vec<f64> = grid.iter().map(|&x| curve_at(&curve, x)).collect();

@@ -120,7 +120,10 @@ impl DesignStudy {
                     base_amplitude_m: *base_amplitude_m,
                 }
                 .force_n(&spec)
-                .map_err(|m| DesignError::Load(format!("{}: {m}", scenario_path.display())))?,
+                .map_err(|source| DesignError::StructureFile {
+                    path: scenario_path.clone(),
+                    source,
+                })?,
                 excitation_point: excitation_point.clone(),
             }),
             _ => None,

@@ -34,10 +34,10 @@
 //! $W_{s\to b} = -\sum \tfrac12(Q_n + Q_{n+1})\cdot(q_{n+1} - q_n)$, next to the DEM ledger
 //! (wall work, bed energy change, dissipation), so the exchange can be checked to close.
 
+use crate::StructureError;
 use crate::forced::SweepSpec;
 use crate::free::{FreeVibrationSpec, TimeHistory};
 use crate::integrate::{ModalIntegrator, generalized_force};
-use crate::StructureError;
 use crate::modal::ModalStructure;
 use nalgebra::DVector;
 use pdamp_dem::math::Rotation;
@@ -268,10 +268,7 @@ fn resolve_kinematics(
         let mut out = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         for (o, p) in out.iter_mut().zip(pts) {
             if let Some(p) = p {
-                *o = structure
-                    .point(p)
-                    .map_err(|e| e.context(what))?
-                    .to_vec();
+                *o = structure.point(p).map_err(|e| e.context(what))?.to_vec();
             }
         }
         Ok(out)

@@ -221,7 +221,8 @@ impl FieldTable {
                 format!("must be > 0, got {bed_mass_kg}"),
             ));
         }
-        let no_column = |name: &str| StructureError::invalid("fields.csv", format!("no column {name}"));
+        let no_column =
+            |name: &str| StructureError::invalid("fields.csv", format!("no column {name}"));
         let col = |name: &str| header.iter().position(|h| h.trim() == name);
         let fi = col("frequency_hz").ok_or_else(|| no_column("frequency_hz"))?;
         let xi = col("amplitude_m").ok_or_else(|| no_column("amplitude_m"))?;

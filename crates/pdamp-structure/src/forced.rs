@@ -4,10 +4,10 @@
 //! rational-fraction-polynomial fit, and the steady-state iteration scheme for approaches 2/3
 //! [D Fig. 3.7, Eq. 3.48–3.50] including a full steady-state FRF.
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::free::{CoupledDamper, TimeHistory, UpdateRecord};
 use crate::integrate::{Attachment, ModalIntegrator, generalized_force};
-use crate::StructureError;
 use crate::modal::ModalStructure;
 use nalgebra::{DMatrix, DVector};
 use pdamp_signal::Complex64;

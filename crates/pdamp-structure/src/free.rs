@@ -8,9 +8,9 @@
 //! $\bar\omega$ depends on $\bar m_{bed}$ [D Eq. 3.33] which depends on Ω and X, each update is
 //! a fixed-point iteration with $\Omega = \bar\omega_k$ [D Sect. 3.3.1].
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::integrate::{Attachment, ModalIntegrator};
-use crate::StructureError;
 use crate::modal::ModalStructure;
 use nalgebra::DVector;
 use pdamp_signal::decay::{PeakOptions, find_peaks};

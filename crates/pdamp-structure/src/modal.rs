@@ -181,7 +181,11 @@ impl ModalStructure {
 
     /// Equivalent single-mode parameters of mode `k` in the coordinates of point `point`
     /// [D Eq. 3.27]: $M = 1/\phi^2$, $K = \omega_k^2/\phi^2$, $D = 2\zeta_k\omega_k/\phi^2$.
-    pub fn equivalent_sdof(&self, k: usize, point: &str) -> Result<(f64, f64, f64), StructureError> {
+    pub fn equivalent_sdof(
+        &self,
+        k: usize,
+        point: &str,
+    ) -> Result<(f64, f64, f64), StructureError> {
         let phi = self.point(point)?[k];
         let m = &self.modes[k];
         let w = m.omega_rad_s();

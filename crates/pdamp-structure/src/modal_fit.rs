@@ -54,7 +54,11 @@ pub struct RfpFit {
 ///
 /// # Errors
 /// Too few points (need ≥ 4N + 3), non-positive or non-finite frequencies, or a singular fit.
-pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Result<RfpFit, StructureError> {
+pub fn rfp_fit(
+    frequencies_hz: &[f64],
+    h: &[Complex64],
+    n_modes: usize,
+) -> Result<RfpFit, StructureError> {
     let n = frequencies_hz.len();
     if n != h.len() {
         return Err(StructureError::invalid(
@@ -63,7 +67,10 @@ pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Resul
         ));
     }
     if n_modes == 0 {
-        return Err(StructureError::invalid("rfp_fit", "ask for at least one mode"));
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "ask for at least one mode",
+        ));
     }
     let na = 2 * n_modes; // denominator degree (monic)
     let nb = 2 * n_modes + 1; // numerator degree
@@ -130,12 +137,9 @@ pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Resul
         for (j, nj) in norms.iter().enumerate() {
             m.column_mut(j).scale_mut(1.0 / nj);
         }
-        let sol = m
-            .svd(true, true)
-            .solve(&rhs, 1e-13)
-            .map_err(|e| {
-                StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
-            })?;
+        let sol = m.svd(true, true).solve(&rhs, 1e-13).map_err(|e| {
+            StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
+        })?;
         for j in 0..na {
             a_coef[j] = sol[nb + 1 + j] / norms[nb + 1 + j];
         }

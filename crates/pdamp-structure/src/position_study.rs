@@ -108,9 +108,7 @@ impl PositionStudySpec {
             _ => {
                 return Err(StructureError::invalid(
                     "study",
-                    format!(
-                        "give positions_m, or start_m + end_m + count (2 to {MAX_POSITIONS})"
-                    ),
+                    format!("give positions_m, or start_m + end_m + count (2 to {MAX_POSITIONS})"),
                 ));
             }
         };
@@ -141,15 +139,12 @@ pub fn position_study(
     spec: &PositionStudySpec,
 ) -> Result<Vec<PositionResult>, StructureError> {
     let positions = spec.positions()?;
-    let beam = structure
-        .beam
-        .as_ref()
-        .ok_or_else(|| {
-            StructureError::invalid(
-                "damper-position study",
-                "the scenario's structure must be a [structure.beam]",
-            )
-        })?;
+    let beam = structure.beam.as_ref().ok_or_else(|| {
+        StructureError::invalid(
+            "damper-position study",
+            "the scenario's structure must be a [structure.beam]",
+        )
+    })?;
     let key = |i: usize| match (&spec.positions_m, i) {
         (Some(_), _) => format!("study.positions_m[{i}]"),
         (None, 0) => "study.start_m".to_string(),
@@ -296,8 +291,7 @@ pub fn run_position_study_file(
     out: &Path,
 ) -> Result<serde_json::Value, StructureError> {
     let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
-    let f: PositionStudyFile =
-        toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
+    let f: PositionStudyFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let scn_path = base.join(&f.scenario);
     let (scn, structure) = CoupleScenario::load(&scn_path)?;
@@ -352,8 +346,7 @@ pub fn run_position_study_file(
             "converged",
         ],
         &rows,
-    )
-    ?;
+    )?;
     let n_modes = res.iter().map(|r| r.mode).max().unwrap_or(0);
     let mut plot = LinePlot::new(
         Axis::linear("damper position (m)"),
@@ -390,10 +383,7 @@ pub fn run_position_study_file(
     });
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            ?
-            .as_bytes(),
-    )
-    ?;
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
     Ok(summary)
 }

@@ -1,10 +1,10 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
+use crate::StructureError;
 use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep_beds};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
-use crate::StructureError;
 use crate::modal::ModalStructure;
 use crate::modal_fit;
 use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, ForceSpec, load_structure};

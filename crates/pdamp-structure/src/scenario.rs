@@ -431,7 +431,10 @@ impl StructureSpec {
                 for (i, p) in self.points.iter().enumerate() {
                     let key = format!("structure.points[{i}].node");
                     let node = p.node.ok_or_else(|| {
-                        StructureError::rule(key.clone(), format!("is missing (point '{}')", p.name))
+                        StructureError::rule(
+                            key.clone(),
+                            format!("is missing (point '{}')", p.name),
+                        )
                     })?;
                     let dof = Dof::parse(&p.dof).ok_or_else(|| {
                         StructureError::invalid(
@@ -625,8 +628,7 @@ impl BeamSpec {
 /// I/O and TOML errors; invalid values with the file, the key's line and column and the fix.
 pub fn load_structure(path: &Path) -> Result<StructureFile, StructureError> {
     let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
-    let f: StructureFile =
-        toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
+    let f: StructureFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
     f.structure
         .validate()
         .map_err(|m| m.located(path, Some(&text)))?;
@@ -869,24 +871,23 @@ impl DamperSpec {
             ));
         };
         let key = |k: &str| format!("dampers[{index}].{k}");
-        let three = |v: &Option<Vec<String>>,
-                     k: &str|
-         -> Result<[Option<String>; 3], StructureError> {
-            let v = v.as_ref().ok_or_else(|| {
-                StructureError::invalid(key(k), format!("required for dofs = {dofs:?}"))
-            })?;
-            if v.len() != 3 {
-                return Err(StructureError::invalid(
-                    key(k),
-                    format!(
-                        "give three point names (x, y, z; \"\" = not moved), got {}",
-                        v.len()
-                    ),
-                ));
-            }
-            let o = |s: &String| (!s.trim().is_empty()).then(|| s.trim().to_string());
-            Ok([o(&v[0]), o(&v[1]), o(&v[2])])
-        };
+        let three =
+            |v: &Option<Vec<String>>, k: &str| -> Result<[Option<String>; 3], StructureError> {
+                let v = v.as_ref().ok_or_else(|| {
+                    StructureError::invalid(key(k), format!("required for dofs = {dofs:?}"))
+                })?;
+                if v.len() != 3 {
+                    return Err(StructureError::invalid(
+                        key(k),
+                        format!(
+                            "give three point names (x, y, z; \"\" = not moved), got {}",
+                            v.len()
+                        ),
+                    ));
+                }
+                let o = |s: &String| (!s.trim().is_empty()).then(|| s.trim().to_string());
+                Ok([o(&v[0]), o(&v[1]), o(&v[2])])
+            };
         match dofs {
             DemDofs::OneDimensional => {
                 for (k, set) in [
@@ -968,10 +969,20 @@ impl DamperSpec {
             } => {
                 let mut v: Vec<Box<dyn EffectiveDamper>> = Vec::new();
                 for l in layers {
-                    let h = match (l.clearance_m, l.container_length_m, l.particles, l.particles_per_layer) {
+                    let h = match (
+                        l.clearance_m,
+                        l.container_length_m,
+                        l.particles,
+                        l.particles_per_layer,
+                    ) {
                         (Some(h), _, _, _) => h,
                         (None, Some(len), Some(n), Some(nmax)) => clearance_m(len, n, nmax),
-                        _ => return Err(StructureError::invalid("rolling layer", "give clearance_m or container_length_m + particles + particles_per_layer")),
+                        _ => {
+                            return Err(StructureError::invalid(
+                                "rolling layer",
+                                "give clearance_m or container_length_m + particles + particles_per_layer",
+                            ));
+                        }
                     };
                     v.push(Box::new(RollingDamper {
                         bed_mass_kg: l.bed_mass_kg,
@@ -1943,7 +1954,10 @@ impl DamperSpec {
                 path, bed_mass_kg, ..
             } => {
                 if path.as_os_str().is_empty() {
-                    return Err(StructureError::invalid(k("path"), "give the fields.csv file"));
+                    return Err(StructureError::invalid(
+                        k("path"),
+                        "give the fields.csv file",
+                    ));
                 }
                 bed(*bed_mass_kg)?;
             }
@@ -1953,7 +1967,10 @@ impl DamperSpec {
                 ..
             } => {
                 if layers.is_empty() {
-                    return Err(StructureError::invalid(k("layers"), "give at least one layer"));
+                    return Err(StructureError::invalid(
+                        k("layers"),
+                        "give at least one layer",
+                    ));
                 }
                 for (j, l) in layers.iter().enumerate() {
                     let lk = |s: &str| format!("layers[{j}].{s}");

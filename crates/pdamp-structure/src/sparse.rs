@@ -334,7 +334,10 @@ impl SkylineLdlt {
                 li[k - fi] = lik;
             }
             if di.abs() <= 1e-14 * scale || !di.is_finite() {
-                return Err(SparseError::Pivot { pivot: i, value: di });
+                return Err(SparseError::Pivot {
+                    pivot: i,
+                    value: di,
+                });
             }
             d[i] = di;
         }

@@ -23,10 +23,10 @@
 //! Layers of one container are interchangeable for the formulas (energies and masses add), so
 //! only sorted particle numbers n₁ ≤ n₂ ≤ … are simulated.
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::formulas::{LayeredDamper, RollingDamper, VerticalDamper, clearance_m};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
-use crate::StructureError;
 use crate::modal::ModalStructure;
 use crate::scenario::CoupleScenario;
 use serde::{Deserialize, Serialize};
@@ -289,13 +289,9 @@ pub fn run_layer_study(
 ///
 /// # Errors
 /// Input, solver and I/O errors.
-pub fn run_layer_study_file(
-    path: &Path,
-    out: &Path,
-) -> Result<serde_json::Value, StructureError> {
+pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value, StructureError> {
     let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
-    let file: LayerStudyFile =
-        toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
+    let file: LayerStudyFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let scn_path = if file.scenario.is_absolute() {
         file.scenario.clone()
@@ -310,12 +306,9 @@ pub fn run_layer_study_file(
         .build(scn_path.parent().unwrap_or(Path::new(".")))
         .map_err(|m| crate::scenario::locate_error(&scn.structure_source(&scn_path), m))?
         .modal;
-    let fs = scn
-        .analysis
-        .free_vibration_spec()
-        .ok_or_else(|| {
-            StructureError::inconsistent("the study's scenario needs [analysis] kind = \"free\"")
-        })?;
+    let fs = scn.analysis.free_vibration_spec().ok_or_else(|| {
+        StructureError::inconsistent("the study's scenario needs [analysis] kind = \"free\"")
+    })?;
     let started = std::time::Instant::now();
     let designs = run_layer_study(&structure, &fs, &file.study)?;
     std::fs::create_dir_all(out)?;
@@ -347,10 +340,7 @@ pub fn run_layer_study_file(
     });
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            ?
-            .as_bytes(),
-    )
-    ?;
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
     Ok(summary)
 }

@@ -461,11 +461,13 @@ impl FeModel {
                 check(nd, "solid")?;
             }
             let x = s.nodes.map(|nd| self.nodes[nd]);
-            let (ke, me) = hex8::matrices(&x, &s.material, s.incompatible_modes)
-                .map_err(|msg| FeError::Element {
-                    kind: "solid",
-                    index: e,
-                    source: Box::new(msg),
+            let (ke, me) =
+                hex8::matrices(&x, &s.material, s.incompatible_modes).map_err(|msg| {
+                    FeError::Element {
+                        kind: "solid",
+                        index: e,
+                        source: Box::new(msg),
+                    }
                 })?;
             for a in 0..8 {
                 for c in 0..8 {
