@@ -567,9 +567,9 @@ fn run_one(
         },
         &mut |_| {},
     )
-    .map_err(|source| DesignError::StructureFile {
+    .map_err(|error| DesignError::StructureFile {
         path: cscn.clone(),
-        source,
+        error,
     })?;
     let sp = run_out.join("summary.json");
     let summary: serde_json::Value = std::fs::read_to_string(&sp)

@@ -26,12 +26,12 @@ pub enum DesignError {
     #[error(transparent)]
     Structure(#[from] pdamp_structure::StructureError),
     /// The structure level refused the scenario file `path` (or a run of it).
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     StructureFile {
         /// The scenario file.
         path: PathBuf,
-        /// The structure level's error.
-        source: pdamp_structure::StructureError,
+        /// The structure level's error (its text is in the message, so it is no `source()`).
+        error: pdamp_structure::StructureError,
     },
     /// No design satisfies the constraints.
     #[error("no design satisfies the constraints: {0}")]

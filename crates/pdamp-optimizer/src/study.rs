@@ -120,9 +120,9 @@ impl DesignStudy {
                     base_amplitude_m: *base_amplitude_m,
                 }
                 .force_n(&spec)
-                .map_err(|source| DesignError::StructureFile {
+                .map_err(|error| DesignError::StructureFile {
                     path: scenario_path.clone(),
-                    source,
+                    error,
                 })?,
                 excitation_point: excitation_point.clone(),
             }),

@@ -519,7 +519,7 @@ fn coupled_run(
         }
     }
     crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
-        .map_err(|e| StructureError::DemTimeStep { source: e })?;
+        .map_err(|e| StructureError::DemTimeStep { error: e })?;
     let mut it = ModalIntegrator::new(structure, dt);
     it.q = q0;
     it.v = v0;

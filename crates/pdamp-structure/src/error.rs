@@ -112,46 +112,46 @@ pub enum StructureError {
     #[error("{0}")]
     Numerical(String),
     /// An error with the context it happened in (`DEM bed 1 at 'tip'`, a file name, a key).
-    #[error("{context}: {source}")]
+    #[error("{context}: {error}")]
     Context {
         /// Where it happened.
         context: String,
         /// The error.
-        source: Box<StructureError>,
+        error: Box<StructureError>,
     },
     /// A file could not be read.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
         /// The I/O error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A TOML file does not parse or does not fit the schema.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Toml {
         /// The file.
         path: PathBuf,
         /// The TOML parser's error (key, line and column).
-        source: toml::de::Error,
+        error: toml::de::Error,
     },
     /// A Matrix Market or dof-map file of `structure.matrix_market.<key>` is unreadable or
     /// malformed.
-    #[error("structure.matrix_market.{key}{}: {source}", quoted(path.as_deref()))]
+    #[error("structure.matrix_market.{key}{}: {error}", quoted(path.as_deref()))]
     MatrixMarketFile {
         /// `stiffness`, `mass` or `dof_map`.
         key: &'static str,
         /// The file, when the error is not an I/O error (which names it already).
         path: Option<PathBuf>,
         /// The reader's error.
-        source: MatrixMarketError,
+        error: MatrixMarketError,
     },
     /// The integration settings of a coupled DEM run are invalid (its time step is the damper
     /// scenario's).
-    #[error("{source} (the time step is the damper scenario's)")]
+    #[error("{error} (the time step is the damper scenario's)")]
     DemTimeStep {
         /// The settings error.
-        source: IntegrationError,
+        error: IntegrationError,
     },
     /// The load of a DEM bed on the structure became non-finite.
     #[error(
@@ -176,8 +176,8 @@ pub enum StructureError {
     #[error("{0}")]
     Interrupted(pdamp_io::checkpoint::Interrupted),
     /// A located error of a scenario or structure file (line and column of the key).
-    #[error(transparent)]
-    Scenario(#[from] pdamp_io::scenario::ScenarioError),
+    #[error("{0}")]
+    Scenario(pdamp_io::scenario::ScenarioError),
     /// A Matrix Market reader error or a check of K and M.
     #[error(transparent)]
     MatrixMarket(#[from] MatrixMarketError),
@@ -191,17 +191,17 @@ pub enum StructureError {
     #[error(transparent)]
     Integration(#[from] IntegrationError),
     /// A CSV file could not be parsed or written.
-    #[error(transparent)]
-    Csv(#[from] pdamp_io::csv::CsvError),
+    #[error("{0}")]
+    Csv(pdamp_io::csv::CsvError),
     /// A plot could not be written.
-    #[error(transparent)]
-    Plot(#[from] pdamp_plot::PlotError),
+    #[error("{0}")]
+    Plot(pdamp_plot::PlotError),
     /// An I/O error (creating the output folder, writing a file).
-    #[error(transparent)]
-    Io(#[from] std::io::Error),
+    #[error("{0}")]
+    Io(std::io::Error),
     /// A JSON value could not be written.
-    #[error(transparent)]
-    Json(#[from] serde_json::Error),
+    #[error("{0}")]
+    Json(serde_json::Error),
     /// An error of pdamp-io (checkpoints, snapshots), as its text (issue 30: becomes
     /// `#[from]` once pdamp-io's errors are typed).
     #[error("{0}")]
@@ -215,8 +215,8 @@ pub enum StructureError {
     #[error("{0}")]
     Design(String),
     /// A signal-processing error (peak search).
-    #[error(transparent)]
-    Signal(#[from] pdamp_signal::SignalError),
+    #[error("{0}")]
+    Signal(pdamp_signal::SignalError),
 }
 
 fn quoted(path: Option<&Path>) -> String {
@@ -257,7 +257,7 @@ impl StructureError {
     pub fn context(self, context: impl Into<String>) -> Self {
         StructureError::Context {
             context: context.into(),
-            source: Box::new(self),
+            error: Box::new(self),
         }
     }
 
@@ -265,7 +265,7 @@ impl StructureError {
     pub fn read(path: &Path, source: std::io::Error) -> Self {
         StructureError::Read {
             path: path.to_path_buf(),
-            source,
+            error: source,
         }
     }
 
@@ -273,7 +273,7 @@ impl StructureError {
     pub fn toml(path: &Path, source: toml::de::Error) -> Self {
         StructureError::Toml {
             path: path.to_path_buf(),
-            source,
+            error: source,
         }
     }
 
@@ -284,6 +284,28 @@ impl StructureError {
         pdamp_io::scenario::ScenarioError::invalid(path, text, self.to_string()).into()
     }
 }
+
+// Errors of other crates are kept as values, not as `source()`: every message above already
+// contains the wrapped error's text, and a chain printed by `anyhow`'s `{:#}` (the CLI) would
+// repeat it.
+macro_rules! wrap {
+    ($($variant:ident($ty:ty)),* $(,)?) => {
+        $(impl From<$ty> for StructureError {
+            fn from(e: $ty) -> Self {
+                StructureError::$variant(e)
+            }
+        })*
+    };
+}
+
+wrap!(
+    Scenario(pdamp_io::scenario::ScenarioError),
+    Csv(pdamp_io::csv::CsvError),
+    Plot(pdamp_plot::PlotError),
+    Io(std::io::Error),
+    Json(serde_json::Error),
+    Signal(pdamp_signal::SignalError),
+);
 
 /// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
 impl From<StructureError> for String {

@@ -395,7 +395,7 @@ impl StructureSpec {
                             matrix_market::MatrixMarketError::Io { .. } => None,
                             _ => Some(p.to_path_buf()),
                         },
-                        source: e,
+                        error: e,
                     }
                 };
                 let k = matrix_market::read_matrix_market(&kp)

@@ -32,14 +32,14 @@ pub enum FeError {
         nodes: usize,
     },
     /// An error of one element.
-    #[error("{kind} {index}: {source}")]
+    #[error("{kind} {index}: {error}")]
     Element {
         /// `beam` or `solid`.
         kind: &'static str,
         /// The element's index (0-based).
         index: usize,
         /// The element's error.
-        source: Box<FeError>,
+        error: Box<FeError>,
     },
     /// A point mass is negative or not finite.
     #[error("point mass at node {node}: mass must be ≥ 0")]
@@ -432,7 +432,7 @@ impl FeModel {
             let in_beam = |s: FeError| FeError::Element {
                 kind: "beam",
                 index: e,
-                source: Box::new(s),
+                error: Box::new(s),
             };
             b.section.validate().map_err(in_beam)?;
             check(b.nodes[0], "beam")?;
@@ -466,7 +466,7 @@ impl FeModel {
                     FeError::Element {
                         kind: "solid",
                         index: e,
-                        source: Box::new(msg),
+                        error: Box::new(msg),
                     }
                 })?;
             for a in 0..8 {
