@@ -569,7 +569,7 @@ fn run_one(
     )
     .map_err(|error| DesignError::StructureFile {
         path: cscn.clone(),
-        error,
+        error: Box::new(error),
     })?;
     let sp = run_out.join("summary.json");
     let summary: serde_json::Value = std::fs::read_to_string(&sp)

@@ -24,14 +24,14 @@ pub enum DesignError {
     Solver(String),
     /// The structure level refused a design or its input.
     #[error(transparent)]
-    Structure(#[from] pdamp_structure::StructureError),
+    Structure(Box<pdamp_structure::StructureError>),
     /// The structure level refused the scenario file `path` (or a run of it).
     #[error("{}: {error}", path.display())]
     StructureFile {
         /// The scenario file.
         path: PathBuf,
         /// The structure level's error (its text is in the message, so it is no `source()`).
-        error: pdamp_structure::StructureError,
+        error: Box<pdamp_structure::StructureError>,
     },
     /// No design satisfies the constraints.
     #[error("no design satisfies the constraints: {0}")]
@@ -44,6 +44,12 @@ pub enum DesignError {
         /// The cause.
         message: String,
     },
+}
+
+impl From<pdamp_structure::StructureError> for DesignError {
+    fn from(e: pdamp_structure::StructureError) -> Self {
+        DesignError::Structure(Box::new(e))
+    }
 }
 
 impl DesignError {

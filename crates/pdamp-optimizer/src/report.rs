@@ -585,11 +585,11 @@ fn level1_damping_curves(
             let out_phi = st
                 .structure
                 .point(&st.free.output_point)
-                .map_err(DesignError::Structure)?;
+                .map_err(DesignError::from)?;
             let init_phi = st
                 .structure
                 .point(&st.free.initial_point)
-                .map_err(DesignError::Structure)?;
+                .map_err(DesignError::from)?;
             let k = st.free.mode;
             let x0 = (st.free.initial_displacement_m * out_phi[k] / init_phi[k]).abs();
             let x1 = best

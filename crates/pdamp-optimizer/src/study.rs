@@ -98,11 +98,11 @@ impl DesignStudy {
         } else {
             base.join(&file.scenario)
         };
-        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::Structure)?;
+        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::from)?;
         let structure = spec
             .build(scenario_path.parent().unwrap_or(Path::new(".")))
             .map_err(|m| {
-                DesignError::Structure(pdamp_structure::scenario::locate_error(
+                DesignError::from(pdamp_structure::scenario::locate_error(
                     &scn.structure_source(&scenario_path),
                     m,
                 ))
@@ -122,7 +122,7 @@ impl DesignStudy {
                 .force_n(&spec)
                 .map_err(|error| DesignError::StructureFile {
                     path: scenario_path.clone(),
-                    error,
+                    error: Box::new(error),
                 })?,
                 excitation_point: excitation_point.clone(),
             }),
