@@ -567,7 +567,10 @@ fn run_one(
         },
         &mut |_| {},
     )
-    .map_err(|e| DesignError::Solver(format!("{}: {e}", cscn.display())))?;
+    .map_err(|error| DesignError::StructureFile {
+        path: cscn.clone(),
+        error: Box::new(error),
+    })?;
     let sp = run_out.join("summary.json");
     let summary: serde_json::Value = std::fs::read_to_string(&sp)
         .map_err(|e| DesignError::output(&sp, e))
@@ -716,7 +719,7 @@ fn damping_decays(
     };
     result.objective = "mean_damping_ratio";
     result.time_simulation = -level1.cost;
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     let structure = space.structure(d.choice);
     let plans = modes
         .iter()
@@ -851,7 +854,7 @@ fn resonance_sweeps(
     } else {
         -level1.cost
     };
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     let structure = space.structure(d.choice);
     let mut plans = Vec::new();
     let mut level1_modes = Vec::new();

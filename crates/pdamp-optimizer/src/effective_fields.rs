@@ -130,12 +130,8 @@ fn output_range_m(space: &Space, level1: &Evaluation, k: usize) -> Result<(f64, 
     match &st.file.objective {
         ObjectiveSpec::MinStroke { .. } => {
             let s = &st.structure;
-            let out = s
-                .point(&st.free.output_point)
-                .map_err(DesignError::Solver)?[k];
-            let init = s
-                .point(&st.free.initial_point)
-                .map_err(DesignError::Solver)?[k];
+            let out = s.point(&st.free.output_point).map_err(DesignError::from)?[k];
+            let init = s.point(&st.free.initial_point).map_err(DesignError::from)?[k];
             let x0 = (st.free.initial_displacement_m * out / init).abs();
             let x1 = level1.stroke_m.unwrap_or(x0 / 10.0);
             Ok(((0.5 * x1).max(1e-3 * x0), 1.1 * x0))
@@ -170,12 +166,12 @@ fn damper_range_m(
     let s = space.structure(d.choice);
     let out = s
         .point(&space.study.free.output_point)
-        .map_err(DesignError::Solver)?[k]
+        .map_err(DesignError::from)?[k]
         .abs()
         .max(1e-300);
     let mut ratio = (f64::INFINITY, 0.0_f64);
     for p in &space.location(d.choice).points {
-        let r = s.point(p).map_err(DesignError::Solver)?[k].abs() / out;
+        let r = s.point(p).map_err(DesignError::from)?[k].abs() / out;
         ratio = (ratio.0.min(r), ratio.1.max(r));
     }
     let (a, b) = ((lo * ratio.0).max(1e-9), (hi * ratio.1).max(2e-9));
@@ -288,7 +284,7 @@ fn packing_tables(
     (0..packings)
         .map(|k| {
             let f = packing_dir(dir, packings, k).join("fields.csv");
-            FieldTable::read(&f, bed_mass_kg).map_err(DesignError::Solver)
+            FieldTable::read(&f, bed_mass_kg).map_err(DesignError::from)
         })
         .collect()
 }

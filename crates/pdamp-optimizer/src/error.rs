@@ -22,6 +22,17 @@ pub enum DesignError {
     /// The structure or a solver refused a design (unknown point, unstable step, …).
     #[error("{0}")]
     Solver(String),
+    /// The structure level refused a design or its input.
+    #[error(transparent)]
+    Structure(Box<pdamp_structure::StructureError>),
+    /// The structure level refused the scenario file `path` (or a run of it).
+    #[error("{}: {error}", path.display())]
+    StructureFile {
+        /// The scenario file.
+        path: PathBuf,
+        /// The structure level's error (its text is in the message, so it is no `source()`).
+        error: Box<pdamp_structure::StructureError>,
+    },
     /// No design satisfies the constraints.
     #[error("no design satisfies the constraints: {0}")]
     Empty(String),
@@ -33,6 +44,12 @@ pub enum DesignError {
         /// The cause.
         message: String,
     },
+}
+
+impl From<pdamp_structure::StructureError> for DesignError {
+    fn from(e: pdamp_structure::StructureError) -> Self {
+        DesignError::Structure(Box::new(e))
+    }
 }
 
 impl DesignError {

@@ -216,7 +216,7 @@ fn mode_coupling(
         .as_ref()
         .ok_or_else(|| DesignError::Solver("min_frf_peak without a harmonic load".into()))?;
     let phi_pd = match dampers.first() {
-        Some(d) => structure.point(&d.point).map_err(DesignError::Solver)?[k],
+        Some(d) => structure.point(&d.point).map_err(DesignError::from)?[k],
         None => 0.0,
     };
     Ok(pdamp_structure::forced::ModeCoupling {
@@ -225,7 +225,7 @@ fn mode_coupling(
         phi_pd,
         phi_ex: structure
             .point(&load.excitation_point)
-            .map_err(DesignError::Solver)?[k],
+            .map_err(DesignError::from)?[k],
         force_amplitude_n: load.force_n,
     })
 }
@@ -240,10 +240,10 @@ pub fn bare_peak_m(study: &DesignStudy, k: usize) -> Result<f64, DesignError> {
         .ok_or_else(|| DesignError::Solver("min_frf_peak without a harmonic load".into()))?;
     let phi_out = st
         .point(&study.free.output_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let phi_ex = st
         .point(&load.excitation_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let m = &st.modes[k];
     Ok((phi_out * phi_ex * load.force_n).abs()
         / (2.0 * m.damping_ratio.max(1e-12) * m.omega_rad_s().powi(2)))
@@ -261,7 +261,7 @@ fn equilibrium_peak(
     let c = mode_coupling(study, structure, dampers, k)?;
     let phi_out = structure
         .point(&study.free.output_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let r = (c.phi_ex * c.force_amplitude_n).abs();
     if dampers.is_empty() || c.phi_pd == 0.0 {
         let q = r / (2.0 * c.damping_ratio.max(1e-12) * c.omega_rad_s.powi(2));
@@ -300,7 +300,7 @@ pub fn frf_resonance(
     let c = mode_coupling(study, structure, dampers, k)?;
     let phi_out = structure
         .point(&study.free.output_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let f0 = if dampers.is_empty() || c.phi_pd == 0.0 {
         structure.modes[k].frequency_hz
     } else {
@@ -350,7 +350,7 @@ pub fn steady_frf_at_output(
     let c = mode_coupling(study, structure, dampers, k)?;
     let phi_out = structure
         .point(&study.free.output_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let none: [CoupledDamper; 0] = [];
     let model = Combined(if c.phi_pd == 0.0 { &none } else { dampers });
     Ok(
@@ -377,7 +377,7 @@ pub fn resonance_damping_ratio(
         .ok_or_else(|| DesignError::Solver("a forced objective without a harmonic load".into()))?;
     let phi_ex = structure
         .point(&load.excitation_point)
-        .map_err(DesignError::Solver)?[k];
+        .map_err(DesignError::from)?[k];
     let wk = structure.modes[k].omega_rad_s();
     Ok((phi_ex * load.force_n).abs() / (2.0 * modal_peak.max(1e-300) * wk * wk))
 }
@@ -418,7 +418,7 @@ pub fn envelope_evaluation(
     let bed: f64 = dampers.iter().map(|d| d.model.bed_mass_kg()).sum();
     let out_shape = structure
         .point(&study.free.output_point)
-        .map_err(DesignError::Solver)?
+        .map_err(DesignError::from)?
         .to_vec();
     match &study.file.objective {
         ObjectiveSpec::MinStroke { evaluate_at_s } => {
@@ -540,7 +540,7 @@ pub fn damping_decay_plan(
     let structure = single_mode(structure, k);
     let mode = k;
     let k = 0;
-    let phi_out = structure.point(out).map_err(DesignError::Solver)?[k];
+    let phi_out = structure.point(out).map_err(DesignError::from)?[k];
     if phi_out == 0.0 {
         return Err(DesignError::Solver(format!(
             "the output point '{out}' is a node of mode {}: no amplitude range there",
@@ -594,7 +594,7 @@ pub fn damping_decay_plan(
 /// # Errors
 /// A history that is not uniformly sampled.
 pub fn damping_curve_of(hist: &TimeHistory, period_s: f64) -> Result<Vec<(f64, f64)>, DesignError> {
-    let peaks = decay_peaks(hist, 0.5 * period_s).map_err(DesignError::Solver)?;
+    let peaks = decay_peaks(hist, 0.5 * period_s).map_err(DesignError::from)?;
     Ok(damping_per_cycle(&peaks)
         .iter()
         .map(|c| (c.mean_amplitude_m, c.damping_ratio))
@@ -623,7 +623,7 @@ pub fn simulated_damping_curve(
         amplitude_max_m,
     )?;
     let hist = free::run_free_vibration(&plan.structure, dampers, &plan.spec)
-        .map_err(DesignError::Solver)?;
+        .map_err(DesignError::from)?;
     damping_curve_of(&hist, plan.period_s)
 }
 
@@ -680,7 +680,7 @@ pub fn time_evaluation_by_mode<'a>(
             fs.duration_s = *evaluate_at_s;
             let k = fs.mode;
             let hist = free::run_free_vibration(structure, dampers_of(k), &fs)
-                .map_err(DesignError::Solver)?;
+                .map_err(DesignError::from)?;
             let period = 1.0 / structure.modes[k].frequency_hz;
             // the layer study's window: one bare period + 10 % (the loaded structure is slower)
             let stroke = pdamp_structure::study::stroke_at(&hist, *evaluate_at_s, 1.1 * period);

@@ -336,7 +336,7 @@ pub fn write_outputs(
         + 1;
     // robustness of the best listed design (level 2's best where it ran): detuned ±d on level 1
     let robust = &top[0].design;
-    let dampers = space.coupled_dampers(robust).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(robust)?;
     let best_structure = space.structure(robust.choice);
     let d = f.search.detuning;
     let mut rob = String::from("case,frequency_scale,objective_time_simulation\n");
@@ -360,9 +360,7 @@ pub fn write_outputs(
             mm(&bh.displacement_m),
         ));
         for (i, c) in verified.iter().take(3).enumerate() {
-            let dm = space
-                .coupled_dampers(&c.design)
-                .map_err(DesignError::Solver)?;
+            let dm = space.coupled_dampers(&c.design)?;
             if let (_, Some(h)) = time_evaluation(st, space.structure(c.design.choice), &dm)? {
                 p.series.push(Series::new(
                     format!("design {}", i + 1),
@@ -508,9 +506,7 @@ fn frf_plots(
             &freqs,
         )?];
         for c in &top {
-            let dm = space
-                .coupled_dampers(&c.design)
-                .map_err(DesignError::Solver)?;
+            let dm = space.coupled_dampers(&c.design)?;
             columns.push(crate::fidelity::steady_frf_at_output(
                 st,
                 space.structure(c.design.choice),
@@ -589,11 +585,11 @@ fn level1_damping_curves(
             let out_phi = st
                 .structure
                 .point(&st.free.output_point)
-                .map_err(DesignError::Solver)?;
+                .map_err(DesignError::from)?;
             let init_phi = st
                 .structure
                 .point(&st.free.initial_point)
-                .map_err(DesignError::Solver)?;
+                .map_err(DesignError::from)?;
             let k = st.free.mode;
             let x0 = (st.free.initial_displacement_m * out_phi[k] / init_phi[k]).abs();
             let x1 = best
@@ -622,9 +618,7 @@ fn level1_damping_curves(
     for &m in &curve_modes {
         let grid = amplitude_grid(lo, hi, 16);
         for (label, c) in verified.iter().take(3).enumerate() {
-            let dm = space
-                .coupled_dampers(&c.design)
-                .map_err(DesignError::Solver)?;
+            let dm = space.coupled_dampers(&c.design)?;
             let curve =
                 simulated_damping_curve(st, space.structure(c.design.choice), &dm, m - 1, lo, hi)?;
             let ys: Vec<f64> = grid.iter().map(|&x| curve_at(&curve, x)).collect();

@@ -187,7 +187,7 @@ pub fn plan_single_mode(
             time_step_s: 1.0 / (SAMPLES_PER_PERIOD * 2.0 * end),
             sample_every: 1,
         };
-        let hist = forced::run_sweep(&single, dampers, &spec).map_err(DesignError::Solver)?;
+        let hist = forced::run_sweep(&single, dampers, &spec).map_err(DesignError::from)?;
         let mut plan = SweepPlan {
             structure: single.clone(),
             spec,

@@ -64,7 +64,7 @@ pub struct SearchOutcome {
 /// # Errors
 /// A damper spec the structure refuses.
 pub fn screen(space: &Space, d: &Design) -> Result<Evaluation, DesignError> {
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     envelope_evaluation(space.study, space.structure(d.choice), &dampers)
 }
 
@@ -73,7 +73,7 @@ pub fn screen(space: &Space, d: &Design) -> Result<Evaluation, DesignError> {
 /// # Errors
 /// Solver errors.
 pub fn verify(space: &Space, d: &Design) -> Result<Evaluation, DesignError> {
-    let dampers = space.coupled_dampers(d).map_err(DesignError::Solver)?;
+    let dampers = space.coupled_dampers(d)?;
     Ok(time_evaluation(space.study, space.structure(d.choice), &dampers)?.0)
 }
 

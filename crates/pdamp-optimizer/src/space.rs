@@ -6,6 +6,7 @@
 //! effective masses add), so a design's particle numbers are kept sorted ascending and every
 //! multiset is one design.
 
+use crate::error::DesignError;
 use crate::study::{DesignStudy, Direction, ObjectiveSpec};
 use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
 use pdamp_structure::effective::EffectiveDamper;
@@ -425,7 +426,7 @@ impl<'a> Space<'a> {
     ///
     /// # Errors
     /// A damper spec the structure refuses.
-    pub fn coupled_dampers(&self, d: &Design) -> Result<Vec<CoupledDamper>, String> {
+    pub fn coupled_dampers(&self, d: &Design) -> Result<Vec<CoupledDamper>, DesignError> {
         let base = self
             .study
             .scenario_path
@@ -435,7 +436,9 @@ impl<'a> Space<'a> {
         for spec in self.damper_specs(d) {
             let model: Box<dyn EffectiveDamper> = spec
                 .effective_model(base, self.structure(d.choice), self.study.free.mode)?
-                .ok_or("design: a damper without an equivalent model")?;
+                .ok_or_else(|| {
+                    DesignError::Solver("design: a damper without an equivalent model".into())
+                })?;
             out.push(CoupledDamper {
                 point: spec.point().to_string(),
                 model,

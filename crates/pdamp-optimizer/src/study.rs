@@ -98,11 +98,11 @@ impl DesignStudy {
         } else {
             base.join(&file.scenario)
         };
-        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::Load)?;
+        let (scn, spec) = CoupleScenario::load(&scenario_path).map_err(DesignError::from)?;
         let structure = spec
             .build(scenario_path.parent().unwrap_or(Path::new(".")))
             .map_err(|m| {
-                DesignError::Load(pdamp_structure::scenario::locate(
+                DesignError::from(pdamp_structure::scenario::locate_error(
                     &scn.structure_source(&scenario_path),
                     m,
                 ))
@@ -120,7 +120,10 @@ impl DesignStudy {
                     base_amplitude_m: *base_amplitude_m,
                 }
                 .force_n(&spec)
-                .map_err(|m| DesignError::Load(format!("{}: {m}", scenario_path.display())))?,
+                .map_err(|error| DesignError::StructureFile {
+                    path: scenario_path.clone(),
+                    error: Box::new(error),
+                })?,
                 excitation_point: excitation_point.clone(),
             }),
             _ => None,

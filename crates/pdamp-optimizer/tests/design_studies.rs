@@ -807,6 +807,7 @@ fn every_design_couple_and_structure_example_loads() {
             couples += 1;
             pdamp_structure::scenario::CoupleScenario::load(&path)
                 .and_then(|(_, spec)| spec.build(&examples()).map(|_| ()))
+                .map_err(|e| e.to_string())
         } else if name.starts_with("structure_") {
             structures += 1;
             std::fs::read_to_string(&path)
@@ -815,7 +816,12 @@ fn every_design_couple_and_structure_example_loads() {
                     toml::from_str::<pdamp_structure::scenario::StructureFile>(&t)
                         .map_err(|e| e.to_string())
                 })
-                .and_then(|f| f.structure.build(&examples()).map(|_| ()))
+                .and_then(|f| {
+                    f.structure
+                        .build(&examples())
+                        .map(|_| ())
+                        .map_err(|e| e.to_string())
+                })
         } else {
             continue;
         };

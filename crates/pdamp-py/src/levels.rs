@@ -105,7 +105,7 @@ pub(crate) fn couple(
     progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<String> {
     pdamp_structure::scenario::CoupleScenario::load(&path)
-        .map_err(crate::scenario::ScenarioError::new_err)?;
+        .map_err(|e| crate::scenario::ScenarioError::new_err(e.to_string()))?;
     if !(checkpoint_interval_s.is_finite() && checkpoint_interval_s >= 0.0) {
         return Err(pyo3::exceptions::PyValueError::new_err(format!(
             "checkpoint_interval_s must be a finite number of seconds >= 0, got {checkpoint_interval_s}"
@@ -133,10 +133,10 @@ pub(crate) fn couple(
 #[pyo3(signature = (path, out))]
 pub(crate) fn structure_modes(py: Python<'_>, path: PathBuf, out: PathBuf) -> PyResult<String> {
     pdamp_structure::scenario::load_structure(&path)
-        .map_err(crate::scenario::ScenarioError::new_err)?;
+        .map_err(|e| crate::scenario::ScenarioError::new_err(e.to_string()))?;
     let pool = crate::detach::pool(Some(1))?;
     let v = detached(py, &pool, None, |_: &Progress| {
-        pdamp_structure::report::run_modes(&path, &out)
+        Ok(pdamp_structure::report::run_modes(&path, &out)?)
     })?;
     serde_json::to_string(&v).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }

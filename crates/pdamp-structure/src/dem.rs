@@ -34,6 +34,7 @@
 //! $W_{s\to b} = -\sum \tfrac12(Q_n + Q_{n+1})\cdot(q_{n+1} - q_n)$, next to the DEM ledger
 //! (wall work, bed energy change, dissipation), so the exchange can be checked to close.
 
+use crate::StructureError;
 use crate::forced::SweepSpec;
 use crate::free::{FreeVibrationSpec, TimeHistory};
 use crate::integrate::{ModalIntegrator, generalized_force};
@@ -261,16 +262,13 @@ fn resolve_kinematics(
     damper: &Damper,
     damper_point: &str,
     k: &DemKinematics,
-) -> Result<Resolved, String> {
+) -> Result<Resolved, StructureError> {
     let n = structure.modes.len();
-    let rows = |pts: &[Option<String>; 3], what: &str| -> Result<[Vec<f64>; 3], String> {
+    let rows = |pts: &[Option<String>; 3], what: &str| -> Result<[Vec<f64>; 3], StructureError> {
         let mut out = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         for (o, p) in out.iter_mut().zip(pts) {
             if let Some(p) = p {
-                *o = structure
-                    .point(p)
-                    .map_err(|e| format!("{what}: {e}"))?
-                    .to_vec();
+                *o = structure.point(p).map_err(|e| e.context(what))?.to_vec();
             }
         }
         Ok(out)
@@ -343,7 +341,11 @@ struct BedRun {
 
 impl BedRun {
     /// The bed of `b` moved to the structure's initial state (`it`).
-    fn start(structure: &ModalStructure, b: &DemBed, it: &ModalIntegrator) -> Result<Self, String> {
+    fn start(
+        structure: &ModalStructure,
+        b: &DemBed,
+        it: &ModalIntegrator,
+    ) -> Result<Self, StructureError> {
         let damper = b.damper;
         let kin = resolve_kinematics(structure, damper, b.point, &b.coupling.kinematics)?;
         let mut w = damper.settled.clone();
@@ -496,25 +498,28 @@ fn coupled_run(
     load: Load,
     progress: &mut dyn FnMut(f64),
     ck: Option<&CouplingCheckpoint>,
-) -> Result<CoupledResult, String> {
+) -> Result<CoupledResult, StructureError> {
     use pdamp_io::checkpoint as cp;
     structure.validate()?;
-    let first_bed = beds.first().ok_or("a coupled DEM run needs a DEM bed")?;
+    let first_bed = beds
+        .first()
+        .ok_or_else(|| StructureError::inconsistent("a coupled DEM run needs a DEM bed"))?;
     let out = structure.point(output_point)?.to_vec();
     let dt = first_bed.damper.time_step_s;
     for (i, b) in beds.iter().enumerate() {
         if b.damper.time_step_s != dt {
-            return Err(format!(
-                "DEM bed {} at '{}': time step {:e} s, but bed 1's is {dt:e} s; the beds of one \
-                 coupled run step together: give their damper scenarios the same time_step_s",
-                i + 1,
-                b.point,
-                b.damper.time_step_s
+            return Err(StructureError::invalid(
+                format!("DEM bed {} at '{}'", i + 1, b.point),
+                format!(
+                    "time step {:e} s, but bed 1's is {dt:e} s; the beds of one coupled run step \
+                     together: give their damper scenarios the same time_step_s",
+                    b.damper.time_step_s
+                ),
             ));
         }
     }
     crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
-        .map_err(|e| format!("{e} (the time step is the damper scenario's)"))?;
+        .map_err(|e| StructureError::DemTimeStep { error: e })?;
     let mut it = ModalIntegrator::new(structure, dt);
     it.q = q0;
     it.v = v0;
@@ -523,7 +528,7 @@ fn coupled_run(
         .enumerate()
         .map(|(i, b)| {
             BedRun::start(structure, b, &it)
-                .map_err(|e| format!("DEM bed {} at '{}': {e}", i + 1, b.point))
+                .map_err(|e| e.context(format!("DEM bed {} at '{}'", i + 1, b.point)))
         })
         .collect::<Result<Vec<_>, _>>()?;
     let total_load = |runs: &[BedRun], q: &DVector<f64>| -> (DVector<f64>, Vec<DVector<f64>>) {
@@ -561,19 +566,23 @@ fn coupled_run(
     let mut first = 1;
     let header = ck.map(|c| cp::CheckpointHeader::new(COUPLE_KIND, &c.inputs_digest));
     if let Some(c) = ck.filter(|c| c.resume)
-        && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)?
+        && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)
+            .map_err(|e| StructureError::PdampIo(e.to_string()))?
     {
         if st.more_worlds.len() + 1 != runs.len() {
-            return Err(format!(
-                "{}: a checkpoint of {} DEM bed(s), the scenario has {}",
-                c.path.display(),
-                st.more_worlds.len() + 1,
-                runs.len()
+            return Err(StructureError::invalid(
+                c.path.display().to_string(),
+                format!(
+                    "a checkpoint of {} DEM bed(s), the scenario has {}",
+                    st.more_worlds.len() + 1,
+                    runs.len()
+                ),
             ));
         }
         let worlds = std::iter::once(st.world).chain(st.more_worlds);
         for (r, ws) in runs.iter_mut().zip(worlds) {
-            r.w.restore_state(ws)?;
+            r.w.restore_state(ws)
+                .map_err(|e| StructureError::Dem(e.to_string()))?;
         }
         (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
         hist.time_s = st.time;
@@ -600,9 +609,11 @@ fn coupled_run(
     };
     if let Some(s) = snapshots.as_mut() {
         if first > 1 {
-            s.resume_after((first - 1) as u64, dt, &runs[0].w)?;
+            s.resume_after((first - 1) as u64, dt, &runs[0].w)
+                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
         } else {
-            s.on_step(0, 0.0, &runs[0].w)?;
+            s.on_step(0, 0.0, &runs[0].w)
+                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
         }
     }
     let every = sample_every.max(1);
@@ -620,15 +631,13 @@ fn coupled_run(
             energy.structure_work_on_bed_j -= 0.5 * (&r.q_raw + &q_new).dot(&(&it.q - &q_prev));
             r.q_raw = q_new;
             if !l.iter().all(|x| x.is_finite()) || !r.w.ledger.kinetic_j.is_finite() {
-                return Err(format!(
-                    "numerical failure at t = {t1:e} s: the load of DEM bed {} ('{}') on the \
-                     structure became non-finite (bed kinetic energy {:e} J); likely cause: \
-                     the damper scenario's time step {dt:e} s against its contact stiffness \
-                     (check it with `pdamp check`)",
-                    i + 1,
-                    beds[i].point,
-                    r.w.ledger.kinetic_j
-                ));
+                return Err(StructureError::BedLoadNonFinite {
+                    time_s: t1,
+                    bed: i + 1,
+                    point: beds[i].point.to_string(),
+                    kinetic_j: r.w.ledger.kinetic_j,
+                    time_step_s: dt,
+                });
             }
             q_pd += l;
         }
@@ -638,7 +647,8 @@ fn coupled_run(
             push(&it, &mut hist);
         }
         if let Some(s) = snapshots.as_mut() {
-            s.on_step(step as u64, t1, &runs[0].w)?;
+            s.on_step(step as u64, t1, &runs[0].w)
+                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
         }
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);
@@ -662,13 +672,12 @@ fn coupled_run(
                     more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
                     more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
                 };
-                cp::save(&c.path, h, &st)?;
+                cp::save(&c.path, h, &st).map_err(|e| StructureError::PdampIo(e.to_string()))?;
                 if stop {
-                    return Err(cp::Interrupted {
+                    return Err(StructureError::Interrupted(cp::Interrupted {
                         time_s: it.time_s,
                         path: c.path.clone(),
-                    }
-                    .to_string());
+                    }));
                 }
             }
         }
@@ -699,7 +708,7 @@ pub fn run_dem_free(
     opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
-) -> Result<TimeHistory, String> {
+) -> Result<TimeHistory, StructureError> {
     run_dem_free_with_energy(
         structure,
         damper,
@@ -724,7 +733,7 @@ pub fn run_dem_free_with_energy(
     opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
-) -> Result<(TimeHistory, DemEnergy), String> {
+) -> Result<(TimeHistory, DemEnergy), StructureError> {
     let bed = DemBed {
         damper,
         point: damper_point,
@@ -745,14 +754,16 @@ pub fn run_dem_free_beds(
     spec: &FreeVibrationSpec,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
-) -> Result<(TimeHistory, DemEnergy), String> {
+) -> Result<(TimeHistory, DemEnergy), StructureError> {
     let init = structure.point(&spec.initial_point)?;
     let k = spec.mode;
     if k >= structure.modes.len() || init[k] == 0.0 {
-        return Err(format!(
-            "mode {} cannot carry the initial condition at '{}'",
-            k + 1,
-            spec.initial_point
+        return Err(StructureError::rule(
+            format!("mode {}", k + 1),
+            format!(
+                "cannot carry the initial condition at '{}'",
+                spec.initial_point
+            ),
         ));
     }
     let n = structure.modes.len();
@@ -794,7 +805,7 @@ pub fn run_dem_sweep(
     opts: &DemCoupling,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
-) -> Result<TimeHistory, String> {
+) -> Result<TimeHistory, StructureError> {
     let bed = DemBed {
         damper,
         point: damper_point,
@@ -816,7 +827,7 @@ pub fn run_dem_sweep_beds(
     spec: &SweepSpec,
     progress: &mut dyn FnMut(f64),
     checkpoint: Option<&CouplingCheckpoint>,
-) -> Result<(TimeHistory, DemEnergy), String> {
+) -> Result<(TimeHistory, DemEnergy), StructureError> {
     spec.sweep.validate()?;
     let ex = structure.point(&spec.excitation_point)?.to_vec();
     let n = structure.modes.len();

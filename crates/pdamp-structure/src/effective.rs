@@ -4,6 +4,7 @@
 //! [D Eq. 3.39], from a viscous reference, an effective field (`fields.csv`) or analytical
 //! formulas ([`crate::formulas`]).
 
+use crate::StructureError;
 use std::path::Path;
 
 /// Effective properties of a damper at one excitation state.
@@ -176,7 +177,7 @@ impl FieldTable {
         header: &[String],
         rows: &[Vec<f64>],
         bed_mass_kg: f64,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, StructureError> {
         Self::from_rows_at(header, rows, None, bed_mass_kg)
     }
 
@@ -185,8 +186,8 @@ impl FieldTable {
     ///
     /// # Errors
     /// CSV errors and everything [`Self::from_rows_at`] refuses.
-    pub fn parse(text: &str, bed_mass_kg: f64) -> Result<Self, String> {
-        let (header, rows) = pdamp_io::csv::parse_csv_f64(text).map_err(|e| e.to_string())?;
+    pub fn parse(text: &str, bed_mass_kg: f64) -> Result<Self, StructureError> {
+        let (header, rows) = pdamp_io::csv::parse_csv_f64(text)?;
         // the lines parse_csv_f64 reads: not blank, not a '#' comment; the first is the header
         let lines: Vec<usize> = text
             .lines()
@@ -213,20 +214,26 @@ impl FieldTable {
         rows: &[Vec<f64>],
         lines: Option<&[usize]>,
         bed_mass_kg: f64,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, StructureError> {
         if !(bed_mass_kg > 0.0 && bed_mass_kg.is_finite()) {
-            return Err(format!("bed_mass_kg must be > 0, got {bed_mass_kg}"));
+            return Err(StructureError::rule(
+                "bed_mass_kg",
+                format!("must be > 0, got {bed_mass_kg}"),
+            ));
         }
+        let no_column =
+            |name: &str| StructureError::invalid("fields.csv", format!("no column {name}"));
         let col = |name: &str| header.iter().position(|h| h.trim() == name);
-        let fi = col("frequency_hz").ok_or("fields.csv: no column frequency_hz")?;
-        let xi = col("amplitude_m").ok_or("fields.csv: no column amplitude_m")?;
-        let mi = col("effective_mass_ratio").ok_or("fields.csv: no column effective_mass_ratio")?;
+        let fi = col("frequency_hz").ok_or_else(|| no_column("frequency_hz"))?;
+        let xi = col("amplitude_m").ok_or_else(|| no_column("amplitude_m"))?;
+        let mi = col("effective_mass_ratio").ok_or_else(|| no_column("effective_mass_ratio"))?;
         let ei = col("effective_loss_factor");
         let di = col("dissipated_energy_per_cycle_j");
         if ei.is_none() && di.is_none() {
-            return Err(
-                "fields.csv: needs effective_loss_factor or dissipated_energy_per_cycle_j".into(),
-            );
+            return Err(StructureError::invalid(
+                "fields.csv",
+                "needs effective_loss_factor or dissipated_energy_per_cycle_j",
+            ));
         }
         let mut pts: Vec<(f64, f64, f64, f64)> = Vec::new();
         let eta_col = if ei.is_some() {
@@ -243,9 +250,12 @@ impl FieldTable {
             let (f, x, m) = (get(fi), get(xi), get(mi));
             for (col, v) in [("frequency_hz", f), ("amplitude_m", x)] {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(format!(
-                        "{at}: column {col} = {v} must be a finite number > 0 (a grid point of \
-                         the effective field)"
+                    return Err(StructureError::invalid(
+                        at,
+                        format!(
+                            "column {col} = {v} must be a finite number > 0 (a grid point of \
+                             the effective field)"
+                        ),
                     ));
                 }
             }
@@ -260,23 +270,32 @@ impl FieldTable {
                 continue; // a failed point of `pdamp fields`
             }
             if !eta.is_finite() || eta < -1e-6 {
-                return Err(format!(
-                    "{at}: column {eta_col} gives η̄ = {eta:e}; the effective loss factor must be \
-                     a finite number ≥ 0 (energy is dissipated, not created): recompute the \
-                     point or remove the row"
+                return Err(StructureError::invalid(
+                    at,
+                    format!(
+                        "column {eta_col} gives η̄ = {eta:e}; the effective loss factor must be \
+                         a finite number ≥ 0 (energy is dissipated, not created): recompute the \
+                         point or remove the row"
+                    ),
                 ));
             }
             eta = eta.max(0.0);
             if !(m.is_finite() && m >= 0.0) {
-                return Err(format!(
-                    "{at}: column effective_mass_ratio = {m:e} must be a finite number ≥ 0 \
-                     (m̄_bed/m_bed): recompute the point or remove the row"
+                return Err(StructureError::invalid(
+                    at,
+                    format!(
+                        "column effective_mass_ratio = {m:e} must be a finite number ≥ 0 \
+                         (m̄_bed/m_bed): recompute the point or remove the row"
+                    ),
                 ));
             }
             pts.push((f, x, eta, m));
         }
         if pts.is_empty() {
-            return Err("fields.csv: no usable (finite) points".into());
+            return Err(StructureError::invalid(
+                "fields.csv",
+                "no usable (finite) points",
+            ));
         }
         pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let mut frequencies_hz: Vec<f64> = Vec::new();
@@ -317,9 +336,9 @@ impl FieldTable {
     ///
     /// # Errors
     /// I/O and format errors, see [`Self::from_rows`].
-    pub fn read(path: &Path, bed_mass_kg: f64) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        Self::parse(&text, bed_mass_kg).map_err(|e| format!("{}: {e}", path.display()))
+    pub fn read(path: &Path, bed_mass_kg: f64) -> Result<Self, StructureError> {
+        let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
+        Self::parse(&text, bed_mass_kg).map_err(|e| e.context(path.display().to_string()))
     }
 
     /// Interpolated (η̄, m̄/m_bed) at (f, X).

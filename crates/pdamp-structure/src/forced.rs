@@ -4,6 +4,7 @@
 //! rational-fraction-polynomial fit, and the steady-state iteration scheme for approaches 2/3
 //! [D Fig. 3.7, Eq. 3.48–3.50] including a full steady-state FRF.
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::free::{CoupledDamper, TimeHistory, UpdateRecord};
 use crate::integrate::{Attachment, ModalIntegrator, generalized_force};
@@ -69,14 +70,17 @@ impl Sweep {
     ///
     /// # Errors
     /// A message naming the key and the fix.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         for (key, v) in [
             ("start_hz", self.start_hz),
             ("end_hz", self.end_hz),
             ("duration_s", self.duration_s),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("sweep: {key} = {v:e} must be a finite number > 0"));
+                return Err(StructureError::invalid(
+                    "sweep",
+                    format!("{key} = {v:e} must be a finite number > 0"),
+                ));
             }
         }
         Ok(())
@@ -89,23 +93,29 @@ impl SweepSpec {
     ///
     /// # Errors
     /// A message naming the key and the fix.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         self.sweep.validate()?;
         if !self.force_amplitude_n.is_finite() {
-            return Err(format!(
-                "sweep: force amplitude {:e} N must be finite",
-                self.force_amplitude_n
+            return Err(StructureError::invalid(
+                "sweep",
+                format!(
+                    "force amplitude {:e} N must be finite",
+                    self.force_amplitude_n
+                ),
             ));
         }
         let f_max = self.sweep.start_hz.max(self.sweep.end_hz);
         if self.time_step_s.is_finite() && self.time_step_s * f_max > 0.125 {
-            return Err(format!(
-                "sweep: time_step_s = {:e} s resolves the highest excitation frequency {f_max:e} \
-                 Hz with {:.2} steps per period; use at most {:e} s (8 steps per period, better \
-                 20)",
-                self.time_step_s,
-                1.0 / (self.time_step_s * f_max),
-                0.125 / f_max
+            return Err(StructureError::invalid(
+                "sweep",
+                format!(
+                    "time_step_s = {:e} s resolves the highest excitation frequency {f_max:e} \
+                     Hz with {:.2} steps per period; use at most {:e} s (8 steps per period, \
+                     better 20)",
+                    self.time_step_s,
+                    1.0 / (self.time_step_s * f_max),
+                    0.125 / f_max
+                ),
             ));
         }
         Ok(())
@@ -138,7 +148,7 @@ pub fn run_sweep(
     structure: &ModalStructure,
     dampers: &[CoupledDamper],
     spec: &SweepSpec,
-) -> Result<TimeHistory, String> {
+) -> Result<TimeHistory, StructureError> {
     structure.validate()?;
     spec.validate()?;
     crate::integrate::validate_settings(

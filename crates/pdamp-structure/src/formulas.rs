@@ -13,6 +13,7 @@
 //! Ẽ = 2π η̄ E_kin, E_kin = ½ m_bed V², D Eq. 3.15; the text's Eq. 5.2/6.2 give the per-radian
 //! E_diss, converted here).
 
+use crate::StructureError;
 use crate::effective::{EffectiveDamper, EffectiveState};
 use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
 use std::f64::consts::{PI, TAU};
@@ -571,12 +572,15 @@ impl PowderFrictionDamper {
     ///
     /// # Errors
     /// Non-positive or non-finite values.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         let pos = |v: f64, k: &str| {
             if v > 0.0 && v.is_finite() {
                 Ok(())
             } else {
-                Err(format!("powder_friction: {k} must be > 0, got {v}"))
+                Err(StructureError::invalid(
+                    "powder_friction",
+                    format!("{k} must be > 0, got {v}"),
+                ))
             }
         };
         pos(self.cavity_length_m, "cavity_length_m")?;
@@ -590,11 +594,17 @@ impl PowderFrictionDamper {
             (self.effective_mass_kg, "effective_mass_kg"),
         ] {
             if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("powder_friction: {k} must be ≥ 0, got {v}"));
+                return Err(StructureError::invalid(
+                    "powder_friction",
+                    format!("{k} must be ≥ 0, got {v}"),
+                ));
             }
         }
         if !self.angle_per_displacement_rad_m.is_finite() {
-            return Err("powder_friction: angle_per_displacement_rad_m must be finite".into());
+            return Err(StructureError::invalid(
+                "powder_friction",
+                "angle_per_displacement_rad_m must be finite",
+            ));
         }
         Ok(())
     }
@@ -761,7 +771,7 @@ mod tests {
         d.friction = 0.0;
         assert_eq!(d.evaluate(1e-4, 100.0).dissipated_energy_per_cycle_j, 0.0);
         d.friction = -1.0;
-        assert!(d.validate().unwrap_err().contains("friction"));
+        assert!(d.validate().unwrap_err().to_string().contains("friction"));
     }
 
     #[test]

@@ -8,6 +8,7 @@
 //! $\bar\omega$ depends on $\bar m_{bed}$ [D Eq. 3.33] which depends on Ω and X, each update is
 //! a fixed-point iteration with $\Omega = \bar\omega_k$ [D Sect. 3.3.1].
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::integrate::{Attachment, ModalIntegrator};
 use crate::modal::ModalStructure;
@@ -172,13 +173,12 @@ pub fn run_free_vibration(
     structure: &ModalStructure,
     dampers: &[CoupledDamper],
     spec: &FreeVibrationSpec,
-) -> Result<TimeHistory, String> {
+) -> Result<TimeHistory, StructureError> {
     structure.validate()?;
     if spec.mode >= structure.modes.len() {
-        return Err(format!(
-            "mode {} does not exist ({} modes)",
-            spec.mode + 1,
-            structure.modes.len()
+        return Err(StructureError::rule(
+            format!("mode {}", spec.mode + 1),
+            format!("does not exist ({} modes)", structure.modes.len()),
         ));
     }
     crate::integrate::validate_settings(
@@ -189,10 +189,10 @@ pub fn run_free_vibration(
         false,
     )?;
     if !(spec.initial_displacement_m.is_finite() && spec.initial_velocity_m_s.is_finite()) {
-        return Err(format!(
+        return Err(StructureError::inconsistent(format!(
             "initial_displacement_m = {:e}, initial_velocity_m_s = {:e}: must be finite",
             spec.initial_displacement_m, spec.initial_velocity_m_s
-        ));
+        )));
     }
     let init = structure.point(&spec.initial_point)?.to_vec();
     let out = structure.point(&spec.output_point)?.to_vec();
@@ -202,11 +202,11 @@ pub fn run_free_vibration(
         .collect::<Result<_, _>>()?;
     let k = spec.mode;
     if init[k] == 0.0 {
-        return Err(format!(
+        return Err(StructureError::inconsistent(format!(
             "point '{}' is a node of mode {}: cannot set the initial condition there",
             spec.initial_point,
             k + 1
-        ));
+        )));
     }
     let mut it = ModalIntegrator::new(structure, spec.time_step_s);
     let scale = if spec.scale_initial_by_bed_mass {
@@ -336,9 +336,15 @@ pub struct CycleDamping {
 
 /// Positive peaks of a uniformly sampled decay (parabolic refinement, pdamp-signal), with
 /// peaks closer than `min_separation_s` merged.
-pub fn decay_peaks(hist: &TimeHistory, min_separation_s: f64) -> Result<Vec<(f64, f64)>, String> {
+///
+/// # Errors
+/// Fewer than three samples; errors of the peak search.
+pub fn decay_peaks(
+    hist: &TimeHistory,
+    min_separation_s: f64,
+) -> Result<Vec<(f64, f64)>, StructureError> {
     if hist.time_s.len() < 3 {
-        return Err("too few samples".into());
+        return Err(StructureError::numerical("too few samples"));
     }
     let dt = hist.time_s[1] - hist.time_s[0];
     let peaks = find_peaks(
@@ -349,8 +355,7 @@ pub fn decay_peaks(hist: &TimeHistory, min_separation_s: f64) -> Result<Vec<(f64
             min_separation_s,
             ..Default::default()
         },
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(peaks.iter().map(|p| (p.time_s, p.value)).collect())
 }
 

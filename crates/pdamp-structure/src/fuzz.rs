@@ -40,7 +40,8 @@ pub fn dof_map(bytes: &[u8]) {
 /// modal, a beam of at most 200 elements) — built.
 pub fn structure_scenario(bytes: &[u8]) {
     let text = String::from_utf8_lossy(bytes);
-    let locate = |m: String| {
+    let locate = |m: crate::StructureError| {
+        let m = m.to_string();
         let _ = pdamp_io::scenario::locate_key(&text, pdamp_io::scenario::leading_key_path(&m));
     };
     let spec = if let Ok(f) = toml::from_str::<crate::scenario::StructureFile>(&text) {

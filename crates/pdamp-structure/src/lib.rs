@@ -23,6 +23,7 @@
 pub mod dem;
 pub mod design;
 pub mod effective;
+pub mod error;
 pub mod fe;
 pub mod forced;
 pub mod formulas;
@@ -38,4 +39,5 @@ pub mod scenario;
 pub mod sparse;
 pub mod study;
 
+pub use error::StructureError;
 pub use modal::{ModalPoint, ModalStructure, Mode};

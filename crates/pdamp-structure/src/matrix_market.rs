@@ -51,6 +51,57 @@ pub enum MatrixMarketError {
         /// The I/O error text.
         message: String,
     },
+    /// K and M of [`check_structural_pair`] are not square or differ in size.
+    #[error(
+        "stiffness '{k_file}' is {k_rows}×{k_cols}, mass '{m_file}' is {m_rows}×{m_cols}: both \
+         must be square and of one size"
+    )]
+    PairSizes {
+        /// The stiffness file.
+        k_file: String,
+        /// Rows of K.
+        k_rows: usize,
+        /// Columns of K.
+        k_cols: usize,
+        /// The mass file.
+        m_file: String,
+        /// Rows of M.
+        m_rows: usize,
+        /// Columns of M.
+        m_cols: usize,
+    },
+    /// An entry of K or M violates a structural check ([`check_structural_pair`]).
+    #[error("{matrix} '{file}', line {line}: {message}")]
+    PairEntry {
+        /// `stiffness` or `mass`.
+        matrix: &'static str,
+        /// The file.
+        file: String,
+        /// 1-based line of the entry in the file.
+        line: usize,
+        /// What is wrong and the fix.
+        message: String,
+    },
+    /// K or M as a whole violates a structural check ([`check_structural_pair`]).
+    #[error("{matrix} '{file}': {message}")]
+    PairMatrix {
+        /// `stiffness` or `mass`.
+        matrix: &'static str,
+        /// The file.
+        file: String,
+        /// What is wrong and the fix.
+        message: String,
+    },
+    /// A sparse matrix of the checks could not be built.
+    #[error(transparent)]
+    Sparse(#[from] crate::sparse::SparseError),
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<MatrixMarketError> for String {
+    fn from(e: MatrixMarketError) -> String {
+        e.to_string()
+    }
 }
 
 /// A sparse matrix as triplets (0-based).
@@ -462,30 +513,37 @@ pub fn check_structural_pair(
     m: &CooMatrix,
     m_file: &str,
     map: Option<&DofMap>,
-) -> Result<(), String> {
+) -> Result<(), MatrixMarketError> {
     if k.nrows != k.ncols || m.nrows != m.ncols || k.nrows != m.nrows {
-        return Err(format!(
-            "stiffness '{k_file}' is {}×{}, mass '{m_file}' is {}×{}: both must be square and \
-             of one size",
-            k.nrows, k.ncols, m.nrows, m.ncols
-        ));
+        return Err(MatrixMarketError::PairSizes {
+            k_file: k_file.to_string(),
+            k_rows: k.nrows,
+            k_cols: k.ncols,
+            m_file: m_file.to_string(),
+            m_rows: m.nrows,
+            m_cols: m.ncols,
+        });
     }
     let n = k.nrows;
     for (a, file, what) in [(k, k_file, "stiffness"), (m, m_file, "mass")] {
         if let Some((e, l, v, w)) = a.asymmetry(SYMMETRY_TOLERANCE) {
             let (i, j, _) = a.entries[e];
-            return Err(format!(
-                "{what} '{file}', line {}: a({}, {}) = {v:e} but a({}, {}) = {w:e} ({}): a \
-                 structural matrix must be symmetric (|a_ij − a_ji| ≤ {SYMMETRY_TOLERANCE:e}·max|a| \
-                 = {:e}); export the symmetric matrix (or one triangle as 'symmetric')",
-                a.line_of(e),
-                i + 1,
-                j + 1,
-                j + 1,
-                i + 1,
-                entry_at(a, l),
-                SYMMETRY_TOLERANCE * a.max_abs()
-            ));
+            return Err(MatrixMarketError::PairEntry {
+                matrix: what,
+                file: file.to_string(),
+                line: a.line_of(e),
+                message: format!(
+                    "a({}, {}) = {v:e} but a({}, {}) = {w:e} ({}): a structural matrix must be \
+                     symmetric (|a_ij − a_ji| ≤ {SYMMETRY_TOLERANCE:e}·max|a| = {:e}); export the \
+                     symmetric matrix (or one triangle as 'symmetric')",
+                    i + 1,
+                    j + 1,
+                    j + 1,
+                    i + 1,
+                    entry_at(a, l),
+                    SYMMETRY_TOLERANCE * a.max_abs()
+                ),
+            });
         }
     }
     let (kd, md) = (k.diagonal(), m.diagonal());
@@ -493,26 +551,33 @@ pub fn check_structural_pair(
         |a: &CooMatrix, i: usize| entry_at(a, a.entries.iter().position(|e| e.0 == i && e.1 == i));
     for i in 0..n {
         if md[i] <= 0.0 {
-            return Err(format!(
-                "mass '{m_file}': diagonal entry m({0}, {0}) of {1} is {2:e} ({3}): the mass \
-                 matrix must be positive definite; give every dof mass (rotary inertia for \
-                 rotations) or remove the dof from the export",
-                i + 1,
-                row_name(i, map),
-                md[i],
-                diag_line(m, i)
-            ));
+            return Err(MatrixMarketError::PairMatrix {
+                matrix: "mass",
+                file: m_file.to_string(),
+                message: format!(
+                    "diagonal entry m({0}, {0}) of {1} is {2:e} ({3}): the mass matrix must be \
+                     positive definite; give every dof mass (rotary inertia for rotations) or \
+                     remove the dof from the export",
+                    i + 1,
+                    row_name(i, map),
+                    md[i],
+                    diag_line(m, i)
+                ),
+            });
         }
         if kd[i] < 0.0 {
-            return Err(format!(
-                "stiffness '{k_file}': diagonal entry k({0}, {0}) of {1} is {2:e} ({3}): the \
-                 stiffness matrix must be positive semi-definite (wrong sign or a stress-stiffened \
-                 export?)",
-                i + 1,
-                row_name(i, map),
-                kd[i],
-                diag_line(k, i)
-            ));
+            return Err(MatrixMarketError::PairMatrix {
+                matrix: "stiffness",
+                file: k_file.to_string(),
+                message: format!(
+                    "diagonal entry k({0}, {0}) of {1} is {2:e} ({3}): the stiffness matrix must \
+                     be positive semi-definite (wrong sign or a stress-stiffened export?)",
+                    i + 1,
+                    row_name(i, map),
+                    kd[i],
+                    diag_line(k, i)
+                ),
+            });
         }
     }
     for (a, d, file, what, strict) in [
@@ -527,28 +592,33 @@ pub fn check_structural_pair(
                 v * v > bound * (1.0 + 1e-9) + f64::MIN_POSITIVE
             };
             if i != j && bad {
-                return Err(format!(
-                    "{what} '{file}', line {}: a({}, {}) = {v:e} exceeds √(a_ii·a_jj) = {:e} \
-                     ({} and {}): the {what} matrix is not positive {}definite",
-                    a.line_of(e),
-                    i + 1,
-                    j + 1,
-                    bound.sqrt(),
-                    row_name(i, map),
-                    row_name(j, map),
-                    if strict { "" } else { "semi-" }
-                ));
+                return Err(MatrixMarketError::PairEntry {
+                    matrix: what,
+                    file: file.to_string(),
+                    line: a.line_of(e),
+                    message: format!(
+                        "a({}, {}) = {v:e} exceeds √(a_ii·a_jj) = {:e} ({} and {}): the {what} \
+                         matrix is not positive {}definite",
+                        i + 1,
+                        j + 1,
+                        bound.sqrt(),
+                        row_name(i, map),
+                        row_name(j, map),
+                        if strict { "" } else { "semi-" }
+                    ),
+                });
             }
         }
     }
     let ms = crate::sparse::SparseSym::from_triplets(n, &m.entries, false)?;
     let perm = crate::sparse::rcm_order(&ms);
-    let not_pd = || {
-        format!(
-            "mass '{m_file}': the mass matrix is not positive definite (its LDLᵀ factorization \
-             has a non-positive pivot): a dof without mass or a wrong sign; give every dof mass \
-             or remove it from the export"
-        )
+    let not_pd = || MatrixMarketError::PairMatrix {
+        matrix: "mass",
+        file: m_file.to_string(),
+        message: "the mass matrix is not positive definite (its LDLᵀ factorization has a \
+                  non-positive pivot): a dof without mass or a wrong sign; give every dof mass \
+                  or remove it from the export"
+            .to_string(),
     };
     let fac = crate::sparse::SkylineLdlt::factor(&ms, &perm).map_err(|_| not_pd())?;
     if fac.negative_pivots() > 0 {
@@ -565,11 +635,15 @@ pub fn check_structural_pair(
             Err(_) => 0, // singular at the shift: an eigenvalue at −σ exactly, not decided here
         };
         if negative > 0 {
-            return Err(format!(
-                "stiffness '{k_file}': the stiffness matrix is not positive semi-definite: \
-                 {negative} eigenvalue(s) of (K, M) lie below −{sigma:e} (1/s²); check the sign \
-                 of the export and that K holds no stress-stiffening or follower terms"
-            ));
+            return Err(MatrixMarketError::PairMatrix {
+                matrix: "stiffness",
+                file: k_file.to_string(),
+                message: format!(
+                    "the stiffness matrix is not positive semi-definite: {negative} eigenvalue(s) \
+                     of (K, M) lie below −{sigma:e} (1/s²); check the sign of the export and that \
+                     K holds no stress-stiffening or follower terms"
+                ),
+            });
         }
     }
     Ok(())

@@ -5,6 +5,7 @@
 //! $L^{-1} K L^{-T} y = \omega^2 y$, $\phi = L^{-T} y$, which gives mass-normalised shapes
 //! ($\Phi^T M \Phi = E$, $\Phi^T K \Phi = \Omega$). Dense is adequate up to a few thousand dof.
 
+use crate::StructureError;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
@@ -29,35 +30,37 @@ pub fn lowest_modes(
     mass: &DMatrix<f64>,
     n_modes: usize,
     min_frequency_hz: f64,
-) -> Result<ModalBasis, String> {
+) -> Result<ModalBasis, StructureError> {
     let n = stiffness.nrows();
     if stiffness.ncols() != n || mass.nrows() != n || mass.ncols() != n {
-        return Err(format!(
+        return Err(StructureError::numerical(format!(
             "K is {}×{}, M is {}×{}: both must be square and equal",
             stiffness.nrows(),
             stiffness.ncols(),
             mass.nrows(),
             mass.ncols()
-        ));
+        )));
     }
     if n == 0 {
-        return Err("empty model (no active dof)".into());
+        return Err(StructureError::numerical("empty model (no active dof)"));
     }
     if stiffness.iter().chain(mass.iter()).any(|v| !v.is_finite()) {
-        return Err("K or M has non-finite entries".into());
+        return Err(StructureError::numerical("K or M has non-finite entries"));
     }
-    let chol = nalgebra::Cholesky::new(mass.clone()).ok_or(
-        "the mass matrix is not positive definite (a dof has stiffness but no mass: add rotary \
-         inertia or a point mass, or fix the dof)",
-    )?;
+    let chol = nalgebra::Cholesky::new(mass.clone()).ok_or_else(|| {
+        StructureError::numerical(
+            "the mass matrix is not positive definite (a dof has stiffness but no mass: add \
+             rotary inertia or a point mass, or fix the dof)",
+        )
+    })?;
     let l = chol.l();
     // A = L⁻¹ K L⁻ᵀ
     let x = l
         .solve_lower_triangular(stiffness)
-        .ok_or("singular Cholesky factor")?;
+        .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
     let a = l
         .solve_lower_triangular(&x.transpose())
-        .ok_or("singular Cholesky factor")?;
+        .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
     let a = (&a + a.transpose()) * 0.5;
     let eig = nalgebra::SymmetricEigen::new(a);
     let mut order: Vec<usize> = (0..n).collect();
@@ -76,7 +79,7 @@ pub fn lowest_modes(
         let y = eig.eigenvectors.column(i).into_owned();
         let mut phi = lt
             .solve_upper_triangular(&y)
-            .ok_or("singular Cholesky factor")?;
+            .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
         // Sign convention: the largest component positive.
         let imax = phi.iamax();
         if phi[imax] < 0.0 {
@@ -86,7 +89,9 @@ pub fn lowest_modes(
         cols.push(phi);
     }
     if cols.is_empty() {
-        return Err(format!("no mode above {min_frequency_hz} Hz"));
+        return Err(StructureError::numerical(format!(
+            "no mode above {min_frequency_hz} Hz"
+        )));
     }
     Ok(ModalBasis {
         omega_rad_s: omegas,
@@ -154,14 +159,14 @@ impl ModalStructure {
     ///
     /// # Errors
     /// Unknown point name.
-    pub fn point(&self, name: &str) -> Result<&[f64], String> {
+    pub fn point(&self, name: &str) -> Result<&[f64], StructureError> {
         self.points
             .iter()
             .find(|p| p.name == name)
             .map(|p| p.shape.as_slice())
-            .ok_or_else(|| {
-                let names: Vec<_> = self.points.iter().map(|p| p.name.as_str()).collect();
-                format!("no structure point named '{name}' (known: {names:?})")
+            .ok_or_else(|| StructureError::UnknownPoint {
+                name: name.to_string(),
+                known: self.points.iter().map(|p| p.name.clone()).collect(),
             })
     }
 
@@ -176,7 +181,11 @@ impl ModalStructure {
 
     /// Equivalent single-mode parameters of mode `k` in the coordinates of point `point`
     /// [D Eq. 3.27]: $M = 1/\phi^2$, $K = \omega_k^2/\phi^2$, $D = 2\zeta_k\omega_k/\phi^2$.
-    pub fn equivalent_sdof(&self, k: usize, point: &str) -> Result<(f64, f64, f64), String> {
+    pub fn equivalent_sdof(
+        &self,
+        k: usize,
+        point: &str,
+    ) -> Result<(f64, f64, f64), StructureError> {
         let phi = self.point(point)?[k];
         let m = &self.modes[k];
         let w = m.omega_rad_s();
@@ -185,29 +194,40 @@ impl ModalStructure {
     }
 
     /// Checks sizes and values.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         if self.modes.is_empty() {
-            return Err("structure has no modes".into());
+            return Err(StructureError::rule("structure", "has no modes"));
         }
         for (k, m) in self.modes.iter().enumerate() {
             if !(m.frequency_hz.is_finite() && m.frequency_hz >= 0.0) {
-                return Err(format!("mode {}: frequency must be ≥ 0", k + 1));
+                return Err(StructureError::invalid(
+                    format!("mode {}", k + 1),
+                    "frequency must be ≥ 0",
+                ));
             }
             if !(m.damping_ratio.is_finite() && m.damping_ratio >= 0.0) {
-                return Err(format!("mode {}: damping ratio must be ≥ 0", k + 1));
+                return Err(StructureError::invalid(
+                    format!("mode {}", k + 1),
+                    "damping ratio must be ≥ 0",
+                ));
             }
         }
         for p in &self.points {
             if p.shape.len() != self.modes.len() {
-                return Err(format!(
-                    "point '{}' has {} mode-shape values for {} modes",
-                    p.name,
-                    p.shape.len(),
-                    self.modes.len()
+                return Err(StructureError::rule(
+                    format!("point '{}'", p.name),
+                    format!(
+                        "has {} mode-shape values for {} modes",
+                        p.shape.len(),
+                        self.modes.len()
+                    ),
                 ));
             }
             if p.shape.iter().any(|v| !v.is_finite()) {
-                return Err(format!("point '{}': non-finite mode-shape value", p.name));
+                return Err(StructureError::invalid(
+                    format!("point '{}'", p.name),
+                    "non-finite mode-shape value",
+                ));
             }
         }
         Ok(())

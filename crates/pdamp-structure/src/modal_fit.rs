@@ -15,6 +15,7 @@
 //! - [`half_power_per_mode`]: half-power bandwidth $\zeta \approx (f_2 - f_1)/(2f_r)$ around each
 //!   resonance (pdamp-signal), each searched between the midpoints to its neighbours.
 
+use crate::StructureError;
 use nalgebra::{DMatrix, DVector};
 use pdamp_signal::Complex64;
 use serde::Serialize;
@@ -53,27 +54,43 @@ pub struct RfpFit {
 ///
 /// # Errors
 /// Too few points (need ≥ 4N + 3), non-positive or non-finite frequencies, or a singular fit.
-pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Result<RfpFit, String> {
+pub fn rfp_fit(
+    frequencies_hz: &[f64],
+    h: &[Complex64],
+    n_modes: usize,
+) -> Result<RfpFit, StructureError> {
     let n = frequencies_hz.len();
     if n != h.len() {
-        return Err("rfp_fit: frequency and FRF lengths differ".into());
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "frequency and FRF lengths differ",
+        ));
     }
     if n_modes == 0 {
-        return Err("rfp_fit: ask for at least one mode".into());
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "ask for at least one mode",
+        ));
     }
     let na = 2 * n_modes; // denominator degree (monic)
     let nb = 2 * n_modes + 1; // numerator degree
     let unknowns = na + nb + 1;
     if 2 * n < unknowns + 2 {
-        return Err(format!(
-            "rfp_fit: {n} points are too few for {n_modes} modes (need ≥ {})",
-            unknowns.div_ceil(2) + 1
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            format!(
+                "{n} points are too few for {n_modes} modes (need ≥ {})",
+                unknowns.div_ceil(2) + 1
+            ),
         ));
     }
     if frequencies_hz.iter().any(|f| !(f.is_finite() && *f > 0.0))
         || h.iter().any(|c| !(c.re.is_finite() && c.im.is_finite()))
     {
-        return Err("rfp_fit: non-finite FRF or non-positive frequency".into());
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "non-finite FRF or non-positive frequency",
+        ));
     }
     let w_max = frequencies_hz.iter().fold(0.0f64, |a, &f| a.max(TAU * f));
     let w_min = frequencies_hz
@@ -120,10 +137,9 @@ pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Resul
         for (j, nj) in norms.iter().enumerate() {
             m.column_mut(j).scale_mut(1.0 / nj);
         }
-        let sol = m
-            .svd(true, true)
-            .solve(&rhs, 1e-13)
-            .map_err(|e| format!("rfp_fit: least squares failed: {e}"))?;
+        let sol = m.svd(true, true).solve(&rhs, 1e-13).map_err(|e| {
+            StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
+        })?;
         for j in 0..na {
             a_coef[j] = sol[nb + 1 + j] / norms[nb + 1 + j];
         }
@@ -195,7 +211,7 @@ pub fn rfp_fit(frequencies_hz: &[f64], h: &[Complex64], n_modes: usize) -> Resul
         .clone()
         .svd(true, true)
         .solve(&rhs, 1e-13)
-        .map_err(|e| format!("rfp_fit: residue fit failed: {e}"))?;
+        .map_err(|e| StructureError::numerical(format!("rfp_fit: residue fit failed: {e}")))?;
     let fitted = &m * &sol;
     let relative_error = (&fitted - &rhs).norm() / rhs.norm().max(1e-300);
     let modes = poles

@@ -22,6 +22,7 @@
 //! damper_amplitude_m,effective_loss_factor,converged`), `positions.png/svg` (ζ over the
 //! position, one line per mode), `summary.json` (best position per mode).
 
+use crate::StructureError;
 use crate::forced::{ModeCoupling, resonance_equilibrium};
 use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, PointSpec, StructureSpec};
 use pdamp_io::csv::write_csv_atomic;
@@ -98,28 +99,29 @@ impl PositionStudySpec {
     ///
     /// # Errors
     /// Neither or both of `positions_m` and `start_m`/`end_m`/`count`, empty or non-finite.
-    pub fn positions(&self) -> Result<Vec<f64>, String> {
+    pub fn positions(&self) -> Result<Vec<f64>, StructureError> {
         let v = match (&self.positions_m, self.start_m, self.end_m, self.count) {
             (Some(p), None, None, None) => p.clone(),
             (None, Some(a), Some(b), Some(n)) if (2..=MAX_POSITIONS).contains(&n) => (0..n)
                 .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
                 .collect(),
             _ => {
-                return Err(format!(
-                    "study: give positions_m, or start_m + end_m + count (2 to {MAX_POSITIONS})"
+                return Err(StructureError::invalid(
+                    "study",
+                    format!("give positions_m, or start_m + end_m + count (2 to {MAX_POSITIONS})"),
                 ));
             }
         };
         if v.is_empty() || v.len() > MAX_POSITIONS {
-            return Err(format!(
-                "study.positions_m: give 1 to {MAX_POSITIONS} positions, got {}",
-                v.len()
+            return Err(StructureError::invalid(
+                "study.positions_m",
+                format!("give 1 to {MAX_POSITIONS} positions, got {}", v.len()),
             ));
         }
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            return Err(format!(
-                "study.positions_m[{i}] must be a finite number, got {}",
-                v[i]
+            return Err(StructureError::rule(
+                format!("study.positions_m[{i}]"),
+                format!("must be a finite number, got {}", v[i]),
             ));
         }
         Ok(v)
@@ -135,12 +137,14 @@ pub fn position_study(
     structure: &StructureSpec,
     base: &Path,
     spec: &PositionStudySpec,
-) -> Result<Vec<PositionResult>, String> {
+) -> Result<Vec<PositionResult>, StructureError> {
     let positions = spec.positions()?;
-    let beam = structure
-        .beam
-        .as_ref()
-        .ok_or("damper-position study: the scenario's structure must be a [structure.beam]")?;
+    let beam = structure.beam.as_ref().ok_or_else(|| {
+        StructureError::invalid(
+            "damper-position study",
+            "the scenario's structure must be a [structure.beam]",
+        )
+    })?;
     let key = |i: usize| match (&spec.positions_m, i) {
         (Some(_), _) => format!("study.positions_m[{i}]"),
         (None, 0) => "study.start_m".to_string(),
@@ -155,11 +159,10 @@ pub fn position_study(
     let damper = match scn.dampers.as_slice() {
         [d] if !matches!(d, DamperSpec::Dem { .. }) => d,
         _ => {
-            return Err(
-                "damper-position study: the scenario needs exactly one equivalent damper \
-                 (approach 2 or 3)"
-                    .into(),
-            );
+            return Err(StructureError::invalid(
+                "damper-position study",
+                "the scenario needs exactly one equivalent damper (approach 2 or 3)",
+            ));
         }
     };
     let AnalysisSpec::SteadyState {
@@ -169,11 +172,10 @@ pub fn position_study(
         ..
     } = &scn.analysis
     else {
-        return Err(
-            "damper-position study: [analysis] must be kind = \"steady_state\" (force and \
-             excitation point)"
-                .into(),
-        );
+        return Err(StructureError::invalid(
+            "damper-position study",
+            "[analysis] must be kind = \"steady_state\" (force and excitation point)",
+        ));
     };
     let force = crate::scenario::ForceSpec {
         force_amplitude_n: *force_amplitude_n,
@@ -182,8 +184,9 @@ pub fn position_study(
     .force_n(structure)?;
     let point = damper.point().to_string();
     if !structure.points.iter().any(|p| p.name == point) {
-        return Err(format!(
-            "damper-position study: damper point '{point}' is not a [[structure.points]] entry"
+        return Err(StructureError::invalid(
+            "damper-position study",
+            format!("damper point '{point}' is not a [[structure.points]] entry"),
         ));
     }
     let moved_mass = match spec.move_mass_at_m {
@@ -191,7 +194,12 @@ pub fn position_study(
             beam.masses
                 .iter()
                 .position(|m| (m.position_m - x).abs() < 1e-9)
-                .ok_or_else(|| format!("study.move_mass_at_m: no structure mass at {x} m"))?,
+                .ok_or_else(|| {
+                    StructureError::invalid(
+                        "study.move_mass_at_m",
+                        format!("no structure mass at {x} m"),
+                    )
+                })?,
         ),
         None => None,
     };
@@ -199,9 +207,9 @@ pub fn position_study(
     let mut out = Vec::new();
     for &x in &positions {
         if !(0.0..=beam.length_m).contains(&x) {
-            return Err(format!(
-                "study.positions_m: {x} m is outside the beam (0 … {} m)",
-                beam.length_m
+            return Err(StructureError::invalid(
+                "study.positions_m",
+                format!("{x} m is outside the beam (0 … {} m)", beam.length_m),
             ));
         }
         let mut st = structure.clone();
@@ -222,7 +230,7 @@ pub fn position_study(
         for (j, m) in modal.modes.iter().enumerate() {
             let model = damper.effective_model(base, &modal, j).or_else(|e| {
                 // a node of mode j cannot carry a mode-dependent kinematic ratio: no damping
-                if e.contains("is a node") {
+                if matches!(e, StructureError::NodeOfMode { .. }) {
                     Ok(None)
                 } else {
                     Err(e)
@@ -278,10 +286,12 @@ fn nearest_node(beam: &crate::scenario::BeamSpec, x: f64) -> f64 {
 ///
 /// # Errors
 /// Input, build and I/O errors.
-pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let f: PositionStudyFile =
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+pub fn run_position_study_file(
+    path: &Path,
+    out: &Path,
+) -> Result<serde_json::Value, StructureError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
+    let f: PositionStudyFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let scn_path = base.join(&f.scenario);
     let (scn, structure) = CoupleScenario::load(&scn_path)?;
@@ -293,13 +303,13 @@ pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Va
         &f.study,
     )
     .map_err(|m| {
-        if m.starts_with("study") {
-            crate::scenario::locate(path, m)
+        if m.to_string().starts_with("study") {
+            crate::scenario::locate_error(path, m)
         } else {
             m
         }
     })?;
-    std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(out)?;
     let rows: Vec<Vec<f64>> = res
         .iter()
         .map(|r| {
@@ -336,8 +346,7 @@ pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Va
             "converged",
         ],
         &rows,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let n_modes = res.iter().map(|r| r.mode).max().unwrap_or(0);
     let mut plot = LinePlot::new(
         Axis::linear("damper position (m)"),
@@ -364,7 +373,7 @@ pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Va
             );
         }
     }
-    line_plot(out.join("positions"), &plot).map_err(|e| e.to_string())?;
+    line_plot(out.join("positions"), &plot)?;
     let summary = json!({
         "study": f.study,
         "scenario": f.scenario,
@@ -374,10 +383,7 @@ pub fn run_position_study_file(path: &Path, out: &Path) -> Result<serde_json::Va
     });
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
-    )
-    .map_err(|e| e.to_string())?;
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
     Ok(summary)
 }

@@ -1,5 +1,6 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
 
+use crate::StructureError;
 use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep_beds};
 use crate::design::damping_ratio_modal;
 use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
@@ -13,8 +14,8 @@ use serde_json::json;
 use std::f64::consts::TAU;
 use std::path::Path;
 
-fn io<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
+fn io<E: Into<StructureError>>(e: E) -> StructureError {
+    e.into()
 }
 
 /// `pdamp structure modes`: builds and reduces the structure, writes `modes.csv`
@@ -22,13 +23,13 @@ fn io<E: std::fmt::Display>(e: E) -> String {
 ///
 /// # Errors
 /// Input, solver and I/O errors.
-pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value, String> {
+pub fn run_modes(structure_path: &Path, out: &Path) -> Result<serde_json::Value, StructureError> {
     let file = load_structure(structure_path)?;
     let base = structure_path.parent().unwrap_or(Path::new("."));
     let built = file
         .structure
         .build(base)
-        .map_err(|m| crate::scenario::locate(structure_path, m))?;
+        .map_err(|m| crate::scenario::locate_error(structure_path, m))?;
     std::fs::create_dir_all(out).map_err(io)?;
     let s = &built.modal;
     let names: Vec<String> = s
@@ -74,7 +75,7 @@ pub fn run_couple_default(
     path: &Path,
     out: &Path,
     progress: &mut dyn FnMut(f64),
-) -> Result<serde_json::Value, String> {
+) -> Result<serde_json::Value, StructureError> {
     let options = pdamp_io::run::RunOptions {
         checkpoint_interval_s: 0.0,
         resume: false,
@@ -91,13 +92,13 @@ pub fn run_couple(
     out: &Path,
     options: pdamp_io::run::RunOptions,
     progress: &mut dyn FnMut(f64),
-) -> Result<serde_json::Value, String> {
+) -> Result<serde_json::Value, StructureError> {
     let (scn, structure_spec) = CoupleScenario::load(path)?;
-    let mut inputs = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut inputs = std::fs::read(path).map_err(|e| StructureError::read(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let structure = structure_spec
         .build(base)
-        .map_err(|m| crate::scenario::locate(&scn.structure_source(path), m))?
+        .map_err(|m| crate::scenario::locate_error(&scn.structure_source(path), m))?
         .modal;
     let dem_count = scn
         .dampers
@@ -105,11 +106,10 @@ pub fn run_couple(
         .filter(|d| matches!(d, DamperSpec::Dem { .. }))
         .count();
     if dem_count > 0 && dem_count < scn.dampers.len() {
-        return Err(
+        return Err(StructureError::inconsistent(
             "DEM dampers (approach 1) cannot be mixed with other damper models in a scenario: \
-             make every damper `model = \"dem\"` or none"
-                .into(),
-        );
+             make every damper `model = \"dem\"` or none",
+        ));
     }
     // The DEM beds (one per damper, each its own scenario and seed); the first bed's
     // `[output]` interval and format give the ParaView output.
@@ -131,15 +131,15 @@ pub fn run_couple(
         } else {
             base.join(scenario)
         };
-        let sc = pdamp_io::scenario::Scenario::load(&p)
-            .map_err(|e| format!("dampers[{i}]: {}: {e}", p.display()))?;
+        let in_damper = |e: StructureError| e.context(format!("dampers[{i}]: {}", p.display()));
+        let sc = pdamp_io::scenario::Scenario::load(&p).map_err(|e| in_damper(e.into()))?;
         inputs.extend_from_slice(sc.to_toml().as_bytes());
         if bed_vtk.is_none() {
             bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
         }
         let d =
             pdamp_design::Damper::from_scenario(&sc, p.parent().unwrap_or(Path::new(".")), |_| {})
-                .map_err(|e| format!("dampers[{i}]: {}: {e}", p.display()))?;
+                .map_err(|e| in_damper(StructureError::Design(e.to_string())))?;
         dem_beds.push((
             point.clone(),
             d,
@@ -180,7 +180,7 @@ pub fn run_couple(
     for (i, d) in scn.dampers.iter().enumerate() {
         if let Some(m) = d
             .effective_model(base, &structure, analysis_mode)
-            .map_err(|e| crate::scenario::locate(path, format!("dampers[{i}]: {e}")))?
+            .map_err(|e| crate::scenario::locate_error(path, e.context(format!("dampers[{i}]"))))?
         {
             dampers.push(CoupledDamper {
                 point: d.point().to_string(),
@@ -298,7 +298,8 @@ pub fn run_couple(
                 // continues the running one, ending bit for bit as an uninterrupted run.
                 let mut done: Vec<SegmentHistory> = match (&dem, options.resume) {
                     (Some(_), true) => {
-                        pdamp_io::checkpoint::load(&ck.path, SEGMENTS_KIND, &ck.inputs_digest)?
+                        pdamp_io::checkpoint::load(&ck.path, SEGMENTS_KIND, &ck.inputs_digest)
+                            .map_err(|e| StructureError::PdampIo(e.to_string()))?
                             .unwrap_or_default()
                     }
                     _ => Vec::new(),
@@ -338,7 +339,8 @@ pub fn run_couple(
                                     &ck.inputs_digest,
                                 ),
                                 &done,
-                            )?;
+                            )
+                            .map_err(|e| StructureError::PdampIo(e.to_string()))?;
                             let _ = std::fs::remove_file(&cki.path);
                             h
                         }
@@ -385,9 +387,10 @@ pub fn run_couple(
             mode,
         } => {
             if dampers.len() != 1 {
-                return Err(
-                    "steady_state needs exactly one equivalent damper (approach 2 or 3)".into(),
-                );
+                return Err(StructureError::rule(
+                    "steady_state",
+                    "needs exactly one equivalent damper (approach 2 or 3)",
+                ));
             }
             let f = ForceSpec {
                 force_amplitude_n: *force_amplitude_n,
@@ -395,7 +398,10 @@ pub fn run_couple(
             }
             .force_n(&structure_spec)?;
             let k = mode.saturating_sub(1);
-            let m = structure.modes.get(k).ok_or("mode does not exist")?;
+            let m = structure
+                .modes
+                .get(k)
+                .ok_or_else(|| StructureError::rule("mode", "does not exist"))?;
             let mc = ModeCoupling {
                 omega_rad_s: m.omega_rad_s(),
                 damping_ratio: m.damping_ratio,
@@ -435,7 +441,8 @@ pub fn run_couple(
                 &rows,
             )
             .map_err(io)?;
-            let (zeta, f_r, x_peak) = forced::steady_state_damping(&mc, &pts).ok_or("empty FRF")?;
+            let (zeta, f_r, x_peak) = forced::steady_state_damping(&mc, &pts)
+                .ok_or_else(|| StructureError::numerical("empty FRF"))?;
             let eq = forced::resonance_equilibrium(&mc, dampers[0].model.as_ref(), 200);
             // Fig. 3.7 equilibrium of every mode (D Sect. 8.2.3 treats modes one at a time).
             let mut per_mode = Vec::new();
@@ -549,7 +556,7 @@ fn free_outputs(
     spec: &FreeVibrationSpec,
     hist: &TimeHistory,
     out: &Path,
-) -> Result<serde_json::Value, String> {
+) -> Result<serde_json::Value, StructureError> {
     let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
         .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.velocity_m_s[i]])
         .collect();
@@ -758,7 +765,7 @@ fn extract_modal_parameters(
                 "modal_constant_re": m.map(|m| m.modal_constant_re),
                 "modal_constant_im": m.map(|m| m.modal_constant_im),
                 "fit_relative_error": fit.as_ref().ok().map(|r| r.relative_error),
-                "fit_error": fit.err(),
+                "fit_error": fit.err().map(|e| e.to_string()),
                 "half_power_frequency_hz": hp[k].map(|r| r.resonance_frequency_hz),
                 "half_power_damping_ratio": hp[k].map(|r| r.damping_ratio),
             })
@@ -779,7 +786,7 @@ fn sweep_outputs(
     frf: Vec<forced::FrfPoint>,
     mode: usize,
     out: &Path,
-) -> Result<serde_json::Value, String> {
+) -> Result<serde_json::Value, StructureError> {
     let k = mode.min(structure.modes.len() - 1);
     let phi_ex = structure.point(&spec.excitation_point)?[k];
     let phi_out = structure.point(&spec.output_point)?[k];
@@ -803,7 +810,10 @@ fn sweep_outputs(
             peak_run = i;
         }
     }
-    let hist = &runs.get(peak_run).ok_or("no sweep run")?.0;
+    let hist = &runs
+        .get(peak_run)
+        .ok_or_else(|| StructureError::numerical("no sweep run"))?
+        .0;
     let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
         .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.force_n[i]])
         .collect();

@@ -1,6 +1,7 @@
 //! TOML input of `pdamp structure modes` and `pdamp couple` (see docs/structure.md). SI units
 //! in every key name; unknown keys are errors.
 
+use crate::StructureError;
 use crate::effective::{EffectiveDamper, FieldTable, ViscousDamper};
 use crate::fe::{BeamSection, Dof, FeModel, GroundSpring, PointMass};
 use crate::forced::SweepLaw;
@@ -273,7 +274,7 @@ impl StructureSpec {
     ///
     /// # Errors
     /// Not exactly one model section, invalid values, unknown points, solver errors.
-    pub fn build(&self, base_dir: &Path) -> Result<BuiltStructure, String> {
+    pub fn build(&self, base_dir: &Path) -> Result<BuiltStructure, StructureError> {
         let count = [
             self.single_mode.is_some(),
             self.modal.is_some(),
@@ -284,9 +285,10 @@ impl StructureSpec {
         .filter(|b| **b)
         .count();
         if count != 1 {
-            return Err(
-                "structure: give exactly one of single_mode, modal, beam, matrix_market".into(),
-            );
+            return Err(StructureError::invalid(
+                "structure",
+                "give exactly one of single_mode, modal, beam, matrix_market",
+            ));
         }
         self.validate()?;
         if let Some(s) = &self.single_mode {
@@ -299,7 +301,10 @@ impl StructureSpec {
         }
         if let Some(m) = &self.modal {
             if m.damping_ratios.len() != m.frequencies_hz.len() {
-                return Err("modal: damping_ratios needs one value per frequency".into());
+                return Err(StructureError::invalid(
+                    "modal",
+                    "damping_ratios needs one value per frequency",
+                ));
             }
             let s = ModalStructure {
                 modes: m
@@ -328,10 +333,10 @@ impl StructureSpec {
         };
         let dense_limit = |n: usize| {
             if n > DENSE_MAX_DOF {
-                Err(format!(
-                    "{n} dof: the dense modal solver is limited to {DENSE_MAX_DOF} dof (use \
-                     solver = \"sparse\" or \"auto\")"
-                ))
+                Err(StructureError::DenseLimit {
+                    dofs: n,
+                    max: DENSE_MAX_DOF,
+                })
             } else {
                 Ok(())
             }
@@ -343,13 +348,16 @@ impl StructureSpec {
                 let mut wanted = Vec::new();
                 for (i, p) in self.points.iter().enumerate() {
                     let x = p.position_m.ok_or_else(|| {
-                        format!(
-                            "structure.points[{i}].position_m is missing (point '{}')",
-                            p.name
+                        StructureError::rule(
+                            format!("structure.points[{i}].position_m"),
+                            format!("is missing (point '{}')", p.name),
                         )
                     })?;
                     let dof = Dof::parse(&p.dof).ok_or_else(|| {
-                        format!("structure.points[{i}].dof: unknown dof '{}'", p.dof)
+                        StructureError::invalid(
+                            format!("structure.points[{i}].dof"),
+                            format!("unknown dof '{}'", p.dof),
+                        )
                     })?;
                     wanted.push((nearest(&positions, x), dof));
                 }
@@ -373,33 +381,40 @@ impl StructureSpec {
                 }
             } else {
                 let Some(mm) = self.matrix_market.as_ref() else {
-                    return Err("structure: no model section".into());
+                    return Err(StructureError::invalid("structure", "no model section"));
                 };
                 let (kp, mp, dp) = (
                     resolve(base_dir, &mm.stiffness),
                     resolve(base_dir, &mm.mass),
                     resolve(base_dir, &mm.dof_map),
                 );
-                let named = |key: &str, p: &Path, e: matrix_market::MatrixMarketError| match e {
-                    matrix_market::MatrixMarketError::Io { .. } => {
-                        format!("structure.matrix_market.{key}: {e}")
+                let named = |key: &'static str, p: &Path, e: matrix_market::MatrixMarketError| {
+                    StructureError::MatrixMarketFile {
+                        key,
+                        path: match e {
+                            matrix_market::MatrixMarketError::Io { .. } => None,
+                            _ => Some(p.to_path_buf()),
+                        },
+                        error: e,
                     }
-                    _ => format!("structure.matrix_market.{key} '{}': {e}", p.display()),
                 };
                 let k = matrix_market::read_matrix_market(&kp)
                     .map_err(|e| named("stiffness", &kp, e))?;
                 let m =
                     matrix_market::read_matrix_market(&mp).map_err(|e| named("mass", &mp, e))?;
                 if k.nrows != m.nrows || k.nrows != k.ncols || m.nrows != m.ncols {
-                    return Err(format!(
-                        "structure.matrix_market.mass: K ('{}') is {}×{}, M ('{}') is {}×{}; both \
-                         must be square and of one size",
-                        kp.display(),
-                        k.nrows,
-                        k.ncols,
-                        mp.display(),
-                        m.nrows,
-                        m.ncols
+                    return Err(StructureError::invalid(
+                        "structure.matrix_market.mass",
+                        format!(
+                            "K ('{}') is {}×{}, M ('{}') is {}×{}; both must be square and of one \
+                             size",
+                            kp.display(),
+                            k.nrows,
+                            k.ncols,
+                            mp.display(),
+                            m.nrows,
+                            m.ncols
+                        ),
                     ));
                 }
                 let map = matrix_market::read_dof_map(&dp, k.nrows)
@@ -411,23 +426,32 @@ impl StructureSpec {
                     &mp.display().to_string(),
                     Some(&map),
                 )
-                .map_err(|e| format!("structure.matrix_market: {e}"))?;
+                .map_err(|e| StructureError::from(e).context("structure.matrix_market"))?;
                 let mut rows = Vec::new();
                 for (i, p) in self.points.iter().enumerate() {
                     let key = format!("structure.points[{i}].node");
-                    let node = p
-                        .node
-                        .ok_or_else(|| format!("{key} is missing (point '{}')", p.name))?;
+                    let node = p.node.ok_or_else(|| {
+                        StructureError::rule(
+                            key.clone(),
+                            format!("is missing (point '{}')", p.name),
+                        )
+                    })?;
                     let dof = Dof::parse(&p.dof).ok_or_else(|| {
-                        format!("structure.points[{i}].dof: unknown dof '{}'", p.dof)
+                        StructureError::invalid(
+                            format!("structure.points[{i}].dof"),
+                            format!("unknown dof '{}'", p.dof),
+                        )
                     })?;
                     rows.push(Some(map.row(node, dof).ok_or_else(|| {
-                        format!(
-                            "{key}: node {node} {dof:?} of point '{}' is not in the dof map '{}' \
-                             ({} rows); give a node and dof listed there",
-                            p.name,
-                            dp.display(),
-                            map.rows.len()
+                        StructureError::invalid(
+                            key.clone(),
+                            format!(
+                                "node {node} {dof:?} of point '{}' is not in the dof map '{}' \
+                                 ({} rows); give a node and dof listed there",
+                                p.name,
+                                dp.display(),
+                                map.rows.len()
+                            ),
                         )
                     })?));
                 }
@@ -515,7 +539,7 @@ impl BeamSpec {
     ///
     /// # Errors
     /// Missing section data.
-    pub fn model(&self) -> Result<(FeModel, Vec<f64>), String> {
+    pub fn model(&self) -> Result<(FeModel, Vec<f64>), StructureError> {
         self.validate()?;
         let g = self.youngs_modulus_pa / (2.0 * (1.0 + self.poisson_ratio));
         let section = match (self.width_m, self.height_m) {
@@ -528,12 +552,15 @@ impl BeamSpec {
                 self.timoshenko,
             ),
             _ => {
-                let a = self
-                    .area_m2
-                    .ok_or("beam: give width_m and height_m, or area_m2 and second_moment_m4")?;
+                let a = self.area_m2.ok_or_else(|| {
+                    StructureError::invalid(
+                        "beam",
+                        "give width_m and height_m, or area_m2 and second_moment_m4",
+                    )
+                })?;
                 let iz = self
                     .second_moment_m4
-                    .ok_or("beam: second_moment_m4 missing")?;
+                    .ok_or_else(|| StructureError::invalid("beam", "second_moment_m4 missing"))?;
                 let iy = self.second_moment_z_m4.unwrap_or(iz);
                 BeamSection {
                     youngs_modulus_pa: self.youngs_modulus_pa,
@@ -549,7 +576,10 @@ impl BeamSpec {
         };
         section.validate()?;
         if self.elements == 0 || self.length_m <= 0.0 {
-            return Err("beam: elements ≥ 1 and length_m > 0".into());
+            return Err(StructureError::invalid(
+                "beam",
+                "elements ≥ 1 and length_m > 0",
+            ));
         }
         // Nodes at the element ends plus exact nodes at supports, masses and points are not
         // inserted: positions snap to the nearest node (use element counts that hit them).
@@ -596,12 +626,12 @@ impl BeamSpec {
 ///
 /// # Errors
 /// I/O and TOML errors; invalid values with the file, the key's line and column and the fix.
-pub fn load_structure(path: &Path) -> Result<StructureFile, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let f: StructureFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    f.structure.validate().map_err(|m| {
-        pdamp_io::scenario::ScenarioError::invalid(path, Some(&text), m).to_string()
-    })?;
+pub fn load_structure(path: &Path) -> Result<StructureFile, StructureError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
+    let f: StructureFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
+    f.structure
+        .validate()
+        .map_err(|m| m.located(path, Some(&text)))?;
     Ok(f)
 }
 
@@ -821,7 +851,10 @@ impl DamperSpec {
     ///
     /// # Errors
     /// Messages name the offending key; not a DEM damper.
-    pub fn dem_kinematics(&self, index: usize) -> Result<crate::dem::DemKinematics, String> {
+    pub fn dem_kinematics(
+        &self,
+        index: usize,
+    ) -> Result<crate::dem::DemKinematics, StructureError> {
         use crate::dem::{DemKinematics, RigidKinematics};
         let DamperSpec::Dem {
             point,
@@ -832,23 +865,29 @@ impl DamperSpec {
             ..
         } = self
         else {
-            return Err(format!("dampers[{index}]: not a DEM damper"));
+            return Err(StructureError::invalid(
+                format!("dampers[{index}]"),
+                "not a DEM damper",
+            ));
         };
         let key = |k: &str| format!("dampers[{index}].{k}");
-        let three = |v: &Option<Vec<String>>, k: &str| -> Result<[Option<String>; 3], String> {
-            let v = v
-                .as_ref()
-                .ok_or_else(|| format!("{}: required for dofs = {dofs:?}", key(k)))?;
-            if v.len() != 3 {
-                return Err(format!(
-                    "{}: give three point names (x, y, z; \"\" = not moved), got {}",
-                    key(k),
-                    v.len()
-                ));
-            }
-            let o = |s: &String| (!s.trim().is_empty()).then(|| s.trim().to_string());
-            Ok([o(&v[0]), o(&v[1]), o(&v[2])])
-        };
+        let three =
+            |v: &Option<Vec<String>>, k: &str| -> Result<[Option<String>; 3], StructureError> {
+                let v = v.as_ref().ok_or_else(|| {
+                    StructureError::invalid(key(k), format!("required for dofs = {dofs:?}"))
+                })?;
+                if v.len() != 3 {
+                    return Err(StructureError::invalid(
+                        key(k),
+                        format!(
+                            "give three point names (x, y, z; \"\" = not moved), got {}",
+                            v.len()
+                        ),
+                    ));
+                }
+                let o = |s: &String| (!s.trim().is_empty()).then(|| s.trim().to_string());
+                Ok([o(&v[0]), o(&v[1]), o(&v[2])])
+            };
         match dofs {
             DemDofs::OneDimensional => {
                 for (k, set) in [
@@ -857,9 +896,9 @@ impl DamperSpec {
                     ("attachment_point_m", attachment_point_m.is_some()),
                 ] {
                     if set {
-                        return Err(format!(
-                            "{}: only with dofs = \"translation\" or \"translation+rotation\"",
-                            key(k)
+                        return Err(StructureError::invalid(
+                            key(k),
+                            "only with dofs = \"translation\" or \"translation+rotation\"",
                         ));
                     }
                 }
@@ -868,17 +907,17 @@ impl DamperSpec {
             DemDofs::Translation | DemDofs::TranslationRotation => {
                 let tr = three(translation_points, "translation_points")?;
                 if !tr.iter().flatten().any(|p| p == point) {
-                    return Err(format!(
-                        "{}: '{point}' must be one of translation_points",
-                        key("point")
+                    return Err(StructureError::invalid(
+                        key("point"),
+                        format!("'{point}' must be one of translation_points"),
                     ));
                 }
                 let rot = if *dofs == DemDofs::TranslationRotation {
                     Some(three(rotation_points, "rotation_points")?)
                 } else if rotation_points.is_some() {
-                    return Err(format!(
-                        "{}: only with dofs = \"translation+rotation\"",
-                        key("rotation_points")
+                    return Err(StructureError::invalid(
+                        key("rotation_points"),
+                        "only with dofs = \"translation+rotation\"",
                     ));
                 } else {
                     None
@@ -886,7 +925,10 @@ impl DamperSpec {
                 if let Some(a) = attachment_point_m
                     && !a.iter().all(|x| x.is_finite())
                 {
-                    return Err(format!("{}: must be finite", key("attachment_point_m")));
+                    return Err(StructureError::invalid(
+                        key("attachment_point_m"),
+                        "must be finite",
+                    ));
                 }
                 Ok(DemKinematics::Rigid(RigidKinematics {
                     translation_points: tr,
@@ -907,7 +949,7 @@ impl DamperSpec {
         base_dir: &Path,
         structure: &crate::modal::ModalStructure,
         mode: usize,
-    ) -> Result<Option<Box<dyn EffectiveDamper>>, String> {
+    ) -> Result<Option<Box<dyn EffectiveDamper>>, StructureError> {
         Ok(Some(match self {
             DamperSpec::Viscous {
                 damping_n_s_m,
@@ -927,10 +969,20 @@ impl DamperSpec {
             } => {
                 let mut v: Vec<Box<dyn EffectiveDamper>> = Vec::new();
                 for l in layers {
-                    let h = match (l.clearance_m, l.container_length_m, l.particles, l.particles_per_layer) {
+                    let h = match (
+                        l.clearance_m,
+                        l.container_length_m,
+                        l.particles,
+                        l.particles_per_layer,
+                    ) {
                         (Some(h), _, _, _) => h,
                         (None, Some(len), Some(n), Some(nmax)) => clearance_m(len, n, nmax),
-                        _ => return Err("rolling layer: give clearance_m or container_length_m + particles + particles_per_layer".into()),
+                        _ => {
+                            return Err(StructureError::invalid(
+                                "rolling layer",
+                                "give clearance_m or container_length_m + particles + particles_per_layer",
+                            ));
+                        }
                     };
                     v.push(Box::new(RollingDamper {
                         bed_mass_kg: l.bed_mass_kg,
@@ -971,13 +1023,18 @@ impl DamperSpec {
                     (Some(h), None, None, None) => *h,
                     (None, Some(l), Some(n), Some(nm)) => crate::formulas::clearance_m(*l, *n, *nm),
                     _ => {
-                        return Err("vertical damper: give clearance_m, or container_length_m, \
-                                    particles and max_particles (Eq. 7.4)"
-                            .into());
+                        return Err(StructureError::invalid(
+                            "vertical damper",
+                            "give clearance_m, or container_length_m, particles and \
+                             max_particles (Eq. 7.4)",
+                        ));
                     }
                 };
                 if !(h >= 0.0 && *bed_mass_kg > 0.0) {
-                    return Err("vertical damper: bed_mass_kg > 0 and clearance ≥ 0".into());
+                    return Err(StructureError::invalid(
+                        "vertical damper",
+                        "bed_mass_kg > 0 and clearance ≥ 0",
+                    ));
                 }
                 Box::new(crate::formulas::VerticalDamper {
                     bed_mass_kg: *bed_mass_kg,
@@ -1010,20 +1067,23 @@ impl DamperSpec {
                 let kappa = match (angle_per_displacement_rad_m, angle_points) {
                     (Some(k), None) => *k,
                     (None, Some(pts)) => {
-                        let val = |p: &str| -> Result<f64, String> {
+                        let val = |p: &str| -> Result<f64, StructureError> {
                             let v = structure
                                 .point(p)
-                                .map_err(|e| format!("powder_friction.angle_points: {e}"))?;
+                                .map_err(|e| e.context("powder_friction.angle_points"))?;
                             v.get(mode).copied().ok_or_else(|| {
-                                format!("powder_friction: mode {} does not exist", mode + 1)
+                                StructureError::invalid(
+                                    "powder_friction",
+                                    format!("mode {} does not exist", mode + 1),
+                                )
                             })
                         };
                         let x = val(point)?;
                         if x == 0.0 {
-                            return Err(format!(
-                                "powder_friction: point '{point}' is a node of mode {} (φ/X undefined)",
-                                mode + 1
-                            ));
+                            return Err(StructureError::NodeOfMode {
+                                point: point.clone(),
+                                mode: mode + 1,
+                            });
                         }
                         match (mechanism, pts.len()) {
                             (FrictionMechanism::Bending, 2) => {
@@ -1035,17 +1095,19 @@ impl DamperSpec {
                                     / x
                             }
                             _ => {
-                                return Err("powder_friction.angle_points: bending needs \
-                                            [θ_start, θ_end], shear [u_start, θ_start, u_end, \
-                                            θ_end]"
-                                    .into());
+                                return Err(StructureError::invalid(
+                                    "powder_friction.angle_points",
+                                    "bending needs [θ_start, θ_end], shear [u_start, θ_start, \
+                                     u_end, θ_end]",
+                                ));
                             }
                         }
                     }
                     _ => {
-                        return Err("powder_friction: give exactly one of \
-                                    angle_per_displacement_rad_m and angle_points"
-                            .into());
+                        return Err(StructureError::invalid(
+                            "powder_friction",
+                            "give exactly one of angle_per_displacement_rad_m and angle_points",
+                        ));
                     }
                 };
                 let d = PowderFrictionDamper {
@@ -1053,7 +1115,10 @@ impl DamperSpec {
                     cavity_length_m: *cavity_length_m,
                     cavity_width_m: match (mechanism, cavity_width_m) {
                         (FrictionMechanism::Bending, None) => {
-                            return Err("powder_friction: bending needs cavity_width_m".into());
+                            return Err(StructureError::invalid(
+                                "powder_friction",
+                                "bending needs cavity_width_m",
+                            ));
                         }
                         (_, w) => w.unwrap_or(0.0),
                     },
@@ -1231,14 +1296,24 @@ fn thousand() -> usize {
 
 impl ForceSpec {
     /// The force amplitude, N (needs the single-mode stiffness for `base_amplitude_m`).
-    pub fn force_n(&self, structure: &StructureSpec) -> Result<f64, String> {
+    ///
+    /// # Errors
+    /// Not exactly one of the two amplitudes; a base amplitude without a single-mode structure.
+    pub fn force_n(&self, structure: &StructureSpec) -> Result<f64, StructureError> {
         match (self.force_amplitude_n, self.base_amplitude_m) {
             (Some(f), None) => Ok(f),
             (None, Some(u)) => structure
                 .single_mode
                 .map(|s| u * s.stiffness_n_m)
-                .ok_or_else(|| "base_amplitude_m needs a single_mode structure (R' = U K)".into()),
-            _ => Err("give exactly one of force_amplitude_n and base_amplitude_m".into()),
+                .ok_or_else(|| {
+                    StructureError::rule(
+                        "base_amplitude_m",
+                        "needs a single_mode structure (R' = U K)",
+                    )
+                }),
+            _ => Err(StructureError::inconsistent(
+                "give exactly one of force_amplitude_n and base_amplitude_m",
+            )),
         }
     }
 }
@@ -1248,14 +1323,11 @@ impl CoupleScenario {
     ///
     /// # Errors
     /// I/O, TOML, missing structure.
-    pub fn load(path: &Path) -> Result<(Self, StructureSpec), String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let s: CoupleScenario =
-            toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    pub fn load(path: &Path) -> Result<(Self, StructureSpec), StructureError> {
+        let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
+        let s: CoupleScenario = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
         let base = path.parent().unwrap_or(Path::new("."));
-        let located = |m: String| {
-            pdamp_io::scenario::ScenarioError::invalid(path, Some(&text), m).to_string()
-        };
+        let located = |m: StructureError| m.located(path, Some(&text));
         let structure = match (&s.structure, &s.structure_file) {
             (Some(st), None) => {
                 st.validate().map_err(located)?;
@@ -1263,9 +1335,10 @@ impl CoupleScenario {
             }
             (None, Some(f)) => load_structure(&resolve(base, f))?.structure,
             _ => {
-                return Err(located(
-                    "structure_file: give exactly one of structure_file and [structure]".into(),
-                ));
+                return Err(located(StructureError::invalid(
+                    "structure_file",
+                    "give exactly one of structure_file and [structure]",
+                )));
             }
         };
         s.validate(&structure).map_err(located)?;
@@ -1309,18 +1382,26 @@ pub const MAX_SEGMENTS: usize = 1000;
 
 /// One number of the input: finite and `ok`, else a message starting with the key path (for
 /// its line and column), the value and the wanted range.
-fn check_num(key: &str, v: f64, ok: bool, want: &str) -> Result<(), String> {
+fn check_num(key: &str, v: f64, ok: bool, want: &str) -> Result<(), StructureError> {
     if !v.is_finite() {
-        return Err(format!("{key} must be a finite number {want}, got {v}"));
+        return Err(StructureError::NotFinite {
+            key: key.to_string(),
+            expected: want.to_string(),
+            value: v,
+        });
     }
     if !ok {
-        return Err(format!("{key} must be {want}, got {v:e}"));
+        return Err(StructureError::OutOfRange {
+            key: key.to_string(),
+            expected: want.to_string(),
+            value: v,
+        });
     }
     Ok(())
 }
 
 /// `v` in (0, hi].
-fn positive(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), String> {
+fn positive(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), StructureError> {
     check_num(
         key,
         v,
@@ -1330,7 +1411,7 @@ fn positive(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), String> {
 }
 
 /// `v` in [0, hi].
-fn non_negative(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), String> {
+fn non_negative(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), StructureError> {
     check_num(
         key,
         v,
@@ -1340,9 +1421,14 @@ fn non_negative(key: &str, v: f64, hi: f64, unit: &str) -> Result<(), String> {
 }
 
 /// A count in [lo, hi].
-fn count(key: &str, v: usize, lo: usize, hi: usize) -> Result<(), String> {
+fn count(key: &str, v: usize, lo: usize, hi: usize) -> Result<(), StructureError> {
     if v < lo || v > hi {
-        return Err(format!("{key} must be an integer in [{lo}, {hi}], got {v}"));
+        return Err(StructureError::Count {
+            key: key.to_string(),
+            value: v,
+            lo,
+            hi,
+        });
     }
     Ok(())
 }
@@ -1351,15 +1437,15 @@ fn count(key: &str, v: usize, lo: usize, hi: usize) -> Result<(), String> {
 ///
 /// # Errors
 /// A message naming `key`, the value and the beam length.
-pub fn on_beam(key: &str, x: f64, length_m: f64) -> Result<(), String> {
+pub fn on_beam(key: &str, x: f64, length_m: f64) -> Result<(), StructureError> {
     check_num(key, x, true, "")?;
     let tol = 1e-9 * length_m;
     if x < -tol || x > length_m + tol {
-        return Err(format!(
-            "{key} = {x} m lies outside the beam [0, {length_m}] m (structure.beam.length_m = \
-             {length_m}); positions are measured from the beam's start, give one in [0, \
-             {length_m}] m"
-        ));
+        return Err(StructureError::OffBeam {
+            key: key.to_string(),
+            value: x,
+            length_m,
+        });
     }
     Ok(())
 }
@@ -1372,6 +1458,13 @@ pub fn locate(path: &Path, message: impl Into<String>) -> String {
     pdamp_io::scenario::ScenarioError::invalid(path, text.as_deref(), message).to_string()
 }
 
+/// [`locate`] as a typed error: `error` located in the file `path` (read again for the key's
+/// line and column), a [`StructureError::Scenario`].
+pub fn locate_error(path: &Path, error: StructureError) -> StructureError {
+    let text = std::fs::read_to_string(path).ok();
+    error.located(path, text.as_deref())
+}
+
 impl StructureSpec {
     /// Checks every number of the structure for finiteness and a physical range, the point
     /// names, and that supports, masses and points lie on the beam; messages start with the
@@ -1379,7 +1472,7 @@ impl StructureSpec {
     ///
     /// # Errors
     /// The first invalid value.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         count("structure.n_modes", self.n_modes, 1, MAX_MODES)?;
         non_negative(
             "structure.min_frequency_hz",
@@ -1409,7 +1502,10 @@ impl StructureSpec {
         }
         if let Some(m) = &self.modal {
             if m.frequencies_hz.is_empty() {
-                return Err("structure.modal.frequencies_hz: give at least one mode".into());
+                return Err(StructureError::invalid(
+                    "structure.modal.frequencies_hz",
+                    "give at least one mode",
+                ));
             }
             count(
                 "structure.modal.frequencies_hz",
@@ -1426,10 +1522,13 @@ impl StructureSpec {
                 )?;
             }
             if m.damping_ratios.len() != m.frequencies_hz.len() {
-                return Err(format!(
-                    "structure.modal.damping_ratios needs one value per frequency ({}), got {}",
-                    m.frequencies_hz.len(),
-                    m.damping_ratios.len()
+                return Err(StructureError::rule(
+                    "structure.modal.damping_ratios",
+                    format!(
+                        "needs one value per frequency ({}), got {}",
+                        m.frequencies_hz.len(),
+                        m.damping_ratios.len()
+                    ),
                 ));
             }
             for (k, z) in m.damping_ratios.iter().enumerate() {
@@ -1439,16 +1538,22 @@ impl StructureSpec {
             for (i, p) in m.points.iter().enumerate() {
                 let key = format!("structure.modal.points[{i}]");
                 if p.name.trim().is_empty() || !names.insert(p.name.as_str()) {
-                    return Err(format!(
-                        "{key}.name '{}' is empty or used twice; give every point its own name",
-                        p.name
+                    return Err(StructureError::rule(
+                        format!("{key}.name"),
+                        format!(
+                            "'{}' is empty or used twice; give every point its own name",
+                            p.name
+                        ),
                     ));
                 }
                 if p.shape.len() != m.frequencies_hz.len() {
-                    return Err(format!(
-                        "{key}.shape needs one value per mode ({}), got {}",
-                        m.frequencies_hz.len(),
-                        p.shape.len()
+                    return Err(StructureError::rule(
+                        format!("{key}.shape"),
+                        format!(
+                            "needs one value per mode ({}), got {}",
+                            m.frequencies_hz.len(),
+                            p.shape.len()
+                        ),
                     ));
                 }
                 for (k, v) in p.shape.iter().enumerate() {
@@ -1466,7 +1571,10 @@ impl StructureSpec {
                 ("dof_map", &mm.dof_map),
             ] {
                 if p.as_os_str().is_empty() {
-                    return Err(format!("structure.matrix_market.{k}: give a file name"));
+                    return Err(StructureError::invalid(
+                        format!("structure.matrix_market.{k}"),
+                        "give a file name",
+                    ));
                 }
             }
         }
@@ -1488,26 +1596,36 @@ impl StructureSpec {
         for (i, p) in self.points.iter().enumerate() {
             let key = format!("structure.points[{i}]");
             if p.name.trim().is_empty() || !names.insert(p.name.as_str()) {
-                return Err(format!(
-                    "{key}.name '{}' is empty or used twice; give every point its own name",
-                    p.name
+                return Err(StructureError::rule(
+                    format!("{key}.name"),
+                    format!(
+                        "'{}' is empty or used twice; give every point its own name",
+                        p.name
+                    ),
                 ));
             }
             if Dof::parse(&p.dof).is_none() {
-                return Err(format!(
-                    "{key}.dof '{}' is not a dof; give one of ux uy uz rotx roty rotz",
-                    p.dof
+                return Err(StructureError::rule(
+                    format!("{key}.dof"),
+                    format!(
+                        "'{}' is not a dof; give one of ux uy uz rotx roty rotz",
+                        p.dof
+                    ),
                 ));
             }
             if let Some(b) = &self.beam {
                 let x = p.position_m.ok_or_else(|| {
-                    format!("{key}.position_m is missing: a point on a beam needs its position")
+                    StructureError::rule(
+                        format!("{key}.position_m"),
+                        "is missing: a point on a beam needs its position",
+                    )
                 })?;
                 on_beam(&format!("{key}.position_m"), x, b.length_m)?;
             }
             if self.matrix_market.is_some() && p.node.is_none() {
-                return Err(format!(
-                    "{key}.node is missing: a point of a Matrix Market model needs its node id"
+                return Err(StructureError::rule(
+                    format!("{key}.node"),
+                    "is missing: a point of a Matrix Market model needs its node id",
                 ));
             }
         }
@@ -1521,7 +1639,7 @@ impl BeamSpec {
     ///
     /// # Errors
     /// The first invalid value, naming its key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         let k = |s: &str| format!("structure.beam.{s}");
         positive(&k("length_m"), self.length_m, MAX_LENGTH_M, "m")?;
         count(&k("elements"), self.elements, 1, MAX_ELEMENTS)?;
@@ -1600,7 +1718,11 @@ fn mode_count(structure: &StructureSpec) -> usize {
 }
 
 /// Time step, duration and sampling of a time-domain analysis (`analysis.*`).
-fn check_time(duration_s: f64, time_step_s: f64, sample_every: usize) -> Result<(), String> {
+fn check_time(
+    duration_s: f64,
+    time_step_s: f64,
+    sample_every: usize,
+) -> Result<(), StructureError> {
     positive("analysis.duration_s", duration_s, MAX_DURATION_S, "s")?;
     positive(
         "analysis.time_step_s",
@@ -1610,27 +1732,33 @@ fn check_time(duration_s: f64, time_step_s: f64, sample_every: usize) -> Result<
     )?;
     let steps = duration_s / time_step_s;
     if steps > crate::integrate::MAX_STEPS {
-        return Err(format!(
-            "analysis.time_step_s = {time_step_s:e} s gives {steps:.3e} steps over {duration_s:e} \
-             s, more than the {:e} accepted; use a longer time step or a shorter duration",
-            crate::integrate::MAX_STEPS
+        return Err(StructureError::rule(
+            "analysis.time_step_s",
+            format!(
+                "= {time_step_s:e} s gives {steps:.3e} steps over {duration_s:e} s, more than the \
+                 {:e} accepted; use a longer time step or a shorter duration",
+                crate::integrate::MAX_STEPS
+            ),
         ));
     }
     count("analysis.sample_every", sample_every, 1, usize::MAX)?;
     if steps / sample_every as f64 > crate::integrate::MAX_SAMPLES {
-        return Err(format!(
-            "analysis.sample_every = {sample_every} stores {:.3e} samples, more than the {:e} \
-             accepted; use sample_every ≥ {}",
-            steps / sample_every as f64,
-            crate::integrate::MAX_SAMPLES,
-            (steps / crate::integrate::MAX_SAMPLES).ceil()
+        return Err(StructureError::rule(
+            "analysis.sample_every",
+            format!(
+                "= {sample_every} stores {:.3e} samples, more than the {:e} accepted; use \
+                 sample_every ≥ {}",
+                steps / sample_every as f64,
+                crate::integrate::MAX_SAMPLES,
+                (steps / crate::integrate::MAX_SAMPLES).ceil()
+            ),
         ));
     }
     Ok(())
 }
 
 /// Force or base amplitude of a forced analysis: exactly one, finite, bounded.
-fn check_force(force: Option<f64>, base: Option<f64>) -> Result<(), String> {
+fn check_force(force: Option<f64>, base: Option<f64>) -> Result<(), StructureError> {
     match (force, base) {
         (Some(f), None) => check_num(
             "analysis.force_amplitude_n",
@@ -1644,16 +1772,15 @@ fn check_force(force: Option<f64>, base: Option<f64>) -> Result<(), String> {
             u.abs() <= MAX_DISPLACEMENT_M && u != 0.0,
             &format!("non-zero with |U| ≤ {MAX_DISPLACEMENT_M:e} m"),
         ),
-        _ => Err(
-            "analysis.force_amplitude_n: give exactly one of force_amplitude_n and \
-             base_amplitude_m"
-                .into(),
-        ),
+        _ => Err(StructureError::invalid(
+            "analysis.force_amplitude_n",
+            "give exactly one of force_amplitude_n and base_amplitude_m",
+        )),
     }
 }
 
 /// Frequency range of a forced analysis.
-fn check_range(start_hz: f64, end_hz: f64) -> Result<(), String> {
+fn check_range(start_hz: f64, end_hz: f64) -> Result<(), StructureError> {
     positive("analysis.start_hz", start_hz, MAX_FREQUENCY_HZ, "Hz")?;
     positive("analysis.end_hz", end_hz, MAX_FREQUENCY_HZ, "Hz")
 }
@@ -1664,7 +1791,7 @@ impl CoupleScenario {
     ///
     /// # Errors
     /// The first invalid value.
-    pub fn validate(&self, structure: &StructureSpec) -> Result<(), String> {
+    pub fn validate(&self, structure: &StructureSpec) -> Result<(), StructureError> {
         let modes = mode_count(structure);
         let mode_ok = |m: usize| count("analysis.mode", m, 1, modes.max(1));
         let dem = self
@@ -1694,7 +1821,10 @@ impl CoupleScenario {
                     ("output_point", output_point),
                 ] {
                     if p.trim().is_empty() {
-                        return Err(format!("analysis.{k}: give a structure point name"));
+                        return Err(StructureError::invalid(
+                            format!("analysis.{k}"),
+                            "give a structure point name",
+                        ));
                     }
                 }
                 check_num(
@@ -1710,11 +1840,11 @@ impl CoupleScenario {
                     "in [-1e6, 1e6] m/s",
                 )?;
                 if *initial_displacement_m == 0.0 && *initial_velocity_m_s == 0.0 {
-                    return Err(
-                        "analysis.initial_displacement_m: the structure starts at rest; \
-                                give a non-zero initial_displacement_m or initial_velocity_m_s"
-                            .into(),
-                    );
+                    return Err(StructureError::invalid(
+                        "analysis.initial_displacement_m",
+                        "the structure starts at rest; give a non-zero initial_displacement_m or \
+                         initial_velocity_m_s",
+                    ));
                 }
             }
             AnalysisSpec::Sweep {
@@ -1740,12 +1870,15 @@ impl CoupleScenario {
                     check_time(*duration_s, *time_step_s, *sample_every)?;
                     let f_max = start_hz.max(*end_hz);
                     if time_step_s * f_max > 0.125 {
-                        return Err(format!(
-                            "analysis.time_step_s = {time_step_s:e} s gives {:.2} steps per \
-                             period of the highest excitation frequency {f_max} Hz; use at most \
-                             {:e} s (8 steps per period, better 20)",
-                            1.0 / (time_step_s * f_max),
-                            0.125 / f_max
+                        return Err(StructureError::rule(
+                            "analysis.time_step_s",
+                            format!(
+                                "= {time_step_s:e} s gives {:.2} steps per period of the highest \
+                                 excitation frequency {f_max} Hz; use at most {:e} s (8 steps \
+                                 per period, better 20)",
+                                1.0 / (time_step_s * f_max),
+                                0.125 / f_max
+                            ),
                         ));
                     }
                 }
@@ -1764,7 +1897,10 @@ impl CoupleScenario {
                     ("output_point", output_point),
                 ] {
                     if p.trim().is_empty() {
-                        return Err(format!("analysis.{k}: give a structure point name"));
+                        return Err(StructureError::invalid(
+                            format!("analysis.{k}"),
+                            "give a structure point name",
+                        ));
                     }
                 }
             }
@@ -1795,10 +1931,13 @@ impl DamperSpec {
     ///
     /// # Errors
     /// The first invalid value.
-    pub fn validate(&self, index: usize) -> Result<(), String> {
+    pub fn validate(&self, index: usize) -> Result<(), StructureError> {
         let k = |s: &str| format!("dampers[{index}].{s}");
         if self.point().trim().is_empty() {
-            return Err(format!("{}: give a structure point name", k("point")));
+            return Err(StructureError::invalid(
+                k("point"),
+                "give a structure point name",
+            ));
         }
         let bed = |v: f64| positive(&k("bed_mass_kg"), v, MAX_MASS_KG, "kg");
         let clearance = |key: &str, v: f64| non_negative(&k(key), v, MAX_DISPLACEMENT_M, "m");
@@ -1815,7 +1954,10 @@ impl DamperSpec {
                 path, bed_mass_kg, ..
             } => {
                 if path.as_os_str().is_empty() {
-                    return Err(format!("{}: give the fields.csv file", k("path")));
+                    return Err(StructureError::invalid(
+                        k("path"),
+                        "give the fields.csv file",
+                    ));
                 }
                 bed(*bed_mass_kg)?;
             }
@@ -1825,7 +1967,10 @@ impl DamperSpec {
                 ..
             } => {
                 if layers.is_empty() {
-                    return Err(format!("{}: give at least one layer", k("layers")));
+                    return Err(StructureError::invalid(
+                        k("layers"),
+                        "give at least one layer",
+                    ));
                 }
                 for (j, l) in layers.iter().enumerate() {
                     let lk = |s: &str| format!("layers[{j}].{s}");
@@ -1944,7 +2089,10 @@ impl DamperSpec {
                 ..
             } => {
                 if scenario.as_os_str().is_empty() {
-                    return Err(format!("{}: give the damper scenario file", k("scenario")));
+                    return Err(StructureError::invalid(
+                        k("scenario"),
+                        "give the damper scenario file",
+                    ));
                 }
                 for (j, x) in attachment_point_m.iter().flatten().enumerate() {
                     check_num(

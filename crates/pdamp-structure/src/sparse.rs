@@ -22,6 +22,73 @@ use crate::modal::ModalBasis;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
+/// Errors of the sparse matrices, the LDLᵀ factorization and the sparse eigen solver.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SparseError {
+    /// A triplet lies outside the matrix.
+    #[error("entry ({i}, {j}) outside the {n}×{n} matrix")]
+    OutsideMatrix {
+        /// Row (0-based).
+        i: usize,
+        /// Column (0-based).
+        j: usize,
+        /// Size of the matrix.
+        n: usize,
+    },
+    /// A triplet's value is not finite.
+    #[error("entry ({i}, {j}) is not finite")]
+    NotFinite {
+        /// Row (0-based).
+        i: usize,
+        /// Column (0-based).
+        j: usize,
+    },
+    /// A zero, tiny or non-finite pivot of the LDLᵀ factorization.
+    #[error(
+        "sparse LDLᵀ: pivot {pivot} is {value:e} (singular matrix: a dof without stiffness and \
+         mass, or an unsupported mechanism)"
+    )]
+    Pivot {
+        /// The pivot (0-based, in the factor's ordering).
+        pivot: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// K and M differ in size.
+    #[error("K is {k}×{k}, M is {m}×{m}")]
+    Sizes {
+        /// Size of K.
+        k: usize,
+        /// Size of M.
+        m: usize,
+    },
+    /// An empty model or no modes requested.
+    #[error("empty model or no modes requested")]
+    Empty,
+    /// Every mode found lies below the lowest frequency kept.
+    #[error("no mode above {min_frequency_hz} Hz")]
+    NoMode {
+        /// The lowest frequency kept, Hz.
+        min_frequency_hz: f64,
+    },
+    /// The subspace iteration lost rank.
+    #[error("subspace iteration: the iterated vectors became dependent")]
+    Dependent,
+    /// The subspace iteration did not converge.
+    #[error("subspace iteration did not converge in {iterations} iterations")]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<SparseError> for String {
+    fn from(e: SparseError) -> String {
+        e.to_string()
+    }
+}
+
 /// `solver = "auto"` uses the sparse solver above this many active dof.
 pub const AUTO_SPARSE_ABOVE_DOF: usize = 1500;
 
@@ -48,14 +115,14 @@ impl SparseSym {
         n: usize,
         triplets: &[(usize, usize, f64)],
         mirror: bool,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, SparseError> {
         let mut t: Vec<(usize, usize, f64)> = Vec::with_capacity(triplets.len() * 2);
         for &(i, j, v) in triplets {
             if i >= n || j >= n {
-                return Err(format!("entry ({i}, {j}) outside the {n}×{n} matrix"));
+                return Err(SparseError::OutsideMatrix { i, j, n });
             }
             if !v.is_finite() {
-                return Err(format!("entry ({i}, {j}) is not finite"));
+                return Err(SparseError::NotFinite { i, j });
             }
             t.push((i, j, v));
             if mirror && i != j {
@@ -216,7 +283,7 @@ impl SkylineLdlt {
     ///
     /// # Errors
     /// A zero or tiny pivot (matrix singular, or not definite enough without pivoting).
-    pub fn factor(a: &SparseSym, perm: &[usize]) -> Result<Self, String> {
+    pub fn factor(a: &SparseSym, perm: &[usize]) -> Result<Self, SparseError> {
         let n = a.n;
         let mut inv = vec![0usize; n];
         for (new, &old) in perm.iter().enumerate() {
@@ -267,10 +334,10 @@ impl SkylineLdlt {
                 li[k - fi] = lik;
             }
             if di.abs() <= 1e-14 * scale || !di.is_finite() {
-                return Err(format!(
-                    "sparse LDLᵀ: pivot {i} is {di:e} (singular matrix: a dof without \
-                     stiffness and mass, or an unsupported mechanism)"
-                ));
+                return Err(SparseError::Pivot {
+                    pivot: i,
+                    value: di,
+                });
             }
             d[i] = di;
         }
@@ -336,13 +403,13 @@ pub fn lowest_modes_sparse(
     mass: &SparseSym,
     n_modes: usize,
     min_frequency_hz: f64,
-) -> Result<ModalBasis, String> {
+) -> Result<ModalBasis, SparseError> {
     let n = stiffness.n;
     if mass.n != n {
-        return Err(format!("K is {n}×{n}, M is {0}×{0}", mass.n));
+        return Err(SparseError::Sizes { k: n, m: mass.n });
     }
     if n == 0 || n_modes == 0 {
-        return Err("empty model or no modes requested".into());
+        return Err(SparseError::Empty);
     }
     let f_shift = min_frequency_hz.max(0.1);
     let sigma = -(TAU * f_shift).powi(2);
@@ -375,7 +442,7 @@ pub fn lowest_modes_sparse(
         }
         if omegas.len() == n_modes || p == n {
             if cols.is_empty() {
-                return Err(format!("no mode above {min_frequency_hz} Hz"));
+                return Err(SparseError::NoMode { min_frequency_hz });
             }
             return Ok(ModalBasis {
                 omega_rad_s: omegas,
@@ -414,7 +481,7 @@ fn subspace_iteration(
     wanted: usize,
     p: usize,
     q: usize,
-) -> Result<(Vec<f64>, DMatrix<f64>), String> {
+) -> Result<(Vec<f64>, DMatrix<f64>), SparseError> {
     let n = m.n;
     // Start vectors: diag(M), then deterministic pseudo-random vectors.
     let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -501,7 +568,7 @@ fn subspace_iteration(
         }
         let r = kept.len();
         if r < p {
-            return Err("subspace iteration: the iterated vectors became dependent".into());
+            return Err(SparseError::Dependent);
         }
         let qm = DMatrix::from_columns(&kept);
         let aq = DMatrix::from_columns(&kept_a);
@@ -532,7 +599,7 @@ fn subspace_iteration(
             }
         }
     }
-    Err("subspace iteration did not converge in 300 iterations".into())
+    Err(SparseError::NotConverged { iterations: 300 })
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@
 //! Layers of one container are interchangeable for the formulas (energies and masses add), so
 //! only sorted particle numbers n₁ ≤ n₂ ≤ … are simulated.
 
+use crate::StructureError;
 use crate::effective::EffectiveDamper;
 use crate::formulas::{LayeredDamper, RollingDamper, VerticalDamper, clearance_m};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
@@ -154,27 +155,30 @@ impl LayerStudySpec {
     ///
     /// # Errors
     /// A message naming the key and the fix.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), StructureError> {
         if self.layers == 0 || self.layers > 100 {
-            return Err(format!(
-                "study.layers must be in [1, 100], got {}",
-                self.layers
+            return Err(StructureError::rule(
+                "study.layers",
+                format!("must be in [1, 100], got {}", self.layers),
             ));
         }
         if self.max_particles_per_layer == 0 || self.max_particles_per_layer > 1_000_000_000 {
-            return Err(format!(
-                "study.max_particles_per_layer must be in [1, 1e9], got {}",
-                self.max_particles_per_layer
+            return Err(StructureError::rule(
+                "study.max_particles_per_layer",
+                format!("must be in [1, 1e9], got {}", self.max_particles_per_layer),
             ));
         }
         if self.min_particles_per_layer > self.max_particles_per_layer {
-            return Err(format!(
-                "study.min_particles_per_layer = {} exceeds max_particles_per_layer = {}",
-                self.min_particles_per_layer, self.max_particles_per_layer
+            return Err(StructureError::rule(
+                "study.min_particles_per_layer",
+                format!(
+                    "= {} exceeds max_particles_per_layer = {}",
+                    self.min_particles_per_layer, self.max_particles_per_layer
+                ),
             ));
         }
         if self.step == 0 {
-            return Err("study.step must be ≥ 1, got 0".into());
+            return Err(StructureError::rule("study.step", "must be ≥ 1, got 0"));
         }
         for (key, v, hi) in [
             ("particle_mass_kg", self.particle_mass_kg, 1e6),
@@ -182,17 +186,24 @@ impl LayerStudySpec {
             ("evaluate_at_s", self.evaluate_at_s, 1e6),
         ] {
             if !(v.is_finite() && v > 0.0 && v <= hi) {
-                return Err(format!(
-                    "study.{key} must be a finite number in (0, {hi:e}], got {v}"
+                return Err(StructureError::rule(
+                    format!("study.{key}"),
+                    format!("must be a finite number in (0, {hi:e}], got {v}"),
                 ));
             }
         }
         let n = self.design_count();
         if n > MAX_DESIGNS {
-            return Err(format!(
-                "study.step: {n:.3e} designs (layers {}, particle numbers {}..={} in steps of {}), \
-                 more than the {MAX_DESIGNS:e} accepted; use a larger step or fewer layers",
-                self.layers, self.min_particles_per_layer, self.max_particles_per_layer, self.step
+            return Err(StructureError::invalid(
+                "study.step",
+                format!(
+                    "{n:.3e} designs (layers {}, particle numbers {}..={} in steps of {}), more \
+                     than the {MAX_DESIGNS:e} accepted; use a larger step or fewer layers",
+                    self.layers,
+                    self.min_particles_per_layer,
+                    self.max_particles_per_layer,
+                    self.step
+                ),
             ));
         }
         Ok(())
@@ -236,10 +247,13 @@ pub fn run_layer_study(
     structure: &ModalStructure,
     free_spec: &FreeVibrationSpec,
     spec: &LayerStudySpec,
-) -> Result<Vec<LayerDesign>, String> {
+) -> Result<Vec<LayerDesign>, StructureError> {
     spec.validate()?;
     if !(spec.evaluate_at_s > 0.0 && spec.evaluate_at_s <= free_spec.duration_s) {
-        return Err("study: evaluate_at_s must lie in (0, analysis.duration_s]".into());
+        return Err(StructureError::invalid(
+            "study",
+            "evaluate_at_s must lie in (0, analysis.duration_s]",
+        ));
     }
     let mut fs = free_spec.clone();
     fs.duration_s = spec.evaluate_at_s;
@@ -275,10 +289,9 @@ pub fn run_layer_study(
 ///
 /// # Errors
 /// Input, solver and I/O errors.
-pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let file: LayerStudyFile =
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value, StructureError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StructureError::read(path, e))?;
+    let file: LayerStudyFile = toml::from_str(&text).map_err(|e| StructureError::toml(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let scn_path = if file.scenario.is_absolute() {
         file.scenario.clone()
@@ -288,18 +301,17 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
     let (scn, structure_spec) = CoupleScenario::load(&scn_path)?;
     file.study
         .validate()
-        .map_err(|m| crate::scenario::locate(path, m))?;
+        .map_err(|m| crate::scenario::locate_error(path, m))?;
     let structure = structure_spec
         .build(scn_path.parent().unwrap_or(Path::new(".")))
-        .map_err(|m| crate::scenario::locate(&scn.structure_source(&scn_path), m))?
+        .map_err(|m| crate::scenario::locate_error(&scn.structure_source(&scn_path), m))?
         .modal;
-    let fs = scn
-        .analysis
-        .free_vibration_spec()
-        .ok_or("the study's scenario needs [analysis] kind = \"free\"")?;
+    let fs = scn.analysis.free_vibration_spec().ok_or_else(|| {
+        StructureError::inconsistent("the study's scenario needs [analysis] kind = \"free\"")
+    })?;
     let started = std::time::Instant::now();
     let designs = run_layer_study(&structure, &fs, &file.study)?;
-    std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(out)?;
     let mut header: Vec<String> = (1..=file.study.layers)
         .map(|i| format!("particles_layer_{i}"))
         .collect();
@@ -315,7 +327,7 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
             r
         })
         .collect();
-    pdamp_io::csv::write_csv_atomic(out.join("study.csv"), &h, &rows).map_err(|e| e.to_string())?;
+    pdamp_io::csv::write_csv_atomic(out.join("study.csv"), &h, &rows)?;
     let empty = designs.iter().find(|d| d.bed_mass_kg == 0.0).cloned();
     let summary = serde_json::json!({
         "study": file.study,
@@ -328,10 +340,7 @@ pub fn run_layer_study_file(path: &Path, out: &Path) -> Result<serde_json::Value
     });
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
-    )
-    .map_err(|e| e.to_string())?;
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
     Ok(summary)
 }

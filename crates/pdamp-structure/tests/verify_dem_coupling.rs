@@ -164,6 +164,7 @@ fn two_beds_add_their_modal_masses() {
         &mut |_| {},
         None,
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("DEM bed 2 at 'b'"), "{err}");
 }

@@ -6,6 +6,7 @@
 //! the plane spanned by $x$ and the orientation vector; $z = x \times y$. Bending in the local
 //! $x$–$y$ plane (deflection $v$) uses $I_z$, bending in $x$–$z$ (deflection $w$) uses $I_y$.
 
+use super::FeError;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -67,7 +68,7 @@ impl BeamSection {
     }
 
     /// Checks that all properties are finite and positive.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FeError> {
         let fields = [
             ("youngs_modulus_pa", self.youngs_modulus_pa),
             ("shear_modulus_pa", self.shear_modulus_pa),
@@ -79,17 +80,13 @@ impl BeamSection {
         ];
         for (name, v) in fields {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!(
-                    "beam section: {name} must be finite and > 0, got {v}"
-                ));
+                return Err(FeError::Section { name, value: v });
             }
         }
         if let Some(k) = self.shear_coefficient
             && !(k.is_finite() && k > 0.0)
         {
-            return Err(format!(
-                "beam section: shear_coefficient must be > 0, got {k}"
-            ));
+            return Err(FeError::ShearCoefficient { value: k });
         }
         Ok(())
     }
@@ -103,19 +100,17 @@ pub fn local_axes(
     x1: [f64; 3],
     x2: [f64; 3],
     orientation: [f64; 3],
-) -> Result<Matrix3<f64>, String> {
+) -> Result<Matrix3<f64>, FeError> {
     let d = Vector3::from(x2) - Vector3::from(x1);
     let l = d.norm();
     if !(l > 0.0 && l.is_finite()) {
-        return Err("beam element of zero length".into());
+        return Err(FeError::ZeroLength);
     }
     let ex = d / l;
     let v = Vector3::from(orientation);
     let ez = ex.cross(&v);
     if ez.norm() < 1e-9 * v.norm().max(1e-300) {
-        return Err(format!(
-            "beam orientation vector {orientation:?} is parallel to the element axis"
-        ));
+        return Err(FeError::ParallelOrientation { orientation });
     }
     let ez = ez.normalize();
     let ey = ez.cross(&ex);
@@ -231,7 +226,7 @@ pub fn global_matrices(
     x1: [f64; 3],
     x2: [f64; 3],
     orientation: [f64; 3],
-) -> Result<(Mat12, Mat12), String> {
+) -> Result<(Mat12, Mat12), FeError> {
     let r = local_axes(x1, x2, orientation)?;
     let l = (Vector3::from(x2) - Vector3::from(x1)).norm();
     let mut t = Mat12::zeros();

@@ -7,6 +7,7 @@
 //! Node order: $(\xi,\eta,\zeta)$ = (−,−,−), (+,−,−), (+,+,−), (−,+,−), (−,−,+), (+,−,+),
 //! (+,+,+), (−,+,+).
 
+use super::FeError;
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
 /// 24 × 24 element matrix.
@@ -98,7 +99,7 @@ pub fn matrices(
     x: &[[f64; 3]; 8],
     mat: &SolidMaterial,
     incompatible_modes: bool,
-) -> Result<(Mat24, Mat24), String> {
+) -> Result<(Mat24, Mat24), FeError> {
     let d = elasticity(mat);
     let g = 1.0 / 3f64.sqrt();
     let mut k = Mat24::zeros();
@@ -108,18 +109,16 @@ pub fn matrices(
     let (_, dn0) = shape([0.0; 3]);
     let j0 = jacobian(x, &dn0);
     let det0 = j0.determinant();
-    let j0_inv = j0.try_inverse().ok_or("hex8: singular centre Jacobian")?;
+    let j0_inv = j0.try_inverse().ok_or(FeError::SingularCentreJacobian)?;
     for gp in SIGNS.iter() {
         let xi = [gp[0] * g, gp[1] * g, gp[2] * g];
         let (n, dn) = shape(xi);
         let j = jacobian(x, &dn);
         let det = j.determinant();
         if det <= 0.0 || !det.is_finite() {
-            return Err(format!(
-                "hex8: non-positive Jacobian determinant {det:e} (check node order)"
-            ));
+            return Err(FeError::NonPositiveJacobian { determinant: det });
         }
-        let j_inv = j.try_inverse().ok_or("hex8: singular Jacobian")?;
+        let j_inv = j.try_inverse().ok_or(FeError::SingularJacobian)?;
         let mut b = SMatrix::<f64, 6, 24>::zeros();
         for (a, dna) in dn.iter().enumerate() {
             let gl = j_inv * Vector3::from(*dna);
@@ -157,7 +156,7 @@ pub fn matrices(
     if incompatible_modes {
         let inv = k_ii
             .try_inverse()
-            .ok_or("hex8: singular incompatible-mode block")?;
+            .ok_or(FeError::SingularIncompatibleModes)?;
         let corr = &k_ci * inv * k_ci.transpose();
         for r in 0..24 {
             for c in 0..24 {

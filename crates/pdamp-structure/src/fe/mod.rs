@@ -7,12 +7,103 @@ pub mod beam;
 pub mod hex8;
 pub mod plate;
 
-use crate::sparse::SparseSym;
+use crate::sparse::{SparseError, SparseSym};
 use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
 pub use beam::BeamSection;
 pub use hex8::SolidMaterial;
+
+/// Errors of the finite-element models: invalid properties, degenerate elements, bad node
+/// indices.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FeError {
+    /// The model has no nodes.
+    #[error("FE model has no nodes")]
+    NoNodes,
+    /// An element or point mass refers to a node that does not exist.
+    #[error("{item}: node {node} does not exist ({nodes} nodes)")]
+    NoSuchNode {
+        /// `beam`, `solid` or `point mass`.
+        item: &'static str,
+        /// The node index (0-based).
+        node: usize,
+        /// Nodes of the model.
+        nodes: usize,
+    },
+    /// An error of one element.
+    #[error("{kind} {index}: {error}")]
+    Element {
+        /// `beam` or `solid`.
+        kind: &'static str,
+        /// The element's index (0-based).
+        index: usize,
+        /// The element's error.
+        error: Box<FeError>,
+    },
+    /// A point mass is negative or not finite.
+    #[error("point mass at node {node}: mass must be ≥ 0")]
+    PointMass {
+        /// The node (0-based).
+        node: usize,
+    },
+    /// A beam-section property is not finite and positive.
+    #[error("beam section: {name} must be finite and > 0, got {value}")]
+    Section {
+        /// The property.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The shear coefficient of a Timoshenko section is not positive.
+    #[error("beam section: shear_coefficient must be > 0, got {value}")]
+    ShearCoefficient {
+        /// Its value.
+        value: f64,
+    },
+    /// A beam element has zero (or non-finite) length.
+    #[error("beam element of zero length")]
+    ZeroLength,
+    /// The orientation vector of a beam is parallel to its axis.
+    #[error("beam orientation vector {orientation:?} is parallel to the element axis")]
+    ParallelOrientation {
+        /// The orientation vector.
+        orientation: [f64; 3],
+    },
+    /// A hex8 element is singular at its centre.
+    #[error("hex8: singular centre Jacobian")]
+    SingularCentreJacobian,
+    /// A hex8 element is inverted or degenerate at a Gauss point.
+    #[error("hex8: non-positive Jacobian determinant {determinant:e} (check node order)")]
+    NonPositiveJacobian {
+        /// The determinant.
+        determinant: f64,
+    },
+    /// A hex8 Jacobian is singular at a Gauss point.
+    #[error("hex8: singular Jacobian")]
+    SingularJacobian,
+    /// The incompatible-mode block of a hex8 element is singular.
+    #[error("hex8: singular incompatible-mode block")]
+    SingularIncompatibleModes,
+    /// A plate property is out of range: `plate.key: message`.
+    #[error("plate.{key}: {message}")]
+    Plate {
+        /// The key (`length_m`, `poisson_ratio`, `elements_x, elements_y`).
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The sparse assembly failed.
+    #[error(transparent)]
+    Sparse(#[from] SparseError),
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<FeError> for String {
+    fn from(e: FeError) -> String {
+        e.to_string()
+    }
+}
 
 /// One nodal degree of freedom.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -320,16 +411,17 @@ impl FeModel {
     /// # Errors
     /// Invalid node indices, degenerate elements or invalid properties.
     #[allow(clippy::type_complexity)]
-    fn triplets(&self) -> Result<(Vec<(usize, usize, f64)>, Vec<(usize, usize, f64)>), String> {
+    fn triplets(&self) -> Result<(Vec<(usize, usize, f64)>, Vec<(usize, usize, f64)>), FeError> {
         if self.nodes.is_empty() {
-            return Err("FE model has no nodes".into());
+            return Err(FeError::NoNodes);
         }
-        let check = |i: usize, what: &str| -> Result<(), String> {
+        let check = |i: usize, what: &'static str| {
             if i >= self.nodes.len() {
-                Err(format!(
-                    "{what}: node {i} does not exist ({} nodes)",
-                    self.nodes.len()
-                ))
+                Err(FeError::NoSuchNode {
+                    item: what,
+                    node: i,
+                    nodes: self.nodes.len(),
+                })
             } else {
                 Ok(())
             }
@@ -337,7 +429,12 @@ impl FeModel {
         let mut k = Vec::new();
         let mut m = Vec::new();
         for (e, b) in self.beams.iter().enumerate() {
-            b.section.validate().map_err(|s| format!("beam {e}: {s}"))?;
+            let in_beam = |s: FeError| FeError::Element {
+                kind: "beam",
+                index: e,
+                error: Box::new(s),
+            };
+            b.section.validate().map_err(in_beam)?;
             check(b.nodes[0], "beam")?;
             check(b.nodes[1], "beam")?;
             let (ke, me) = beam::global_matrices(
@@ -346,7 +443,7 @@ impl FeModel {
                 self.nodes[b.nodes[1]],
                 b.orientation,
             )
-            .map_err(|s| format!("beam {e}: {s}"))?;
+            .map_err(in_beam)?;
             for a in 0..2 {
                 for c in 0..2 {
                     for i in 0..6 {
@@ -364,8 +461,14 @@ impl FeModel {
                 check(nd, "solid")?;
             }
             let x = s.nodes.map(|nd| self.nodes[nd]);
-            let (ke, me) = hex8::matrices(&x, &s.material, s.incompatible_modes)
-                .map_err(|msg| format!("solid {e}: {msg}"))?;
+            let (ke, me) =
+                hex8::matrices(&x, &s.material, s.incompatible_modes).map_err(|msg| {
+                    FeError::Element {
+                        kind: "solid",
+                        index: e,
+                        error: Box::new(msg),
+                    }
+                })?;
             for a in 0..8 {
                 for c in 0..8 {
                     for i in 0..3 {
@@ -381,7 +484,7 @@ impl FeModel {
         for p in &self.point_masses {
             check(p.node, "point mass")?;
             if !(p.mass_kg >= 0.0 && p.mass_kg.is_finite()) {
-                return Err(format!("point mass at node {}: mass must be ≥ 0", p.node));
+                return Err(FeError::PointMass { node: p.node });
             }
             // Rigid offset r: u_p = u_n + θ × r = u_n − [r]× θ.
             let r = p.offset_m;
@@ -457,7 +560,7 @@ impl FeModel {
     ///
     /// # Errors
     /// Invalid node indices, degenerate elements or invalid properties.
-    pub fn assemble(&self) -> Result<Assembled, String> {
+    pub fn assemble(&self) -> Result<Assembled, FeError> {
         let (k, m) = self.triplets()?;
         let (dofs, rows, map) = self.active_dofs(&k, &m);
         let na = rows.len();
@@ -481,7 +584,7 @@ impl FeModel {
     ///
     /// # Errors
     /// As [`FeModel::assemble`].
-    pub fn assemble_sparse(&self) -> Result<AssembledSparse, String> {
+    pub fn assemble_sparse(&self) -> Result<AssembledSparse, FeError> {
         let (k, m) = self.triplets()?;
         let (dofs, rows, map) = self.active_dofs(&k, &m);
         let sel = |t: &[(usize, usize, f64)]| {

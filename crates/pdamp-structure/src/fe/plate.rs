@@ -14,7 +14,7 @@
 //! $M_e = \rho h\int N^T N\,dA$ (rotary inertia neglected, thin plate). Both by 4 × 4 Gauss
 //! points (exact for the element's polynomials).
 
-use super::{Assembled, Dof};
+use super::{Assembled, Dof, FeError};
 use nalgebra::{DMatrix, SMatrix};
 
 /// A rectangular Kirchhoff plate `[0, length] × [0, width]` in the x–y plane, deflecting
@@ -166,7 +166,7 @@ impl Plate {
     ///
     /// # Errors
     /// Non-positive sizes, properties or element counts (named).
-    pub fn assemble(&self) -> Result<Assembled, String> {
+    pub fn assemble(&self) -> Result<Assembled, FeError> {
         for (key, v) in [
             ("length_m", self.length_m),
             ("width_m", self.width_m),
@@ -175,17 +175,23 @@ impl Plate {
             ("density_kg_m3", self.density_kg_m3),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("plate.{key}: must be a positive number, got {v}"));
+                return Err(FeError::Plate {
+                    key,
+                    message: format!("must be a positive number, got {v}"),
+                });
             }
         }
         if !(0.0..0.5).contains(&self.poisson_ratio) {
-            return Err(format!(
-                "plate.poisson_ratio: must be in [0, 0.5), got {}",
-                self.poisson_ratio
-            ));
+            return Err(FeError::Plate {
+                key: "poisson_ratio",
+                message: format!("must be in [0, 0.5), got {}", self.poisson_ratio),
+            });
         }
         if self.elements_x == 0 || self.elements_y == 0 {
-            return Err("plate.elements_x, elements_y: at least one element each".into());
+            return Err(FeError::Plate {
+                key: "elements_x, elements_y",
+                message: "at least one element each".into(),
+            });
         }
         let (ke, me) = self.element();
         let (nx, ny) = (self.elements_x, self.elements_y);
