@@ -3,6 +3,7 @@
 //! the transient cycles and evaluate the driving force and container velocity over whole cycles
 //! with the complex power method [D Eq. 3.12–3.17].
 
+use crate::DesignError;
 use crate::convergence::{ConvergenceSpec, RunningEstimate, has_converged};
 use pdamp_dem::{HarmonicTranslation, Motion, Vec3, World};
 use pdamp_io::scenario::{STANDARD_GRAVITY_M_S2, Scenario};
@@ -109,12 +110,12 @@ pub trait PointObserver {
     }
 
     /// What the observer has gathered, for a checkpoint of the point (nothing by default).
-    fn save_state(&self) -> Result<Vec<u8>, String> {
+    fn save_state(&self) -> Result<Vec<u8>, DesignError> {
         Ok(Vec::new())
     }
 
     /// Continues from what [`Self::save_state`] wrote.
-    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), String> {
+    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), DesignError> {
         Ok(())
     }
 }
@@ -197,16 +198,20 @@ pub fn harmonic_amplitude(t_s: &[f64], x: &[f64], frequency_hz: f64) -> (f64, f6
 }
 
 /// The `[damper]` section of a scenario and the index of its container body.
-fn container_of(scenario: &Scenario) -> Result<(&pdamp_io::scenario::DamperSpec, usize), String> {
+fn container_of(
+    scenario: &Scenario,
+) -> Result<(&pdamp_io::scenario::DamperSpec, usize), DesignError> {
     let spec = scenario
         .damper
         .as_ref()
-        .ok_or("scenario has no [damper] section")?;
+        .ok_or(DesignError::NoDamperSection)?;
     let container = scenario
         .bodies
         .iter()
         .position(|b| b.name == spec.container_body)
-        .ok_or_else(|| format!("damper.container_body: no body '{}'", spec.container_body))?;
+        .ok_or_else(|| DesignError::NoContainerBody {
+            body: spec.container_body.clone(),
+        })?;
     Ok((spec, container))
 }
 
@@ -217,10 +222,11 @@ impl Damper {
         scenario: &Scenario,
         base_dir: &Path,
         mut progress: impl FnMut(f64),
-    ) -> Result<Self, String> {
+    ) -> Result<Self, DesignError> {
         // The damper section is checked before the (costly) bed preparation.
         container_of(scenario)?;
-        let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))?;
+        let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))
+            .map_err(DesignError::io)?;
         Self::from_prepared(scenario, prepared)
     }
 
@@ -229,7 +235,7 @@ impl Damper {
     pub fn from_prepared(
         scenario: &Scenario,
         prepared: pdamp_io::prepare::PreparedBed,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, DesignError> {
         let (spec, container) = container_of(scenario)?;
         let mut world = prepared.world;
         world.bodies[container].motion = Motion::Fixed;
@@ -321,7 +327,7 @@ impl Damper {
         frequency_hz: f64,
         amplitude_m: f64,
         observer: &mut dyn PointObserver,
-    ) -> Result<PointResult, String> {
+    ) -> Result<PointResult, DesignError> {
         self.run_point_checkpointed(frequency_hz, amplitude_m, observer, None)
     }
 
@@ -333,7 +339,7 @@ impl Damper {
         amplitude_m: f64,
         observer: &mut dyn PointObserver,
         checkpointing: Option<&PointCheckpointing>,
-    ) -> Result<PointResult, String> {
+    ) -> Result<PointResult, DesignError> {
         use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
         let start = std::time::Instant::now();
         let omega = 2.0 * PI * frequency_hz;
@@ -370,13 +376,14 @@ impl Damper {
         let mut wall_before = 0.0;
         let resumed = match checkpointing {
             Some(c) if c.resume => {
-                match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)? {
+                match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)
+                    .map_err(DesignError::io)?
+                {
                     Some(PointCheckpoint::Running(p)) => Some(p),
                     Some(PointCheckpoint::Finished) => {
-                        return Err(format!(
-                            "checkpoint {}: the point is finished already",
-                            c.path.display()
-                        ));
+                        return Err(DesignError::CheckpointFinished {
+                            path: c.path.clone(),
+                        });
                     }
                     None => None,
                 }
@@ -385,13 +392,13 @@ impl Damper {
         };
         if let Some(p) = resumed {
             if p.frequency_hz != frequency_hz || p.amplitude_m != amplitude_m {
-                return Err(format!(
-                    "checkpoint: written for f = {} Hz, X = {} m, not this point",
-                    p.frequency_hz, p.amplitude_m
-                ));
+                return Err(DesignError::CheckpointOtherPoint {
+                    frequency_hz: p.frequency_hz,
+                    amplitude_m: p.amplitude_m,
+                });
             }
             let p = *p;
-            w.restore_state(p.world)?;
+            w.restore_state(p.world).map_err(DesignError::dem)?;
             times = p.times;
             force = p.force;
             velocity = p.velocity;
@@ -475,7 +482,7 @@ impl Damper {
                             wall_time_s: wall_before + start.elapsed().as_secs_f64(),
                         };
                         ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
-                            .map_err(String::from)
+                            .map_err(DesignError::io)
                     });
                     if let Err(e) = r {
                         save_error = Some(e);
@@ -490,27 +497,27 @@ impl Damper {
             if let Some(e) = save_error.take() {
                 return Err(e);
             }
-            if let Some(h) = health {
-                return Err(format!(
-                    "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m, cycle {}: {h}",
-                    cycle + 1
-                ));
+            if let Some(source) = health {
+                return Err(DesignError::Health {
+                    frequency_hz,
+                    amplitude_m,
+                    cycle: cycle + 1,
+                    source,
+                });
             }
             if pdamp_io::checkpoint::stop_requested() {
-                return Err(format!(
-                    "{}: point f = {frequency_hz} Hz, X = {amplitude_m:.4e} m stopped in cycle {}",
-                    pdamp_io::checkpoint::INTERRUPTED,
-                    cycle + 1
-                ));
+                return Err(DesignError::PointInterrupted {
+                    frequency_hz,
+                    amplitude_m,
+                    cycle: cycle + 1,
+                });
             }
             if !w.ledger.kinetic_j.is_finite() {
-                return Err(format!(
-                    "f = {frequency_hz} Hz, X = {amplitude_m:.4e} m: the simulation became unstable in cycle {} \
-                     (non-finite kinetic energy). Reduce simulation.time_step_s, or for the Gonthier and \
-                     Lankarani–Nikravesh laws raise min_impact_velocity_m_s: enduring contacts created at rest \
-                     get a damping coefficient ∝ 1/min_impact_velocity_m_s that a fixed explicit step cannot follow",
-                    cycle + 1
-                ));
+                return Err(DesignError::Unstable {
+                    frequency_hz,
+                    amplitude_m,
+                    cycle: cycle + 1,
+                });
             }
             if let Some(c) = &self.convergence
                 && evaluating
@@ -561,7 +568,11 @@ impl Damper {
             self.bed_mass_kg,
             self.container_mass_kg,
         )
-        .map_err(|e| format!("complex power at f = {frequency_hz} Hz, X = {amplitude_m} m: {e}"))?;
+        .map_err(|source| DesignError::ComplexPower {
+            frequency_hz,
+            amplitude_m,
+            source,
+        })?;
         let l0 = ledger0.expect("evaluated cycles");
         Ok(PointResult::evaluate(
             (frequency_hz, amplitude_m),

@@ -2,6 +2,7 @@
 //! frequencies × amplitudes, each point an independent simulation from the same settled bed,
 //! run in parallel and resumable (every finished point is stored at once and never recomputed).
 
+use crate::DesignError;
 use crate::damper::{Damper, PointResult};
 use pdamp_io::scenario::{AmplitudeAxis, FieldsSpec};
 use std::path::{Path, PathBuf};
@@ -145,10 +146,8 @@ pub struct FieldGrid {
 
 impl FieldGrid {
     /// Grid from the scenario's `[fields]` section.
-    pub fn from_spec(spec: &FieldsSpec) -> Result<Self, String> {
-        let (axis, a) = spec
-            .amplitude_axis()
-            .ok_or("fields: give exactly one amplitude axis")?;
+    pub fn from_spec(spec: &FieldsSpec) -> Result<Self, DesignError> {
+        let (axis, a) = spec.amplitude_axis().ok_or(DesignError::AmplitudeAxis)?;
         Ok(Self {
             frequencies_hz: spec.frequencies_hz.values(),
             amplitude_axis: axis,
@@ -277,22 +276,22 @@ pub fn store_point(
     dir: &Path,
     i: usize,
     j: usize,
-    r: Result<PointResult, String>,
-) -> Result<PointResult, String> {
+    r: Result<PointResult, DesignError>,
+) -> Result<PointResult, DesignError> {
     match r {
         Ok(r) => {
-            let json = serde_json::to_string_pretty(&r).map_err(|e| e.to_string())?;
-            pdamp_io::atomic::write_atomic(point_path(dir, i, j), json.as_bytes())
-                .map_err(|e| format!("output: {e}"))?;
+            let json = serde_json::to_string_pretty(&r)?;
+            let path = point_path(dir, i, j);
+            pdamp_io::atomic::write_atomic(&path, json.as_bytes())
+                .map_err(DesignError::write(path))?;
             let _ = std::fs::remove_file(point_error_path(dir, i, j));
             Ok(r)
         }
-        Err(e) if e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => {
-            Err(e)
-        }
+        Err(e) if e.is_output() || e.is_interrupted() => Err(e),
         Err(e) => {
-            pdamp_io::atomic::write_atomic(point_error_path(dir, i, j), e.as_bytes())
-                .map_err(|e| format!("output: {e}"))?;
+            let path = point_error_path(dir, i, j);
+            pdamp_io::atomic::write_atomic(&path, e.to_string().as_bytes())
+                .map_err(DesignError::write(path))?;
             Err(e)
         }
     }
@@ -353,7 +352,7 @@ pub fn run_fields(
     grid: &FieldGrid,
     out_dir: &Path,
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
+) -> Result<FieldsOutcome, DesignError> {
     run_fields_with(damper, grid, out_dir, ThreadSplit::default(), on_point)
 }
 
@@ -385,7 +384,7 @@ pub fn run_fields_with(
     out_dir: &Path,
     split: ThreadSplit,
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
+) -> Result<FieldsOutcome, DesignError> {
     run_fields_on(damper, grid, out_dir, PointEngine::Cpu(split), on_point)
 }
 
@@ -396,10 +395,10 @@ pub fn run_fields_on(
     out_dir: &Path,
     engine: PointEngine<'_>,
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
+) -> Result<FieldsOutcome, DesignError> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
-    let io = |e: std::io::Error| format!("output: {e}");
-    std::fs::create_dir_all(out_dir.join("points")).map_err(io)?;
+    std::fs::create_dir_all(out_dir.join("points"))
+        .map_err(DesignError::write(out_dir.join("points")))?;
     let points = grid.points();
     let total = points.len();
     let mut results: Vec<Option<PointResult>> = points
@@ -415,14 +414,14 @@ pub fn run_fields_on(
     let max_steps = |f: f64| damper.cycles as f64 * (1.0 / (f * damper.time_step_s)).ceil();
     pending.sort_by(|&a, &b| max_steps(points[b].2).total_cmp(&max_steps(points[a].2)));
     let particles = damper.settled.particles.len();
-    let store = |k: usize, r: Result<PointResult, String>| {
+    let store = |k: usize, r: Result<PointResult, DesignError>| {
         let (i, j, _, _) = points[k];
         let stored = store_point(out_dir, i, j, r);
         let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         on_point(n, total);
         stored
     };
-    let fresh: Vec<(usize, Result<PointResult, String>)> = match engine {
+    let fresh: Vec<(usize, Result<PointResult, DesignError>)> = match engine {
         PointEngine::Cpu(split) => run_split(&pending, split, particles, |k| {
             let (_, _, f, x) = points[k];
             store(k, damper.run_point(f, x, &mut ()))
@@ -443,8 +442,10 @@ pub fn run_fields_on(
                         }
                     }
                     Err(e) => {
+                        // The batch's error is every point's.
+                        let e = std::sync::Arc::new(e);
                         for &k in batch {
-                            fresh.push((k, store(k, Err(e.clone()))));
+                            fresh.push((k, store(k, Err(DesignError::Batch(e.clone())))));
                         }
                     }
                 }
@@ -457,7 +458,7 @@ pub fn run_fields_on(
             for &k in &pending {
                 let (i, j, f, x) = points[k];
                 match stored_point(out_dir, i, j, f, x) {
-                    StoredPoint::Failed(e) => fresh.push((k, Err(e))),
+                    StoredPoint::Failed(e) => fresh.push((k, Err(DesignError::StoredFailure(e)))),
                     StoredPoint::Corrupt(why) => missing.push(why),
                     StoredPoint::Missing | StoredPoint::Done(_) => {
                         missing.push(format!("f = {f} Hz, X = {x:.4e} m (f{i:03}_a{j:03})"))
@@ -465,18 +466,14 @@ pub fn run_fields_on(
                 }
             }
             if !missing.is_empty() {
-                let shown: Vec<&str> = missing.iter().take(5).map(|s| s.as_str()).collect();
-                return Err(format!(
-                    "{}: {} of {total} points are not finished: {}{}",
-                    out_dir.join("points").display(),
-                    missing.len(),
-                    shown.join("; "),
-                    if missing.len() > shown.len() {
-                        "; …"
-                    } else {
-                        ""
-                    }
-                ));
+                let n = missing.len();
+                missing.truncate(5);
+                return Err(DesignError::NotFinished {
+                    dir: out_dir.join("points"),
+                    missing: n,
+                    total,
+                    shown: missing,
+                });
             }
             fresh
         }
@@ -487,23 +484,23 @@ pub fn run_fields_on(
     for (k, r) in fresh {
         match r {
             Ok(r) => results[k] = Some(r),
-            Err(e) if e.starts_with("output:") => return Err(e),
-            Err(e) if e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => interrupted += 1,
+            Err(e) if e.is_output() => return Err(e),
+            Err(e) if e.is_interrupted() => interrupted += 1,
             Err(e) => {
                 let (_, _, f, x) = points[k];
-                failed.push((f, x, e));
+                failed.push((f, x, e.to_string()));
                 results[k] = Some(failed_point(f, x));
             }
         }
     }
     if interrupted > 0 {
         let finished = results.iter().filter(|r| r.is_some()).count();
-        return Err(format!(
-            "{}: {finished} of {total} points are finished and stored in {}; run the same \
-             command again to compute the other {interrupted}",
-            pdamp_io::checkpoint::INTERRUPTED,
-            out_dir.join("points").display()
-        ));
+        return Err(DesignError::FieldInterrupted {
+            finished,
+            total,
+            interrupted,
+            dir: out_dir.join("points"),
+        });
     }
     let points: Vec<PointResult> = results.into_iter().map(|r| r.unwrap()).collect();
     write_fields_csv(&out_dir.join("fields.csv"), &points)?;
@@ -536,7 +533,7 @@ pub fn point_checkpoint_path(dir: &Path, i: usize, j: usize) -> PathBuf {
 
 /// Outcome of one point of [`run_field_points`]: `Ok(true)` computed now, `Ok(false)` found
 /// finished in the store, `Err` the error of a failed point (stored next to its slot).
-pub type PointRun = Result<bool, String>;
+pub type PointRun = Result<bool, DesignError>;
 
 /// Runs the grid points `indices` (positions in [`FieldGrid::points`], frequency-major) of the
 /// field stored in `out_dir` that are not finished yet — a task of a sweep — with the threads
@@ -551,16 +548,17 @@ pub fn run_field_points(
     indices: &[usize],
     split: ThreadSplit,
     checkpoints: Option<&PointCheckpoints>,
-    on_point: impl Fn(usize, &Result<PointResult, String>) + Sync,
-) -> Result<Vec<(usize, PointRun)>, String> {
+    on_point: impl Fn(usize, &Result<PointResult, DesignError>) + Sync,
+) -> Result<Vec<(usize, PointRun)>, DesignError> {
     let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
-    std::fs::create_dir_all(out_dir.join("points")).map_err(|e| format!("output: {e}"))?;
+    std::fs::create_dir_all(out_dir.join("points"))
+        .map_err(DesignError::write(out_dir.join("points")))?;
     let points = grid.points();
     if let Some(&k) = indices.iter().find(|&&k| k >= points.len()) {
-        return Err(format!(
-            "grid point {k} does not exist: the grid has {} points",
-            points.len()
-        ));
+        return Err(DesignError::NoGridPoint {
+            index: k,
+            points: points.len(),
+        });
     }
     let mut out: Vec<(usize, PointRun)> = Vec::with_capacity(indices.len());
     let mut pending = Vec::new();
@@ -577,7 +575,7 @@ pub fn run_field_points(
         let (i, j, f, x) = points[k];
         if pdamp_io::checkpoint::stop_requested() {
             // Stopped (SIGTERM of a cancelled task): the points not started stay missing.
-            return Err(pdamp_io::checkpoint::INTERRUPTED.to_string());
+            return Err(DesignError::Interrupted);
         }
         let r = match checkpoints {
             None => damper.run_point(f, x, &mut ()),
@@ -602,7 +600,7 @@ pub fn run_field_points(
                 // progress, not its result: it starts again.
                 if resume
                     && let Err(e) = &r
-                    && e.starts_with("checkpoint")
+                    && e.is_checkpoint()
                 {
                     let _ = std::fs::remove_file(&path);
                     r = run(false);
@@ -620,11 +618,7 @@ pub fn run_field_points(
     for (k, r) in ran {
         match r {
             Ok(_) => out.push((k, Ok(true))),
-            Err(e)
-                if e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED) =>
-            {
-                return Err(e);
-            }
+            Err(e) if e.is_output() || e.is_interrupted() => return Err(e),
             Err(e) => out.push((k, Err(e))),
         }
     }
@@ -633,9 +627,9 @@ pub fn run_field_points(
 }
 
 /// Writes `fields.csv` atomically.
-pub fn write_fields_csv(path: &Path, points: &[PointResult]) -> Result<(), String> {
+pub fn write_fields_csv(path: &Path, points: &[PointResult]) -> Result<(), DesignError> {
     pdamp_io::csv::write_csv_atomic(path, &FIELD_COLUMNS, points.iter().map(field_row))
-        .map_err(|e| format!("output: {e}"))
+        .map_err(DesignError::write_csv(path))
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! the end), so nothing is read back per step. The points run all their cycles (the early stop
 //! on convergence of the CPU path is not offered here).
 
+use crate::DesignError;
 use crate::damper::{Damper, PointResult, harmonic_amplitude};
 use pdamp_dem::{HarmonicTranslation, Motion, World};
 use pdamp_gpu::{GpuBatch, GpuDevice};
@@ -21,7 +22,7 @@ impl Damper {
         &self,
         gpu: &GpuDevice,
         points: &[(f64, f64)],
-    ) -> Result<Vec<PointResult>, String> {
+    ) -> Result<Vec<PointResult>, DesignError> {
         let jobs: Vec<(&Damper, f64, f64)> = points.iter().map(|&(f, x)| (self, f, x)).collect();
         run_points_gpu(gpu, &jobs)
     }
@@ -36,7 +37,7 @@ impl Damper {
 pub fn run_points_gpu(
     gpu: &GpuDevice,
     jobs: &[(&Damper, f64, f64)],
-) -> Result<Vec<PointResult>, String> {
+) -> Result<Vec<PointResult>, DesignError> {
     let start = std::time::Instant::now();
     let Some(&(first, _, _)) = jobs.first() else {
         return Ok(Vec::new());
@@ -46,19 +47,23 @@ pub fn run_points_gpu(
         .iter()
         .position(|(d, _, _)| d.cycles != cycles || d.transient_cycles != transient_cycles)
     {
-        return Err(format!(
-            "GPU points: point {k} has {}/{} cycles/transient cycles, point 0 {cycles}/{transient_cycles}; one batch runs one cycle count",
-            jobs[k].0.cycles, jobs[k].0.transient_cycles
-        ));
+        return Err(DesignError::GpuCycles {
+            point: k,
+            cycles: jobs[k].0.cycles,
+            transient_cycles: jobs[k].0.transient_cycles,
+            cycles0: cycles,
+            transient_cycles0: transient_cycles,
+        });
     }
     let points: Vec<(f64, f64)> = jobs.iter().map(|&(_, f, x)| (f, x)).collect();
     let mut worlds: Vec<World> = Vec::with_capacity(points.len());
     for &(this, f, x) in jobs {
         let e = this.direction;
         if !(f > 0.0 && f.is_finite() && x.is_finite()) {
-            return Err(format!(
-                "excitation point f = {f} Hz, X = {x} m is not valid"
-            ));
+            return Err(DesignError::InvalidPoint {
+                frequency_hz: f,
+                amplitude_m: x,
+            });
         }
         let mut w = this.settled.clone();
         w.bodies[this.container].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
@@ -74,13 +79,13 @@ pub fn run_points_gpu(
         worlds.push(w);
     }
     let refs: Vec<&World> = worlds.iter().collect();
-    let mut batch = GpuBatch::new(gpu, &refs).map_err(|e| e.to_string())?;
+    let mut batch = GpuBatch::new(gpu, &refs)?;
     drop(refs);
     let mut l0 = vec![None; points.len()];
     for cycle in 0..cycles {
         if cycle == transient_cycles {
             for (k, &(this, f, _)) in jobs.iter().enumerate() {
-                l0[k] = Some(batch.snapshot(k).map_err(|e| e.to_string())?.ledger);
+                l0[k] = Some(batch.snapshot(k)?.ledger);
                 let period = 1.0 / f;
                 batch.set_load_sampling(
                     k,
@@ -95,23 +100,23 @@ pub fn run_points_gpu(
             .iter()
             .map(|&(f, _)| (cycle + 1) as f64 / f)
             .collect();
-        batch.run_until(&ends).map_err(|e| {
-            format!(
-                "GPU batch of {} points, cycle {}: {e}",
-                points.len(),
-                cycle + 1
-            )
-        })?;
+        batch
+            .run_until(&ends)
+            .map_err(|source| DesignError::GpuRun {
+                points: points.len(),
+                cycle: cycle + 1,
+                source,
+            })?;
     }
     let n_eval = cycles - transient_cycles;
     let mut out = Vec::with_capacity(points.len());
     for (k, &(this, frequency_hz, amplitude_m)) in jobs.iter().enumerate() {
         let e = this.direction;
         let omega = 2.0 * PI * frequency_hz;
-        let (times, re, im) = batch.load_dft(k).map_err(|e| e.to_string())?;
+        let (times, re, im) = batch.load_dft(k)?;
         let span = times.last().copied().unwrap_or(0.0) - times.first().copied().unwrap_or(0.0);
         if span <= 0.0 {
-            return Err(format!("point {k}: no evaluated cycles"));
+            return Err(DesignError::NoEvaluatedCycles { point: k });
         }
         // Driving force = container inertia − particle force on the container [D Sect. 3.2.2].
         let inertia: Vec<f64> = times
@@ -135,9 +140,13 @@ pub fn run_points_gpu(
             this.bed_mass_kg,
             this.container_mass_kg,
         )
-        .map_err(|e| format!("complex power at f = {frequency_hz} Hz, X = {amplitude_m} m: {e}"))?;
+        .map_err(|source| DesignError::ComplexPower {
+            frequency_hz,
+            amplitude_m,
+            source,
+        })?;
         let a = l0[k].expect("evaluated cycles");
-        let b = batch.snapshot(k).map_err(|e| e.to_string())?.ledger;
+        let b = batch.snapshot(k)?.ledger;
         out.push(PointResult::evaluate(
             (frequency_hz, amplitude_m),
             &cp,

@@ -6,6 +6,7 @@
 pub mod convergence;
 pub mod damper;
 pub mod ensemble;
+mod error;
 pub mod event_driven;
 pub mod fields;
 #[cfg(feature = "gpu")]
@@ -15,4 +16,5 @@ pub mod plots;
 pub mod report;
 
 pub use damper::{Damper, PointObserver, PointResult};
+pub use error::DesignError;
 pub use fields::{FieldGrid, PointEngine, ThreadSplit, run_fields, run_fields_on, run_fields_with};

@@ -340,7 +340,7 @@ struct RecorderState {
 }
 
 impl PointObserver for MotionRecorder {
-    fn save_state(&self) -> Result<Vec<u8>, String> {
+    fn save_state(&self) -> Result<Vec<u8>, crate::DesignError> {
         pdamp_io::checkpoint::encode_part(&RecorderState {
             fields: self.fields.clone(),
             trajectories: self.trajectories.clone(),
@@ -353,18 +353,19 @@ impl PointObserver for MotionRecorder {
             fd_slot: self.fd_slot,
             fd_work: self.fd_work,
         })
-        .map_err(String::from)
+        .map_err(crate::DesignError::io)
     }
 
-    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let s: RecorderState = pdamp_io::checkpoint::decode_part(bytes)?;
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), crate::DesignError> {
+        let s: RecorderState =
+            pdamp_io::checkpoint::decode_part(bytes).map_err(crate::DesignError::io)?;
         if s.fields.len() != self.fields.len()
             || s.fields
                 .iter()
                 .zip(&self.fields)
                 .any(|(a, b)| a.count.len() != b.count.len())
         {
-            return Err("checkpoint: the velocity-field grid differs from the scenario's".into());
+            return Err(crate::DesignError::CheckpointFieldGrid);
         }
         self.fields = s.fields;
         self.trajectories = s.trajectories;

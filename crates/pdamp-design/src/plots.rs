@@ -3,6 +3,7 @@
 //! container displacement of a point over time and as hysteresis loops [D Sect. 3.2.2]. PNG
 //! and SVG each.
 
+use crate::DesignError;
 use crate::damper::PointResult;
 use crate::fields::FieldGrid;
 use crate::motion::MotionRecorder;
@@ -10,17 +11,31 @@ use pdamp_plot::{
     Axis, ColorScale, HeatMap, LinePlot, Polyline, Quiver, QuiverKey, Rgb, ScatterField, Series,
     XSpan,
 };
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-fn err(e: impl std::fmt::Display) -> String {
-    format!("plot: {e}")
+/// [`pdamp_plot::heat_map`] with the stem in the error.
+fn heat_map(stem: PathBuf, map: &HeatMap) -> Result<(), DesignError> {
+    pdamp_plot::heat_map(&stem, map).map_err(DesignError::plot(&stem))?;
+    Ok(())
+}
+
+/// [`pdamp_plot::line_plot`] with the stem in the error.
+fn line_plot(stem: PathBuf, plot: &LinePlot) -> Result<(), DesignError> {
+    pdamp_plot::line_plot(&stem, plot).map_err(DesignError::plot(&stem))?;
+    Ok(())
+}
+
+/// [`pdamp_plot::scatter_field`] with the stem in the error.
+fn scatter_field(stem: PathBuf, field: &ScatterField) -> Result<(), DesignError> {
+    pdamp_plot::scatter_field(&stem, field).map_err(DesignError::plot(&stem))?;
+    Ok(())
 }
 
 /// Maps of η̄ (colour saturating at 1, as in the dissertation), m̄_bed/m_bed, Ẽ and the split of
 /// the dissipation over the grid: `effective_loss_factor`, `effective_mass_ratio`,
 /// `dissipated_energy`, `dissipation_normal_over_tangential` [D Fig. 8.8],
 /// `dissipation_wall_share` (.png/.svg).
-pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Result<(), String> {
+pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Result<(), DesignError> {
     field_maps_with(grid, points, out, None)
 }
 
@@ -153,7 +168,7 @@ pub fn field_maps_with(
     points: &[PointResult],
     out: &Path,
     clearance_m: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), DesignError> {
     let nx = grid.frequencies_hz.len();
     let ny = grid.amplitude_values.len();
     if nx < 2 || ny < 2 {
@@ -202,14 +217,14 @@ pub fn field_maps_with(
     eta_map
         .overlays
         .splice(0..0, eta_overlays(grid, clearance_m));
-    pdamp_plot::heat_map(out.join("effective_loss_factor"), &eta_map).map_err(err)?;
+    heat_map(out.join("effective_loss_factor"), &eta_map)?;
     let mass = pick(&|p| p.effective_mass_ratio);
     let mmax = mass
         .iter()
         .copied()
         .filter(|v| v.is_finite())
         .fold(1.0_f64, f64::max);
-    pdamp_plot::heat_map(
+    heat_map(
         out.join("effective_mass_ratio"),
         &make(
             mass,
@@ -217,8 +232,7 @@ pub fn field_maps_with(
             "effective particle mass ratio",
             "m̄_bed / m_bed (-)",
         ),
-    )
-    .map_err(err)?;
+    )?;
     let e = pick(&|p| p.dissipated_energy_per_cycle_j);
     let pos: Vec<f64> = e
         .iter()
@@ -246,7 +260,7 @@ pub fn field_maps_with(
         let t = p.share_tangential_pp + p.share_tangential_pw;
         if n > 0.0 && t > 0.0 { n / t } else { f64::NAN }
     });
-    pdamp_plot::heat_map(
+    heat_map(
         out.join("dissipation_normal_over_tangential"),
         &make(
             ratio,
@@ -254,10 +268,9 @@ pub fn field_maps_with(
             "dissipation in normal / tangential contacts",
             "E_diss,n / E_diss,t (-)",
         ),
-    )
-    .map_err(err)?;
+    )?;
     let wall = pick(&|p| p.share_normal_pw + p.share_tangential_pw);
-    pdamp_plot::heat_map(
+    heat_map(
         out.join("dissipation_wall_share"),
         &make(
             wall,
@@ -265,13 +278,11 @@ pub fn field_maps_with(
             "share of the dissipation in particle–wall contacts",
             "E_diss,pw / E_diss (-)",
         ),
-    )
-    .map_err(err)?;
-    pdamp_plot::heat_map(
+    )?;
+    heat_map(
         out.join("dissipated_energy"),
         &make(e, color, "dissipated energy per cycle", "Ẽ_diss (J)"),
-    )
-    .map_err(err)?;
+    )?;
     Ok(())
 }
 
@@ -407,11 +418,10 @@ pub fn velocity_field_figure(rec: &MotionRecorder, k: usize) -> Option<ScatterFi
 
 /// One scatter plot per recorded phase ([`velocity_field_figure`]):
 /// `velocity_field_phaseK.png/.svg`.
-pub fn velocity_field_plots(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
+pub fn velocity_field_plots(rec: &MotionRecorder, out: &Path) -> Result<(), DesignError> {
     for k in 0..rec.fields.len() {
         if let Some(s) = velocity_field_figure(rec, k) {
-            pdamp_plot::scatter_field(out.join(format!("velocity_field_phase{k}")), &s)
-                .map_err(err)?;
+            scatter_field(out.join(format!("velocity_field_phase{k}")), &s)?;
         }
     }
     Ok(())
@@ -419,7 +429,7 @@ pub fn velocity_field_plots(rec: &MotionRecorder, out: &Path) -> Result<(), Stri
 
 /// Trajectories of the chosen particles in the container frame (excitation direction vs up),
 /// with the container's outline.
-pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
+pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), DesignError> {
     if rec.trajectories.is_empty() {
         return Ok(());
     }
@@ -442,7 +452,7 @@ pub fn trajectory_plot(rec: &MotionRecorder, out: &Path) -> Result<(), String> {
         plot.series
             .push(Series::new("container", ox, oy).with_color(Rgb::BLACK));
     }
-    pdamp_plot::line_plot(out.join("trajectories"), &plot).map_err(err)?;
+    line_plot(out.join("trajectories"), &plot)?;
     Ok(())
 }
 
@@ -462,7 +472,7 @@ pub fn force_displacement_plots(
     transient_cycles: u32,
     point: &PointResult,
     out: &Path,
-) -> Result<(), String> {
+) -> Result<(), DesignError> {
     let rows = &rec.force_displacement;
     if rows.len() < 2 {
         return Ok(());
@@ -499,7 +509,7 @@ pub fn force_displacement_plots(
             .on_secondary_axis(),
     );
     ft.size_px = (1000, 520);
-    pdamp_plot::line_plot(out.join("force_time"), &ft).map_err(err)?;
+    line_plot(out.join("force_time"), &ft)?;
 
     let mut hy = LinePlot::new(
         Axis::linear("container displacement x (mm)"),
@@ -572,7 +582,7 @@ pub fn force_displacement_plots(
         s.color = Some(pdamp_plot::palette_color(k));
     }
     hy.size_px = (900, 620);
-    pdamp_plot::line_plot(out.join("hysteresis"), &hy).map_err(err)?;
+    line_plot(out.join("hysteresis"), &hy)?;
     Ok(())
 }
 
@@ -586,7 +596,7 @@ pub fn value_map(
     name: &str,
     title: &str,
     colorbar: &str,
-) -> Result<(), String> {
+) -> Result<(), DesignError> {
     let nx = grid.frequencies_hz.len();
     let ny = grid.amplitude_values.len();
     if nx < 2 || ny < 2 || values.len() != nx * ny {
@@ -619,7 +629,7 @@ pub fn value_map(
     m.color = ColorScale::linear(0.0, hi.max(1e-300));
     m.title = title.to_string();
     m.colorbar_title = colorbar.to_string();
-    pdamp_plot::heat_map(out.join(name), &m).map_err(err)?;
+    heat_map(out.join(name), &m)?;
     Ok(())
 }
 

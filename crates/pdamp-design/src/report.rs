@@ -1,6 +1,7 @@
 //! Output of damper runs: `summary.json` with the effective quantities, velocity fields,
 //! trajectories, VTK animation of the last cycle and plots.
 
+use crate::DesignError;
 use crate::damper::{Damper, PointResult};
 use crate::ensemble::EnsembleStat;
 use crate::fields::{FieldGrid, FieldsOutcome};
@@ -135,7 +136,7 @@ impl EnsembleSummary {
 fn packing_result(
     k: usize,
     seed: u64,
-    r: Result<(PointResult, BedStatistics, Option<f64>), String>,
+    r: Result<(PointResult, BedStatistics, Option<f64>), DesignError>,
 ) -> PackingResult {
     match r {
         Ok((p, b, clearance)) => PackingResult {
@@ -160,7 +161,7 @@ fn packing_result(
             energy_closure_relative: f64::NAN,
             packing_fraction: f64::NAN,
             clearance_m: f64::NAN,
-            error: Some(e),
+            error: Some(e.to_string()),
         },
     }
 }
@@ -176,15 +177,15 @@ pub fn run_other_packings(
     packings: usize,
     reuse: bool,
     on_done: &(dyn Fn(usize) + Sync),
-) -> Result<Vec<PackingResult>, String> {
+) -> Result<Vec<PackingResult>, DesignError> {
     use rayon::prelude::*;
     if packings <= 1 {
         return Ok(Vec::new());
     }
     let dir = out.join("packings");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("output: {e}"))?;
+    std::fs::create_dir_all(&dir).map_err(DesignError::write(&dir))?;
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let members: Vec<Result<PackingResult, String>> = (1..packings)
+    let members: Vec<Result<PackingResult, DesignError>> = (1..packings)
         .into_par_iter()
         .map(|k| {
             let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
@@ -203,18 +204,15 @@ pub fn run_other_packings(
                 let p = d.run_point(frequency_hz, amplitude_m, &mut ())?;
                 Ok((p, d.bed_statistics(), d.clearance_m()))
             });
-            if let Err(e) = &r
-                && (e.starts_with("output:") || e.starts_with(pdamp_io::checkpoint::INTERRUPTED))
-            {
-                return Err(e.clone());
-            }
+            let r = match r {
+                Err(e) if e.is_output() || e.is_interrupted() => return Err(e),
+                r => r,
+            };
             let m = packing_result(k, sk.simulation.seed, r);
-            let json = serde_json::to_string_pretty(&m).map_err(|e| e.to_string())?;
-            pdamp_io::atomic::write_atomic(
-                dir.join(format!("packing_{k:03}.json")),
-                json.as_bytes(),
-            )
-            .map_err(|e| format!("output: {e}"))?;
+            let json = serde_json::to_string_pretty(&m)?;
+            let path = dir.join(format!("packing_{k:03}.json"));
+            pdamp_io::atomic::write_atomic(&path, json.as_bytes())
+                .map_err(DesignError::write(path))?;
             on_done(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
             Ok(m)
         })
@@ -232,7 +230,7 @@ pub fn run_damper_scenario(
     base_dir: &Path,
     out: &Path,
     progress: impl FnMut(&str, f64),
-) -> Result<DamperRunSummary, String> {
+) -> Result<DamperRunSummary, DesignError> {
     let options = pdamp_io::run::RunOptions {
         checkpoint_interval_s: 0.0,
         resume: false,
@@ -247,14 +245,19 @@ pub fn finished_damper_summary(
     sc: &Scenario,
     base_dir: &Path,
     out: &Path,
-) -> Result<Option<String>, String> {
+) -> Result<Option<String>, DesignError> {
     use crate::damper::{POINT_KIND, PointCheckpoint};
     use pdamp_io::checkpoint as ck;
     let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
-    match ck::load::<PointCheckpoint>(&out.join(ck::CHECKPOINT_FILE), POINT_KIND, &digest)? {
+    match ck::load::<PointCheckpoint>(&out.join(ck::CHECKPOINT_FILE), POINT_KIND, &digest)
+        .map_err(DesignError::io)?
+    {
         Some(PointCheckpoint::Finished) => std::fs::read_to_string(out.join("summary.json"))
             .map(Some)
-            .map_err(|e| format!("output: {}: {e}", out.join("summary.json").display())),
+            .map_err(|source| DesignError::ReadSummary {
+                path: out.join("summary.json"),
+                source,
+            }),
         _ => Ok(None),
     }
 }
@@ -271,7 +274,7 @@ pub fn run_damper_scenario_with(
     out: &Path,
     options: pdamp_io::run::RunOptions,
     mut progress: impl FnMut(&str, f64),
-) -> Result<DamperRunSummary, String> {
+) -> Result<DamperRunSummary, DesignError> {
     use crate::damper::{POINT_KIND, PointCheckpoint, PointCheckpointing};
     use pdamp_io::checkpoint as ck;
     let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
@@ -283,20 +286,12 @@ pub fn run_damper_scenario_with(
         resume: options.resume,
     };
     let _stoppable = ck::StoppableSection::enter();
-    let spec = sc
-        .damper
-        .as_ref()
-        .ok_or("scenario has no [damper] section")?;
-    let f = spec
-        .frequency_hz
-        .ok_or("damper.frequency_hz is needed for `pdamp run`")?;
-    let x = spec
-        .amplitude_at(f)
-        .ok_or("damper: give one of amplitude_m, acceleration_m_s2, intensity")?;
-    let io = |e: std::io::Error| format!("output: {e}");
+    let spec = sc.damper.as_ref().ok_or(DesignError::NoDamperSection)?;
+    let f = spec.frequency_hz.ok_or(DesignError::NoFrequency)?;
+    let x = spec.amplitude_at(f).ok_or(DesignError::NoAmplitude)?;
     pdamp_io::provenance::Provenance::of(sc)
         .write(sc, out)
-        .map_err(io)?;
+        .map_err(DesignError::write(out))?;
     let damper = Damper::from_scenario(sc, base_dir, |p| progress("settling", p))?;
     let omega = 2.0 * std::f64::consts::PI * f;
     let steps_per_cycle = (1.0 / (f * damper.time_step_s)).ceil();
@@ -312,7 +307,7 @@ pub fn run_damper_scenario_with(
     );
     if mo.vtk_frames_per_cycle > 0 {
         let dir = out.join("vtk");
-        std::fs::create_dir_all(&dir).map_err(io)?;
+        std::fs::create_dir_all(&dir).map_err(DesignError::write(&dir))?;
         rec.vtk = Some((dir, mo.vtk_frames_per_cycle));
     }
     let cycles = damper.cycles;
@@ -324,14 +319,18 @@ pub fn run_damper_scenario_with(
     };
     let p = damper.run_point_checkpointed(f, x, &mut wrapped, Some(&checkpointing))?;
     if let Some(e) = &rec.error {
-        return Err(format!("output: {e}"));
+        return Err(DesignError::VtkFrames(e.clone()));
     }
     if !rec.vtk_frames.is_empty() {
         // Particles and the container (every wall with a surface) as the parts of each frame.
-        let mut pvd = pdamp_io::vtk::PvdSeries::new(out.join("particles.pvd"));
+        let pvd_path = out.join("particles.pvd");
+        let mut pvd = pdamp_io::vtk::PvdSeries::new(pvd_path.clone());
         for (idx, (t, _)) in rec.vtk_frames.iter().enumerate() {
             pvd.add_frame(*t, &pdamp_io::run::snapshot_files(&damper.settled, idx))
-                .map_err(|e| e.to_string())?;
+                .map_err(|source| DesignError::Pvd {
+                    path: pvd_path.clone(),
+                    source,
+                })?;
         }
     }
     write_velocity_fields(&rec, &out.join("velocity_fields.csv"))?;
@@ -341,7 +340,7 @@ pub fn run_damper_scenario_with(
             &["particle", "time_s", "x_m", "y_m", "z_m"],
             &rec.trajectories,
         )
-        .map_err(|e| format!("output: {e}"))?;
+        .map_err(DesignError::write_csv(out.join("trajectories.csv")))?;
     }
     crate::plots::velocity_field_plots(&rec, out)?;
     crate::plots::trajectory_plot(&rec, out)?;
@@ -350,7 +349,7 @@ pub fn run_damper_scenario_with(
         &crate::motion::FORCE_DISPLACEMENT_COLUMNS,
         &rec.force_displacement,
     )
-    .map_err(|e| format!("output: {e}"))?;
+    .map_err(DesignError::write_csv(out.join("force_displacement.csv")))?;
     crate::plots::force_displacement_plots(&rec, damper.transient_cycles, &p, out)?;
     let bed = damper.bed_statistics();
     let packings = spec.packings;
@@ -408,13 +407,15 @@ pub fn run_damper_scenario_with(
         ensemble,
         point: p,
     };
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
-    pdamp_io::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
+    let json = serde_json::to_string_pretty(&summary)?;
+    pdamp_io::atomic::write_atomic(out.join("summary.json"), json.as_bytes())
+        .map_err(DesignError::write(out.join("summary.json")))?;
     ck::save(
         &ck_path,
         &ck::CheckpointHeader::new(POINT_KIND, &digest),
         &PointCheckpoint::Finished,
-    )?;
+    )
+    .map_err(DesignError::io)?;
     Ok(summary)
 }
 
@@ -440,17 +441,17 @@ impl<P: FnMut(&str, f64)> crate::damper::PointObserver for ProgressObserver<'_, 
         self.inner.reads_particles()
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
+    fn save_state(&self) -> Result<Vec<u8>, DesignError> {
         self.inner.save_state()
     }
 
-    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), DesignError> {
         self.inner.restore_state(bytes)
     }
 }
 
 /// Writes the phase-averaged velocity fields: one row per phase and occupied cell.
-pub fn write_velocity_fields(rec: &MotionRecorder, path: &Path) -> Result<(), String> {
+pub fn write_velocity_fields(rec: &MotionRecorder, path: &Path) -> Result<(), DesignError> {
     let rows = rec.fields.iter().flat_map(|f| {
         (0..f.count.len())
             .filter(|&c| f.count[c] > 0)
@@ -481,7 +482,7 @@ pub fn write_velocity_fields(rec: &MotionRecorder, path: &Path) -> Result<(), St
         ],
         rows,
     )
-    .map_err(|e| format!("output: {e}"))
+    .map_err(DesignError::write_csv(path))
 }
 
 /// `pdamp fields`: settles the damper once, runs the grid (resumable) and writes `fields.csv`
@@ -492,7 +493,7 @@ pub fn run_fields_scenario(
     out: &Path,
     settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
+) -> Result<FieldsOutcome, DesignError> {
     let engine = crate::fields::PointEngine::Cpu(crate::fields::ThreadSplit::default());
     run_fields_scenario_on(sc, base_dir, out, engine, settle_progress, on_point)
 }
@@ -506,7 +507,7 @@ pub fn run_fields_scenario_on(
     engine: crate::fields::PointEngine<'_>,
     settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
+) -> Result<FieldsOutcome, DesignError> {
     run_fields_scenario_from(
         sc,
         base_dir,
@@ -543,22 +544,25 @@ pub fn field_damper(
     k: usize,
     beds: BedSource<'_>,
     progress: impl FnMut(f64),
-) -> Result<Damper, String> {
+) -> Result<Damper, DesignError> {
     let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
     let BedSource::Saved(dir) = beds else {
         return Damper::from_scenario(&sk, base_dir, progress);
     };
     let path = prepared_bed_path(dir, k);
-    if let Some(prepared) = pdamp_io::prepare::load_prepared(&path, &sk, base_dir)? {
+    if let Some(prepared) =
+        pdamp_io::prepare::load_prepared(&path, &sk, base_dir).map_err(DesignError::io)?
+    {
         return Damper::from_prepared(&sk, prepared);
     }
     let mut progress = progress;
-    let prepared = pdamp_io::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))?;
+    let prepared = pdamp_io::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))
+        .map_err(DesignError::io)?;
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(|e| format!("output: {e}"))?;
+        std::fs::create_dir_all(parent).map_err(DesignError::write(parent))?;
     }
     pdamp_io::prepare::save_prepared(&path, &prepared, &sk, base_dir)
-        .map_err(|e| format!("output: {e}"))?;
+        .map_err(|e| DesignError::IoOutput(e.to_string()))?;
     Damper::from_prepared(&sk, prepared)
 }
 
@@ -572,16 +576,12 @@ pub fn run_fields_scenario_from(
     beds: BedSource<'_>,
     mut settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
-) -> Result<FieldsOutcome, String> {
-    let spec = sc
-        .fields
-        .as_ref()
-        .ok_or("scenario has no [fields] section")?;
+) -> Result<FieldsOutcome, DesignError> {
+    let spec = sc.fields.as_ref().ok_or(DesignError::NoFieldsSection)?;
     let grid = FieldGrid::from_spec(spec)?;
-    let io = |e: std::io::Error| format!("output: {e}");
     pdamp_io::provenance::Provenance::of(sc)
         .write(sc, out)
-        .map_err(io)?;
+        .map_err(DesignError::write(out))?;
     // Stored points are reused only for the same physics: everything but the grid itself and
     // the single-point excitation must match.
     let mut physics = sc.clone();
@@ -596,18 +596,18 @@ pub fn run_fields_scenario_from(
     // The content of meshes and bed files counts, not only their paths.
     let fingerprint = physics.to_toml() + &pdamp_io::run::referenced_files_digest(sc, base_dir);
     let fp_path = out.join("points").join("scenario_physics.toml");
-    std::fs::create_dir_all(out.join("points")).map_err(io)?;
+    std::fs::create_dir_all(out.join("points")).map_err(DesignError::write(out.join("points")))?;
     match std::fs::read_to_string(&fp_path) {
         Ok(old) if old != fingerprint => {
-            return Err(format!(
-                "{}: holds points of a different scenario (see {}); use another --out or delete its points/ folder",
-                out.display(),
-                fp_path.display()
-            ));
+            return Err(DesignError::OtherScenario {
+                out: out.to_path_buf(),
+                fingerprint: fp_path,
+            });
         }
         Ok(_) => {}
         Err(_) => {
-            pdamp_io::atomic::write_atomic(&fp_path, fingerprint.as_bytes()).map_err(io)?;
+            pdamp_io::atomic::write_atomic(&fp_path, fingerprint.as_bytes())
+                .map_err(DesignError::write(&fp_path))?;
         }
     }
     let packings = sc.damper.as_ref().map_or(1, |d| d.packings);
@@ -632,7 +632,7 @@ pub fn run_fields_scenario_from(
             settle_progress((k as f64 + f) / packings as f64)
         })?;
         let dir = out.join("packings").join(format!("packing_{k:03}"));
-        std::fs::create_dir_all(&dir).map_err(io)?;
+        std::fs::create_dir_all(&dir).map_err(DesignError::write(&dir))?;
         let bed = damper.bed_statistics();
         write_bed_statistics(
             &dir,
@@ -661,7 +661,7 @@ pub fn run_fields_scenario_from(
         })
         .collect();
     pdamp_io::csv::write_csv_atomic(out.join("fields.csv"), &columns, rows.iter().cloned())
-        .map_err(|e| format!("output: {e}"))?;
+        .map_err(DesignError::write_csv(out.join("fields.csv")))?;
     let h = EnsembleStat::of(&clearances);
     write_bed_statistics(
         out,
@@ -690,8 +690,8 @@ pub fn run_fields_scenario_from(
 
 /// Writes the bed statistics of a field (`bed_statistics.json`: packing fraction, coordination
 /// number, clearance h used for the X_opt = h/π line of the maps).
-fn write_bed_statistics(dir: &Path, stats: &impl Serialize) -> Result<(), String> {
-    let json = serde_json::to_string_pretty(stats).map_err(|e| e.to_string())?;
-    pdamp_io::atomic::write_atomic(dir.join("bed_statistics.json"), json.as_bytes())
-        .map_err(|e| format!("output: {e}"))
+fn write_bed_statistics(dir: &Path, stats: &impl Serialize) -> Result<(), DesignError> {
+    let json = serde_json::to_string_pretty(stats)?;
+    let path = dir.join("bed_statistics.json");
+    pdamp_io::atomic::write_atomic(&path, json.as_bytes()).map_err(DesignError::write(path))
 }

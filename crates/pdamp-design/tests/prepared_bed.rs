@@ -62,6 +62,7 @@ fn a_saved_prepared_bed_continues_bit_for_bit() {
     let Err(e) = field_damper(&sc, &base, 1, BedSource::Saved(&dir), |_| {}) else {
         panic!("a damaged bed must be refused");
     };
+    let e = e.to_string();
     assert!(
         e.contains("damaged") && e.contains("packing_001.pdprep"),
         "{e}"

@@ -1,6 +1,6 @@
 //! A batch of independent DEM worlds advanced together on the GPU.
 
-use crate::{GpuDevice, GpuError};
+use crate::{GpuDevice, GpuError, GpuFeature, GpuUnsupported};
 use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw, hertz::gonthier_damping};
 use pdamp_dem::walls::Geometry;
 use pdamp_dem::{EnergyLedger, Integrator, Motion, RigidBody, Vec3, World};
@@ -163,7 +163,7 @@ fn law_row_with_table(
     model: &ContactModel,
     el: &pdamp_dem::interaction::PairElastic,
     tables: &mut Vec<f64>,
-) -> Result<([f64; LAW_F], [u32; 4]), String> {
+) -> Result<([f64; LAW_F], [u32; 4]), GpuFeature> {
     if let NormalLaw::GonthierTable {
         impact_velocities_m_s,
         restitutions,
@@ -194,12 +194,12 @@ fn law_row_with_table(
 fn law_row(
     model: &ContactModel,
     el: &pdamp_dem::interaction::PairElastic,
-) -> Result<([f64; LAW_F], [u32; 4]), String> {
+) -> Result<([f64; LAW_F], [u32; 4]), GpuFeature> {
     if model.rolling.is_some() {
-        return Err("rolling resistance".into());
+        return Err(GpuFeature::RollingResistance);
     }
     if model.adhesion.is_some() {
-        return Err("DMT adhesion".into());
+        return Err(GpuFeature::Adhesion);
     }
     let mut f = [0.0; LAW_F];
     let mut u = [0u32; 4];
@@ -273,7 +273,7 @@ fn law_row(
 }
 
 /// Kernel description of one wall: kind, three rows of geometry, two-sided flag.
-fn wall_rows(g: &Geometry) -> Result<(u32, [[f64; 4]; 3], u32), String> {
+fn wall_rows(g: &Geometry) -> Result<(u32, [[f64; 4]; 3], u32), GpuFeature> {
     let v = |a: &Vec3, w: f64| [a.x, a.y, a.z, w];
     Ok(match g {
         Geometry::Plane(p) => (
@@ -295,17 +295,17 @@ fn wall_rows(g: &Geometry) -> Result<(u32, [[f64; 4]; 3], u32), String> {
             ],
             0,
         ),
-        Geometry::CylinderOutside(_) => return Err("a cylinder_outside wall (inner rod)".into()),
-        Geometry::Mesh(_) => return Err("a triangle-mesh wall".into()),
+        Geometry::CylinderOutside(_) => return Err(GpuFeature::CylinderOutside),
+        Geometry::Mesh(_) => return Err(GpuFeature::MeshWall),
     })
 }
 
 /// Whether the GPU kernels can run `world` (integrator, walls, body motions, contact laws,
 /// external forces); the error says what they lack, naming the wall, body or materials. Cheap:
 /// call it before preparing a bed for the GPU.
-pub fn check_world(world: &World) -> Result<(), String> {
+pub fn check_world(world: &World) -> Result<(), GpuUnsupported> {
     if !matches!(world.integrator, Integrator::VelocityVerlet) {
-        return Err("an integrator other than velocity Verlet".into());
+        return Err(GpuUnsupported::Integrator);
     }
     if world
         .particles
@@ -313,15 +313,20 @@ pub fn check_world(world: &World) -> Result<(), String> {
         .iter()
         .any(|f| *f != Vec3::zeros())
     {
-        return Err("external particle forces".into());
+        return Err(GpuUnsupported::ExternalForces);
     }
     for b in &world.bodies {
         if matches!(b.motion, Motion::Driven) {
-            return Err(format!("body '{}' driven from outside (coupling)", b.name));
+            return Err(GpuUnsupported::DrivenBody {
+                body: b.name.clone(),
+            });
         }
         for wall in &b.walls {
-            wall_rows(&wall.geometry)
-                .map_err(|e| format!("{e} ('{}' of body '{}')", wall.name, b.name))?;
+            wall_rows(&wall.geometry).map_err(|feature| GpuUnsupported::Wall {
+                feature,
+                wall: wall.name.clone(),
+                body: b.name.clone(),
+            })?;
         }
     }
     let n = world.interactions.num_materials();
@@ -329,11 +334,12 @@ pub fn check_world(world: &World) -> Result<(), String> {
     for a in 0..n {
         for b in 0..n {
             let (model, el) = world.interactions.get(a as u16, b as u16);
-            law_row_with_table(model, el, &mut tables).map_err(|what| {
-                format!(
-                    "{what} (materials '{}' and '{}')",
-                    world.materials[a].name, world.materials[b].name
-                )
+            law_row_with_table(model, el, &mut tables).map_err(|feature| {
+                GpuUnsupported::ContactLaw {
+                    feature,
+                    material_a: world.materials[a].name.clone(),
+                    material_b: world.materials[b].name.clone(),
+                }
             })?;
         }
     }
@@ -361,7 +367,7 @@ impl GpuBatch {
         let (mut rmin, mut rmax) = (f64::INFINITY, 0.0f64);
         for (k, w) in worlds.iter().enumerate() {
             let unsupported = |what: String| GpuError::Unsupported { world: k, what };
-            check_world(w).map_err(unsupported)?;
+            check_world(w).map_err(|e| unsupported(e.to_string()))?;
             if w.step_pending() {
                 return Err(unsupported(
                     "a world with a half kick pending (call complete_step)".into(),
@@ -398,13 +404,15 @@ impl GpuBatch {
         for a in 0..n_mat {
             for b in 0..n_mat {
                 let (model, el) = w0.interactions.get(a as u16, b as u16);
-                let (f, u) = law_row_with_table(model, el, &mut tables).map_err(|what| {
+                let (f, u) = law_row_with_table(model, el, &mut tables).map_err(|feature| {
                     GpuError::Unsupported {
                         world: 0,
-                        what: format!(
-                            "{what} (materials '{}' and '{}')",
-                            w0.materials[a].name, w0.materials[b].name
-                        ),
+                        what: GpuUnsupported::ContactLaw {
+                            feature,
+                            material_a: w0.materials[a].name.clone(),
+                            material_b: w0.materials[b].name.clone(),
+                        }
+                        .to_string(),
                     }
                 })?;
                 law_f.extend_from_slice(&f);

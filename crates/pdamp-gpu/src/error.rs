@@ -78,3 +78,96 @@ pub enum GpuError {
         what: String,
     },
 }
+
+/// Something the GPU kernels do not implement (a contact-law, wall or world feature).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum GpuFeature {
+    /// Rolling resistance in a contact model.
+    #[error("rolling resistance")]
+    RollingResistance,
+    /// DMT adhesion in a contact model.
+    #[error("DMT adhesion")]
+    Adhesion,
+    /// A `cylinder_outside` wall.
+    #[error("a cylinder_outside wall (inner rod)")]
+    CylinderOutside,
+    /// A triangle-mesh wall.
+    #[error("a triangle-mesh wall")]
+    MeshWall,
+}
+
+/// Why the GPU kernels cannot run a world ([`crate::check_world`]); the text says what they
+/// lack, naming the wall, body or materials.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GpuUnsupported {
+    /// The world's integrator is not velocity Verlet.
+    #[error("an integrator other than velocity Verlet")]
+    Integrator,
+    /// Some particle has an external force.
+    #[error("external particle forces")]
+    ExternalForces,
+    /// A body is driven from outside (coupling).
+    #[error("body '{body}' driven from outside (coupling)")]
+    DrivenBody {
+        /// The body's name.
+        body: String,
+    },
+    /// A wall of a kind the kernels lack.
+    #[error("{feature} ('{wall}' of body '{body}')")]
+    Wall {
+        /// What the wall needs.
+        feature: GpuFeature,
+        /// The wall's name.
+        wall: String,
+        /// The name of its body.
+        body: String,
+    },
+    /// The contact law of a pair of materials needs something the kernels lack.
+    #[error("{feature} (materials '{material_a}' and '{material_b}')")]
+    ContactLaw {
+        /// What the law needs.
+        feature: GpuFeature,
+        /// Name of the first material.
+        material_a: String,
+        /// Name of the second material.
+        material_b: String,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<GpuUnsupported> for String {
+    fn from(e: GpuUnsupported) -> String {
+        e.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unsupported_texts_name_the_wall_or_materials() {
+        let e = GpuUnsupported::Wall {
+            feature: GpuFeature::MeshWall,
+            wall: "lid".into(),
+            body: "container".into(),
+        };
+        assert_eq!(
+            e.to_string(),
+            "a triangle-mesh wall ('lid' of body 'container')"
+        );
+        let e = GpuUnsupported::ContactLaw {
+            feature: GpuFeature::RollingResistance,
+            material_a: "steel".into(),
+            material_b: "glass".into(),
+        };
+        assert_eq!(
+            e.to_string(),
+            "rolling resistance (materials 'steel' and 'glass')"
+        );
+        assert_eq!(
+            String::from(GpuUnsupported::DrivenBody { body: "b".into() }),
+            "body 'b' driven from outside (coupling)"
+        );
+    }
+}

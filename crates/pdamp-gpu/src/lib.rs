@@ -29,4 +29,4 @@ mod error;
 
 pub use batch::{GpuBatch, GpuSnapshot, MemoryEstimate, check_world};
 pub use device::GpuDevice;
-pub use error::GpuError;
+pub use error::{GpuError, GpuFeature, GpuUnsupported};
