@@ -734,10 +734,10 @@ fn scenario_inputs(
 /// `DIR/energy.png` and `.svg` of a plain run: the terms of the energy ledger over time
 /// (kinetic, potential and elastic energy as changes from the start, work of the walls,
 /// dissipation and the balance residual W − ΔE − D, which stays at zero in a healthy run).
-fn energy_plot(out: &std::path::Path) -> Result<(), String> {
+fn energy_plot(out: &std::path::Path) -> Result<()> {
     use pdamp_plot::{Axis, LinePlot, Series, line_plot};
     let (_, rows) =
-        pdamp_io::csv::read_csv_f64(out.join("energy.csv")).map_err(|e| format!("output: {e}"))?;
+        pdamp_io::csv::read_csv_f64(out.join("energy.csv")).map_err(|e| anyhow!("output: {e}"))?;
     let Some(first) = rows.first() else {
         return Ok(());
     };
@@ -763,7 +763,7 @@ fn energy_plot(out: &std::path::Path) -> Result<(), String> {
     }
     line_plot(out.join("energy"), &plot)
         .map(|_| ())
-        .map_err(|e| format!("output: {e}"))
+        .map_err(|e| anyhow!("output: {e}"))
 }
 
 /// `pdamp bench`: the shaken box's size and length within the machine (see
@@ -838,10 +838,10 @@ fn cmd_run(
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {
         let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
-            .map_err(|e| e.to_string())
+            .map_err(anyhow::Error::msg)
             .and_then(|s| energy_plot(out).map(|()| s));
         dir.set_outcome(&s);
-        serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
+        serde_json::to_string_pretty(&s?)?
     };
     dir.close()?;
     bar.finish();

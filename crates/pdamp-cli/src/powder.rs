@@ -253,7 +253,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             // An ensemble continues its finished packings (each checked against its scenario).
             let mut dir = open_continuing(&out, ck, &scenario)?;
             let e = study::run_ensemble(&sc, packings, &out, options, &mut progress)
-                .map_err(|e| anyhow!(e))
+                .map_err(anyhow::Error::msg)
                 .and_then(|r| traced.write(&out).map(|()| r));
             dir.set_outcome(&e);
             dir.close()?;
@@ -277,7 +277,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
                 &[scenario.as_path()],
             )?;
             let r = cantilever::run_in_dir(&sc, &out, options, &mut progress)
-                .map_err(|e| anyhow!(e))
+                .map_err(anyhow::Error::msg)
                 .and_then(|r| traced.write(&out).map(|()| r));
             dir.set_outcome(&r);
             dir.close()?;
@@ -303,7 +303,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             let mut dir = open_continuing(&out, ck, &scenario)?;
             let rows =
                 study::run_study_packings(&sc, p, &values, packings, &out, options, &mut progress)
-                    .map_err(|e| anyhow!(e))
+                    .map_err(anyhow::Error::msg)
                     .and_then(|r| traced.write(&out).map(|()| r));
             dir.set_outcome(&rows);
             dir.close()?;
@@ -314,7 +314,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
         }
         PowderAction::Modes { scenario, count } => {
             let sc = load(&scenario)?;
-            let f = cantilever::empty_beam_modes(&sc.beam, count).map_err(|e| anyhow!(e))?;
+            let f = cantilever::empty_beam_modes(&sc.beam, count).map_err(anyhow::Error::msg)?;
             let timo = cantilever::timoshenko_reference(&sc.beam);
             bar.finish();
             println!(

@@ -169,8 +169,8 @@ pub fn run_structure(args: StructureArgs) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&s)?);
             eprintln!("wrote {}", out.join("modes.csv").display());
             match shapes {
-                Ok(files) => eprintln!("wrote {}", files.png.display()),
-                Err(why) => eprintln!("note: no mode_shapes.png: {why}"),
+                Some(files) => eprintln!("wrote {}", files.png.display()),
+                None => eprintln!("note: no mode_shapes.png: {NO_MODE_SHAPES}"),
             }
             Ok(())
         }
@@ -352,20 +352,21 @@ fn beam_mode_shapes(structure: &std::path::Path) -> Result<Option<BeamModeShapes
     }))
 }
 
+/// Why [`mode_shape_plot`] draws nothing for a structure without node coordinates.
+const NO_MODE_SHAPES: &str = "the structure is not a [structure.beam] and has no node coordinates (single_mode, \
+     modal and matrix_market models); modes.csv holds the shapes at the named points";
+
 /// Writes `DIR/mode_shapes.png/svg` for a beam (see [`beam_mode_shapes`]): one line per mode,
-/// its frequency in the legend. `Ok(Err(why))` when the structure has no node coordinates
-/// (single mode, modal input, Matrix Market: `modes.csv` has φ at the named points).
+/// its frequency in the legend. `Ok(None)` when the structure has no node coordinates
+/// (single mode, modal input, Matrix Market: `modes.csv` has φ at the named points; see
+/// [`NO_MODE_SHAPES`]).
 fn mode_shape_plot(
     structure: &std::path::Path,
     out: &std::path::Path,
-) -> Result<std::result::Result<pdamp_plot::PlotFiles, String>> {
+) -> Result<Option<pdamp_plot::PlotFiles>> {
     use pdamp_plot::{Axis, LinePlot, Series, line_plot};
     let Some(shapes) = beam_mode_shapes(structure)? else {
-        return Ok(Err(
-            "the structure is not a [structure.beam] and has no node coordinates (single_mode, \
-             modal and matrix_market models); modes.csv holds the shapes at the named points"
-                .into(),
-        ));
+        return Ok(None);
     };
     let planar = shapes.modes.iter().all(|m| m.1 == "uy");
     let mut plot = LinePlot::new(
@@ -392,7 +393,7 @@ fn mode_shape_plot(
         plot.series
             .push(Series::new(label, shapes.positions_m.clone(), v.clone()));
     }
-    Ok(Ok(line_plot(out.join("mode_shapes"), &plot)?))
+    Ok(Some(line_plot(out.join("mode_shapes"), &plot)?))
 }
 
 /// A frequency with four significant digits.

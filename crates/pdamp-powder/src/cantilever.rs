@@ -18,15 +18,22 @@ pub use pdamp_io::run::RunOptions;
 use serde::{Deserialize, Serialize};
 
 use crate::bed::PowderBed;
-use crate::couple::{Coupled, CoupledEnergy, CoupledState, CouplingSettings, Interface};
+use crate::couple::{
+    CoupleError, Coupled, CoupledEnergy, CoupledState, CouplingSettings, Interface,
+};
 use crate::damping::{self, TableOneRatios};
+use crate::error::ParameterError;
+use crate::fe::gen_alpha::DynamicsError;
+use crate::fe::sparse::SolverError;
 use crate::fe::{
     self, Aabb, BoxMeshDivisions, Dynamics, GenAlpha, HexMesh, LoadRamp, MassKind, Rayleigh,
     Structure, SurfaceLoad, SvkMaterial,
 };
+use crate::health::HealthError;
 use crate::law::PowderLaw;
-use crate::prep::{PrepReport, PrepSettings, Preparation};
+use crate::prep::{PrepError, PrepReport, PrepSettings, Preparation};
 use crate::psd::LogNormal;
+use crate::vtk::SnapshotError;
 
 fn d_len() -> f64 {
     0.132
@@ -118,13 +125,15 @@ impl BeamSpec {
             },
         )
     }
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), ParameterError> {
         let len = |v: f64, k: &str| {
             if v > 0.0 && v <= MAX_LENGTH_M {
                 Ok(())
             } else {
-                Err(format!(
-                    "beam.{k}: must be a finite length in (0, {MAX_LENGTH_M}] m, got {v}"
+                Err(ParameterError::out_of_range(
+                    format!("beam.{k}"),
+                    v,
+                    format!("must be a finite length in (0, {MAX_LENGTH_M}] m"),
                 ))
             }
         };
@@ -137,38 +146,46 @@ impl BeamSpec {
         len(self.length_element_m, "length_element_m")?;
         let m = &self.material;
         if !(m.youngs_modulus_pa > 0.0 && m.youngs_modulus_pa <= 1e13) {
-            return Err(format!(
-                "beam.material.youngs_modulus_pa: must be a finite modulus in (0, 1e13] Pa (Table A.3: 175e9), got {}",
-                m.youngs_modulus_pa
+            return Err(ParameterError::out_of_range(
+                "beam.material.youngs_modulus_pa",
+                m.youngs_modulus_pa,
+                "must be a finite modulus in (0, 1e13] Pa (Table A.3: 175e9)",
             ));
         }
         if !(m.density_kg_m3 > 0.0 && m.density_kg_m3 <= 1e5) {
-            return Err(format!(
-                "beam.material.density_kg_m3: must be in (0, 1e5] kg/m³ (Table A.3: 8000), got {}",
-                m.density_kg_m3
+            return Err(ParameterError::out_of_range(
+                "beam.material.density_kg_m3",
+                m.density_kg_m3,
+                "must be in (0, 1e5] kg/m³ (Table A.3: 8000)",
             ));
         }
         if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-            return Err(format!(
-                "beam.material.poisson_ratio: must be in (-1, 0.5), got {}",
-                m.poisson_ratio
+            return Err(ParameterError::out_of_range(
+                "beam.material.poisson_ratio",
+                m.poisson_ratio,
+                "must be in (-1, 0.5)",
             ));
         }
         if 2.0 * self.wall_thickness_m >= self.width_m {
-            return Err("beam.wall_thickness_m: must be less than half of width_m".into());
+            return Err(ParameterError::invalid(
+                "beam.wall_thickness_m",
+                "must be less than half of width_m",
+            ));
         }
         if !(self.cavity_offset_m > 0.0
             && self.cavity_offset_m + self.cavity_length_m < self.length_m)
         {
-            return Err(format!(
-                "beam.cavity_offset_m: cavity must lie strictly inside the beam (0 < offset, offset + cavity_length_m < length_m), got {}",
-                self.cavity_offset_m
+            return Err(ParameterError::out_of_range(
+                "beam.cavity_offset_m",
+                self.cavity_offset_m,
+                "cavity must lie strictly inside the beam (0 < offset, offset + cavity_length_m < length_m)",
             ));
         }
         if !(0.0..=1.0).contains(&self.rho_inf) {
-            return Err(format!(
-                "beam.rho_inf: must be in [0, 1], got {}",
-                self.rho_inf
+            return Err(ParameterError::out_of_range(
+                "beam.rho_inf",
+                self.rho_inf,
+                "must be in [0, 1]",
             ));
         }
         for (k, v) in [
@@ -176,16 +193,21 @@ impl BeamSpec {
             ("stiffness_coeff_s", self.rayleigh.stiffness_coeff_s),
         ] {
             if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!(
-                    "beam.rayleigh.{k}: must be finite and ≥ 0, got {v}"
+                return Err(ParameterError::out_of_range(
+                    format!("beam.rayleigh.{k}"),
+                    v,
+                    "must be finite and ≥ 0",
                 ));
             }
         }
         let (elements, nodes) = self.mesh_size();
         if elements > MAX_ELEMENTS as f64 {
-            return Err(format!(
-                "beam.wall_element_m / core_element_m / length_element_m: the mesh would have ≈ {elements:.3e} elements and {nodes:.3e} nodes (≈ {:.1} GB for the element data and matrices, before the factorization's fill-in), more than {MAX_ELEMENTS}; use larger element sizes",
-                elements * BYTES_PER_ELEMENT / 1e9
+            return Err(ParameterError::invalid(
+                "beam.wall_element_m / core_element_m / length_element_m",
+                format!(
+                    "the mesh would have ≈ {elements:.3e} elements and {nodes:.3e} nodes (≈ {:.1} GB for the element data and matrices, before the factorization's fill-in), more than {MAX_ELEMENTS}; use larger element sizes",
+                    elements * BYTES_PER_ELEMENT / 1e9
+                ),
             ));
         }
         Ok(())
@@ -357,6 +379,124 @@ fn d_vtk_interval() -> f64 {
     1e-3
 }
 
+/// Errors of the cantilever scenario and its runs. Texts starting with
+/// [`pdamp_io::checkpoint::INTERRUPTED`] are runs stopped on request
+/// ([`CantileverError::Interrupted`]).
+#[derive(Debug, thiserror::Error)]
+pub enum CantileverError {
+    /// A key of the scenario is out of range (also `--checkpoint-interval-s`).
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// The scenario exceeds a size limit ([`MAX_PARTICLES`], [`MAX_STEPS`]).
+    #[error("{keys}: {estimate}; {limit}")]
+    TooLarge {
+        /// The keys that set the size.
+        keys: &'static str,
+        /// What the scenario would cost.
+        estimate: CostEstimate,
+        /// The limit exceeded and the fix.
+        limit: String,
+    },
+    /// The time step is too long for the stiffest contact of the powder.
+    #[error(
+        "run.time_step_s = {time_step_s:.3e} s is {ratio:.2} of the shortest contact time {contact_time_s:.3e} s (particles of {diameter_m:.3e} m, k = {stiffness_n_m:.4e} N/m after coarse-graining); velocity Verlet needs less than {max_ratio}: use at most {:.3e} s (1/10 of the contact time)",
+        0.1 * .contact_time_s
+    )]
+    TimeStep {
+        /// `run.time_step_s` \[s\].
+        time_step_s: f64,
+        /// Its ratio to the contact time.
+        ratio: f64,
+        /// Shortest contact time \[s\].
+        contact_time_s: f64,
+        /// Diameter of the smallest particles \[m\].
+        diameter_m: f64,
+        /// Normal stiffness after coarse-graining (N/m).
+        stiffness_n_m: f64,
+        /// Largest allowed ratio ([`crate::health::MAX_STEP_RATIO`]).
+        max_ratio: f64,
+    },
+    /// The scenario's TOML does not parse.
+    #[error(transparent)]
+    Toml(#[from] toml::de::Error),
+    /// The scenario cannot be written as TOML for its digest.
+    #[error("scenario: {0}")]
+    Digest(#[source] toml::ser::Error),
+    /// A checkpoint could not be written, read or decoded (pdamp-io).
+    #[error("{0}")]
+    Io(String),
+    /// The run was stopped on request after its checkpoint was written.
+    #[error("{0}")]
+    Interrupted(ck::Interrupted),
+    /// The preparation stopped without a checkpoint to continue from.
+    #[error("preparation stopped")]
+    PreparationStopped,
+    /// A checkpoint holds no preparation ([`decode_preparation`]).
+    #[error("not a preparation")]
+    NotPreparation,
+    /// A saved preparation is inconsistent.
+    #[error(transparent)]
+    Preparation(#[from] PrepError),
+    /// Neither a prepared powder nor a checkpoint to start the coupled run from (a defect).
+    #[error("internal: neither a prepared powder nor a checkpoint")]
+    NoStart,
+    /// The structure's time integration failed.
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+    /// The coupled step (or building the coupled system) failed.
+    #[error(transparent)]
+    Couple(#[from] CoupleError),
+    /// A health check of the preparation or the coupled run failed.
+    #[error(transparent)]
+    Health(#[from] Box<HealthError>),
+    /// The modal analysis failed.
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    /// A ParaView frame could not be written.
+    #[error(transparent)]
+    Snapshot(#[from] SnapshotError),
+    /// A CSV output could not be written.
+    #[error(transparent)]
+    Csv(#[from] pdamp_io::csv::CsvError),
+    /// A plot could not be written.
+    #[error(transparent)]
+    Plot(#[from] pdamp_plot::PlotError),
+    /// A file or folder could not be read or created.
+    #[error("{path}: {source}")]
+    File {
+        /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A JSON file (the summary of a finished run) could not be decoded.
+    #[error("{path}: {source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The decoding error.
+        source: serde_json::Error,
+    },
+    /// The summary could not be encoded as JSON.
+    #[error("{0}")]
+    Encode(#[source] serde_json::Error),
+    /// An output file could not be written.
+    #[error("{source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<CantileverError> for String {
+    fn from(e: CantileverError) -> String {
+        e.to_string()
+    }
+}
+
 /// A cantilever scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -373,8 +513,8 @@ pub struct CantileverScenario {
 
 impl CantileverScenario {
     /// Parses and validates TOML; errors name the key.
-    pub fn from_toml(text: &str) -> Result<Self, String> {
-        let s: Self = toml::from_str(text).map_err(|e| e.to_string())?;
+    pub fn from_toml(text: &str) -> Result<Self, CantileverError> {
+        let s: Self = toml::from_str(text)?;
         s.validate()?;
         Ok(s)
     }
@@ -383,148 +523,201 @@ impl CantileverScenario {
     /// the size limits ([`MAX_PARTICLES`], [`MAX_ELEMENTS`], [`MAX_STEPS`], [`MAX_SAMPLES`];
     /// the message carries the [`CostEstimate`]); nothing is allocated before. The error
     /// names the key, the value and the fix.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), CantileverError> {
         self.beam.validate()?;
         let (l, r) = (&self.load, &self.run);
         let e = self.beam.material.youngs_modulus_pa;
         if !(l.pressure_pa.is_finite() && l.pressure_pa.abs() <= 1e-3 * e) {
-            return Err(format!(
-                "load.pressure_pa: must be finite with |q| ≤ 1e-3 of beam.material.youngs_modulus_pa ({:.3e} Pa; larger loads bend the beam beyond the elastic range), got {}",
-                1e-3 * e,
-                l.pressure_pa
-            ));
+            return Err(ParameterError::out_of_range(
+                "load.pressure_pa",
+                l.pressure_pa,
+                format!(
+                    "must be finite with |q| ≤ 1e-3 of beam.material.youngs_modulus_pa ({:.3e} Pa; larger loads bend the beam beyond the elastic range)",
+                    1e-3 * e
+                ),
+            )
+            .into());
         }
         if !(l.rise_s > 0.0 && l.rise_s <= 1e3) {
-            return Err(format!(
-                "load.rise_s: must be in (0, 1000] s, got {}",
-                l.rise_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "load.rise_s",
+                l.rise_s,
+                "must be in (0, 1000] s",
+            )
+            .into());
         }
         if !(l.hold_s >= 0.0 && l.hold_s <= 1e3) {
-            return Err(format!(
-                "load.hold_s: must be in [0, 1000] s, got {}",
-                l.hold_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "load.hold_s",
+                l.hold_s,
+                "must be in [0, 1000] s",
+            )
+            .into());
         }
         if !(r.duration_s > 0.0 && r.duration_s <= 1e3) {
-            return Err(format!(
-                "run.duration_s: must be in (0, 1000] s, got {}",
-                r.duration_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.duration_s",
+                r.duration_s,
+                "must be in (0, 1000] s",
+            )
+            .into());
         }
         if !(r.time_step_s > 0.0 && r.time_step_s < r.duration_s) {
-            return Err(format!(
-                "run.time_step_s: must be positive and below duration_s, got {}",
-                r.time_step_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.time_step_s",
+                r.time_step_s,
+                "must be positive and below duration_s",
+            )
+            .into());
         }
         let g = r.gravity_m_s2;
         if !(g.iter().all(|x| x.is_finite()) && g.iter().map(|x| x * x).sum::<f64>() <= 1e6) {
-            return Err(format!(
-                "run.gravity_m_s2: must be finite with |g| ≤ 1000 m/s², got {g:?}"
-            ));
+            return Err(ParameterError::invalid(
+                "run.gravity_m_s2",
+                format!("must be finite with |g| ≤ 1000 m/s², got {g:?}"),
+            )
+            .into());
         }
         if !(r.output_interval_s >= 0.0 && r.output_interval_s <= r.duration_s) {
-            return Err(format!(
-                "run.output_interval_s: must be in [0, duration_s] (0 = every step), got {}",
-                r.output_interval_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.output_interval_s",
+                r.output_interval_s,
+                "must be in [0, duration_s] (0 = every step)",
+            )
+            .into());
         }
         if !(r.vtk_interval_s >= 0.0 && r.vtk_interval_s.is_finite()) {
-            return Err(format!(
-                "run.vtk_interval_s: must be finite and >= 0 (seconds between ParaView frames, 0 = none), got {}",
-                r.vtk_interval_s
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.vtk_interval_s",
+                r.vtk_interval_s,
+                "must be finite and >= 0 (seconds between ParaView frames, 0 = none)",
+            )
+            .into());
         }
         let c = &r.coupling;
         if !(c.tolerance > 0.0 && c.tolerance.is_finite()) {
-            return Err(format!(
-                "run.coupling.tolerance: must be finite and positive (eq. 16: 1e-3 m/s), got {}",
-                c.tolerance
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.coupling.tolerance",
+                c.tolerance,
+                "must be finite and positive (eq. 16: 1e-3 m/s)",
+            )
+            .into());
         }
         if !(1..=10_000).contains(&c.max_iterations) {
-            return Err(format!(
-                "run.coupling.max_iterations: must be in [1, 10000], got {}",
-                c.max_iterations
-            ));
+            return Err(ParameterError::invalid(
+                "run.coupling.max_iterations",
+                format!("must be in [1, 10000], got {}", c.max_iterations),
+            )
+            .into());
         }
         if !(c.initial_relaxation > 0.0 && c.initial_relaxation <= 2.0) {
-            return Err(format!(
-                "run.coupling.initial_relaxation: must be in (0, 2], got {}",
-                c.initial_relaxation
-            ));
+            return Err(ParameterError::out_of_range(
+                "run.coupling.initial_relaxation",
+                c.initial_relaxation,
+                "must be in (0, 2]",
+            )
+            .into());
         }
         if let Some(p) = &self.powder {
             p.law.validate("powder.law.")?;
             p.psd().validate("powder.")?;
             if !(p.density_kg_m3 > 0.0 && p.density_kg_m3 <= 1e5) {
-                return Err(format!(
-                    "powder.density_kg_m3: must be in (0, 1e5] kg/m³, got {}",
-                    p.density_kg_m3
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.density_kg_m3",
+                    p.density_kg_m3,
+                    "must be in (0, 1e5] kg/m³",
+                )
+                .into());
             }
             let f = p.d50_m / p.reference_d50_m;
             if !(p.reference_d50_m > 0.0 && (1e-3..=1e3).contains(&f)) {
-                return Err(format!(
-                    "powder.reference_d50_m: must be positive with d50_m / reference_d50_m in [1e-3, 1e3], got {}",
-                    p.reference_d50_m
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.reference_d50_m",
+                    p.reference_d50_m,
+                    "must be positive with d50_m / reference_d50_m in [1e-3, 1e3]",
+                )
+                .into());
             }
             let s = &p.prep;
             if !(s.packing_density > 0.0 && s.packing_density < 0.74) {
-                return Err(format!(
-                    "powder.prep.packing_density: must be in (0, 0.74), got {}",
-                    s.packing_density
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.prep.packing_density",
+                    s.packing_density,
+                    "must be in (0, 0.74)",
+                )
+                .into());
             }
             if !(s.settling_gravity_factor >= 1.0 && s.settling_gravity_factor <= 1e4) {
-                return Err(format!(
-                    "powder.prep.settling_gravity_factor: must be in [1, 1e4], got {}",
-                    s.settling_gravity_factor
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.prep.settling_gravity_factor",
+                    s.settling_gravity_factor,
+                    "must be in [1, 1e4]",
+                )
+                .into());
             }
             if !(s.plate_speed_m_s > 0.0 && s.plate_speed_m_s <= 100.0) {
-                return Err(format!(
-                    "powder.prep.plate_speed_m_s: must be in (0, 100] m/s, got {}",
-                    s.plate_speed_m_s
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.prep.plate_speed_m_s",
+                    s.plate_speed_m_s,
+                    "must be in (0, 100] m/s",
+                )
+                .into());
             }
             if !(s.relax_time_s >= 0.0 && s.relax_time_s <= 1e3) {
-                return Err(format!(
-                    "powder.prep.relax_time_s: must be in [0, 1000] s, got {}",
-                    s.relax_time_s
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.prep.relax_time_s",
+                    s.relax_time_s,
+                    "must be in [0, 1000] s",
+                )
+                .into());
             }
             if !(s.max_settling_time_s > 0.0 && s.max_settling_time_s <= 1e3) {
-                return Err(format!(
-                    "powder.prep.max_settling_time_s: must be in (0, 1000] s, got {}",
-                    s.max_settling_time_s
-                ));
+                return Err(ParameterError::out_of_range(
+                    "powder.prep.max_settling_time_s",
+                    s.max_settling_time_s,
+                    "must be in (0, 1000] s",
+                )
+                .into());
             }
             let gap = self.beam.width_m - 2.0 * self.beam.wall_thickness_m;
             if p.psd().d_max_m * 1.02 > gap.min(self.beam.cavity_length_m) {
-                return Err(format!(
-                    "powder.d50_m: the largest particles ({:.3e} m) do not fit the cavity ({gap:.3e} m across); use a smaller d50_m",
-                    p.psd().d_max_m
-                ));
+                return Err(ParameterError::invalid(
+                    "powder.d50_m",
+                    format!(
+                        "the largest particles ({:.3e} m) do not fit the cavity ({gap:.3e} m across); use a smaller d50_m",
+                        p.psd().d_max_m
+                    ),
+                )
+                .into());
             }
         }
         let est = self.estimate();
         if est.particles > MAX_PARTICLES as f64 {
-            return Err(format!(
-                "powder.d50_m / powder.prep.packing_density: {est}; more than {MAX_PARTICLES} particles; use a larger d50_m (coarse-graining with reference_d50_m)"
-            ));
+            return Err(CantileverError::TooLarge {
+                keys: "powder.d50_m / powder.prep.packing_density",
+                estimate: est,
+                limit: format!(
+                    "more than {MAX_PARTICLES} particles; use a larger d50_m (coarse-graining with reference_d50_m)"
+                ),
+            });
         }
         if est.steps > MAX_STEPS {
-            return Err(format!(
-                "run.duration_s / run.time_step_s: {est}; more than {MAX_STEPS:e} steps; shorten duration_s or lengthen time_step_s"
-            ));
+            return Err(CantileverError::TooLarge {
+                keys: "run.duration_s / run.time_step_s",
+                estimate: est,
+                limit: format!(
+                    "more than {MAX_STEPS:e} steps; shorten duration_s or lengthen time_step_s"
+                ),
+            });
         }
         if est.prep_steps > MAX_STEPS {
-            return Err(format!(
-                "powder.prep.max_settling_time_s / relax_time_s: {est}; more than {MAX_STEPS:e} preparation steps at run.time_step_s; shorten them"
-            ));
+            return Err(CantileverError::TooLarge {
+                keys: "powder.prep.max_settling_time_s / relax_time_s",
+                estimate: est,
+                limit: format!(
+                    "more than {MAX_STEPS:e} preparation steps at run.time_step_s; shorten them"
+                ),
+            });
         }
         if let Some(p) = &self.powder {
             // the stiffest contact: two of the smallest particles, coarse-grained stiffness
@@ -534,28 +727,37 @@ impl CantileverScenario {
             let tc = std::f64::consts::PI * (0.5 * m / law.normal_stiffness_n_m).sqrt();
             let ratio = r.time_step_s / tc;
             if !(ratio <= crate::health::MAX_STEP_RATIO) {
-                return Err(format!(
-                    "run.time_step_s = {:.3e} s is {ratio:.2} of the shortest contact time {tc:.3e} s (particles of {dmin:.3e} m, k = {:.4e} N/m after coarse-graining); velocity Verlet needs less than {}: use at most {:.3e} s (1/10 of the contact time)",
-                    r.time_step_s,
-                    law.normal_stiffness_n_m,
-                    crate::health::MAX_STEP_RATIO,
-                    0.1 * tc
-                ));
+                return Err(CantileverError::TimeStep {
+                    time_step_s: r.time_step_s,
+                    ratio,
+                    contact_time_s: tc,
+                    diameter_m: dmin,
+                    stiffness_n_m: law.normal_stiffness_n_m,
+                    max_ratio: crate::health::MAX_STEP_RATIO,
+                });
             }
         }
         let every = (r.output_interval_s / r.time_step_s).round().max(1.0);
         if est.steps / every > MAX_SAMPLES {
-            return Err(format!(
-                "run.output_interval_s: {:.3e} samples of tip.csv, more than {MAX_SAMPLES:e}; use a larger output_interval_s",
-                est.steps / every
-            ));
+            return Err(ParameterError::invalid(
+                "run.output_interval_s",
+                format!(
+                    "{:.3e} samples of tip.csv, more than {MAX_SAMPLES:e}; use a larger output_interval_s",
+                    est.steps / every
+                ),
+            )
+            .into());
         }
         if r.vtk_interval_s > 0.0 && r.duration_s / r.vtk_interval_s > MAX_VTK_FRAMES {
-            return Err(format!(
-                "run.vtk_interval_s: {:.3e} ParaView frames over duration_s = {} s, more than {MAX_VTK_FRAMES}; use a larger interval (or 0 for none)",
-                r.duration_s / r.vtk_interval_s,
-                r.duration_s
-            ));
+            return Err(ParameterError::invalid(
+                "run.vtk_interval_s",
+                format!(
+                    "{:.3e} ParaView frames over duration_s = {} s, more than {MAX_VTK_FRAMES}; use a larger interval (or 0 for none)",
+                    r.duration_s / r.vtk_interval_s,
+                    r.duration_s
+                ),
+            )
+            .into());
         }
         Ok(())
     }
@@ -686,8 +888,8 @@ pub struct CantileverResult {
 pub const CHECKPOINT_KIND: &str = "powder-run-3";
 
 /// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
-pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, String> {
-    let text = toml::to_string(sc).map_err(|e| format!("scenario: {e}"))?;
+pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, CantileverError> {
+    let text = toml::to_string(sc).map_err(CantileverError::Digest)?;
     Ok(ck::digest(text.as_bytes()))
 }
 
@@ -722,22 +924,23 @@ struct Checkpointing {
 }
 
 impl Checkpointing {
-    fn save(&self, phase: &Phase) -> Result<(), String> {
-        ck::save(&self.path, &self.header, phase).map_err(String::from)
+    fn save(&self, phase: &Phase) -> Result<(), CantileverError> {
+        ck::save(&self.path, &self.header, phase).map_err(|e| CantileverError::Io(e.to_string()))
     }
-    fn interrupted(&self, time_s: f64) -> String {
-        ck::Interrupted {
+    fn interrupted(&self, time_s: f64) -> CantileverError {
+        CantileverError::Interrupted(ck::Interrupted {
             time_s,
             path: self.path.clone(),
-        }
-        .to_string()
+        })
     }
 }
 
 /// Decodes a `pdamp powder run` checkpoint of any scenario and returns its phase and
 /// simulated time \[s\] (for inspection and fuzzing; never panics).
-pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), String> {
-    Ok(match ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)? {
+pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), CantileverError> {
+    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)
+        .map_err(|e| CantileverError::Io(e.to_string()))?;
+    Ok(match phase {
         Phase::Preparing(p) => ("preparing", p.time_s()),
         Phase::Running(r) => ("running", r.coupled.dynamics.t),
         Phase::Finished => ("finished", f64::NAN),
@@ -746,13 +949,15 @@ pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), String> {
 
 /// Decodes a `pdamp powder run` checkpoint of any scenario that holds a preparation in
 /// progress and checks its consistency (for fuzzing; never panics).
-pub fn decode_preparation(bytes: &[u8]) -> Result<Preparation, String> {
-    match ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)? {
+pub fn decode_preparation(bytes: &[u8]) -> Result<Preparation, CantileverError> {
+    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)
+        .map_err(|e| CantileverError::Io(e.to_string()))?;
+    match phase {
         Phase::Preparing(p) => {
             p.check_consistency()?;
             Ok(*p)
         }
-        _ => Err("not a preparation".into()),
+        _ => Err(CantileverError::NotPreparation),
     }
 }
 
@@ -760,7 +965,7 @@ pub fn decode_preparation(bytes: &[u8]) -> Result<Preparation, String> {
 pub fn run(
     sc: &CantileverScenario,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<CantileverResult, String> {
+) -> Result<CantileverResult, CantileverError> {
     sc.validate()?;
     run_core(sc, None, None, None, progress)
 }
@@ -778,13 +983,15 @@ pub fn run_in_dir(
     dir: &Path,
     options: RunOptions,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<CantileverResult, String> {
+) -> Result<CantileverResult, CantileverError> {
     sc.validate()?;
     if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
-        return Err(format!(
-            "--checkpoint-interval-s: must be finite and ≥ 0 (0 = only on Ctrl-C), got {}",
-            options.checkpoint_interval_s
-        ));
+        return Err(ParameterError::out_of_range(
+            "--checkpoint-interval-s",
+            options.checkpoint_interval_s,
+            "must be finite and ≥ 0 (0 = only on Ctrl-C)",
+        )
+        .into());
     }
     let digest = scenario_digest(sc)?;
     let c = Checkpointing {
@@ -793,20 +1000,25 @@ pub fn run_in_dir(
         interval_s: options.checkpoint_interval_s,
     };
     let resumed: Option<Phase> = if options.resume {
-        ck::load(&c.path, CHECKPOINT_KIND, &digest)?
+        ck::load(&c.path, CHECKPOINT_KIND, &digest)
+            .map_err(|e| CantileverError::Io(e.to_string()))?
     } else {
         None
     };
     if let Some(Phase::Finished) = resumed {
         let path = dir.join("summary.json");
-        let text =
-            std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let js: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        return serde_json::from_value(js["result"].clone())
-            .map_err(|e| format!("{}: {e}", path.display()));
+        let text = std::fs::read_to_string(&path).map_err(|source| CantileverError::File {
+            path: path.clone(),
+            source,
+        })?;
+        let json = |source| CantileverError::Json {
+            path: path.clone(),
+            source,
+        };
+        let js: serde_json::Value = serde_json::from_str(&text).map_err(json)?;
+        return serde_json::from_value(js["result"].clone()).map_err(json);
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    create_dir(dir)?;
     let r = run_core(sc, Some(&c), resumed, Some(dir), progress)?;
     write_outputs(dir, sc, &r)?;
     c.save(&Phase::Finished)?;
@@ -820,7 +1032,7 @@ fn run_core(
     resumed: Option<Phase>,
     vtk_dir: Option<&Path>,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<CantileverResult, String> {
+) -> Result<CantileverResult, CantileverError> {
     let (mut s, tip) = build_structure(&sc.beam, &sc.load, sc.run.gravity_m_s2);
     let dt = sc.run.time_step_s;
     let cavity = sc.beam.cavity();
@@ -866,12 +1078,12 @@ fn run_core(
                 }
                 ControlFlow::Continue(())
             });
-            let flow = flow.map_err(|e| e.to_string())?;
+            let flow = flow?;
             if let Some(e) = err {
                 return Err(e);
             }
             if flow.is_break() {
-                let c = ckp.ok_or("preparation stopped")?;
+                let c = ckp.ok_or(CantileverError::PreparationStopped)?;
                 return Err(c.interrupted(pr.time_s()));
             }
             let (pw, rep) = pr.finish();
@@ -890,8 +1102,7 @@ fn run_core(
         vec![0.0; n],
         vec![0.0; n],
         sc.beam.rayleigh,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let interface = cavity_interface(&s, &cavity);
     let structure_mass = s.total_mass();
     let elements = s.mesh.elements.len();
@@ -919,8 +1130,7 @@ fn run_core(
     };
     let (mut c, mut res, first) = match (running, prepared) {
         (Some(st), _) => {
-            let mut c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)
-                .map_err(|e| e.to_string())?;
+            let mut c = Coupled::from_state(s, dynamics, interface, sc.run.coupling, st.coupled)?;
             c.container = sc.powder.is_some().then_some(cavity);
             let res = CantileverResult {
                 time_s: st.time_s,
@@ -935,13 +1145,12 @@ fn run_core(
         }
         (None, Some((mut powder, prep))) => {
             powder.world.gravity_m_s2 = pdamp_dem::Vec3::from(sc.run.gravity_m_s2);
-            let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling)
-                .map_err(|e| e.to_string())?;
+            let mut c = Coupled::new(s, dynamics, powder, interface, sc.run.coupling)?;
             c.container = sc.powder.is_some().then_some(cavity);
             let res = result(&c, prep);
             (c, res, 1)
         }
-        (None, None) => return Err("internal: neither a prepared powder nor a checkpoint".into()),
+        (None, None) => return Err(CantileverError::NoStart),
     };
     let wall_before = res.wall_time_s;
     let clock = Instant::now();
@@ -990,7 +1199,7 @@ fn run_core(
     let e_every = (nsteps / 2000).max(1);
     let t_release = sc.load.rise_s + sc.load.hold_s;
     for q in first..=nsteps {
-        let it = c.step().map_err(|e| e.to_string())?;
+        let it = c.step()?;
         let t = c.dynamics.t;
         let x = c.dynamics.d[3 * tip];
         if t <= t_release {
@@ -1052,7 +1261,10 @@ fn run_core(
 /// cumulative dissipation must not be negative beyond a tenth of the largest energy so far,
 /// and the balance must not grow by more than half of it (from its value after step 1, when
 /// the wall springs are known).
-fn check_energy_health(c: &Coupled, energy: &[(f64, CoupledEnergy)]) -> Result<(), String> {
+fn check_energy_health(
+    c: &Coupled,
+    energy: &[(f64, CoupledEnergy)],
+) -> Result<(), Box<HealthError>> {
     let Some((_, e)) = energy.last() else {
         return Ok(());
     };
@@ -1068,8 +1280,13 @@ fn check_energy_health(c: &Coupled, energy: &[(f64, CoupledEnergy)]) -> Result<(
         .chain(std::iter::once(e.load_work_j.abs()))
         .fold(0.0, f64::max);
     crate::health::check_energy(e.dissipated_j, e.balance_j - b0, scale).map_err(|s| {
-        crate::health::HealthError::of_world(c.world.time_s, "coupled run", s, &c.world, &c.law)
-            .to_string()
+        Box::new(HealthError::of_world(
+            c.world.time_s,
+            "coupled run",
+            s,
+            &c.world,
+            &c.law,
+        ))
     })
 }
 
@@ -1078,8 +1295,8 @@ pub fn write_outputs(
     dir: &Path,
     sc: &CantileverScenario,
     r: &CantileverResult,
-) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+) -> Result<(), CantileverError> {
+    create_dir(dir)?;
     let rows: Vec<[f64; 3]> = (0..r.time_s.len())
         .map(|i| [r.time_s[i], r.tip_m[i], r.iterations[i]])
         .collect();
@@ -1087,8 +1304,7 @@ pub fn write_outputs(
         dir.join("tip.csv"),
         &["time_s", "tip_displacement_m", "coupling_iterations"],
         rows,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let t_rel = sc.load.rise_s + sc.load.hold_s;
     let ext = damping::local_extrema(&r.time_s, &r.tip_m, t_rel);
     let env: Vec<[f64; 2]> = ext
@@ -1099,8 +1315,7 @@ pub fn write_outputs(
         dir.join("envelope.csv"),
         &["time_s", "peak_abs_displacement_m"],
         env.iter(),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let erows: Vec<[f64; 9]> = r
         .energy
         .iter()
@@ -1132,8 +1347,7 @@ pub fn write_outputs(
             "balance_j",
         ],
         erows,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let ms: Vec<f64> = r.time_s.iter().map(|t| t * 1e3).collect();
     let mm: Vec<f64> = r.tip_m.iter().map(|x| x * 1e3).collect();
     let mut plot = pdamp_plot::LinePlot::new(
@@ -1141,7 +1355,7 @@ pub fn write_outputs(
         pdamp_plot::Axis::linear("tip displacement x (mm)"),
     );
     plot.series.push(pdamp_plot::Series::new("", ms, mm));
-    pdamp_plot::line_plot(dir.join("tip"), &plot).map_err(|e| e.to_string())?;
+    pdamp_plot::line_plot(dir.join("tip"), &plot)?;
     // last: a run directory with summary.json is complete (the study skips it)
     // the digest lets a study reuse this run only for the same scenario (study::run_study)
     let summary = serde_json::json!({
@@ -1149,18 +1363,23 @@ pub fn write_outputs(
         "scenario": sc,
         "scenario_digest": scenario_digest(sc)?,
     });
-    pdamp_io::atomic::write_atomic(
-        dir.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
-    )
-    .map_err(|e| e.to_string())?;
+    let path = dir.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).map_err(CantileverError::Encode)?;
+    pdamp_io::atomic::write_atomic(&path, json.as_bytes())
+        .map_err(|source| CantileverError::Write { path, source })?;
     Ok(())
 }
 
+/// Creates `dir` (and its parents).
+fn create_dir(dir: &Path) -> Result<(), CantileverError> {
+    std::fs::create_dir_all(dir).map_err(|source| CantileverError::File {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
 /// First bending frequencies \[Hz\] of the empty beam (no powder), `count` lowest modes.
-pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, String> {
+pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, SolverError> {
     let (s, _) = build_structure(
         beam,
         &LoadSpec {
@@ -1170,9 +1389,7 @@ pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, Strin
         },
         [0.0; 3],
     );
-    fe::modes::lowest_modes(&s, count, 300)
-        .map(|(f, _)| f)
-        .map_err(|e| e.to_string())
+    fe::modes::lowest_modes(&s, count, 300).map(|(f, _)| f)
 }
 
 /// First bending frequency of the empty beam from piecewise Timoshenko theory (solid bottom,
@@ -1258,7 +1475,12 @@ mod tests {
         assert!(e.contains("not 'run'"), "{e}");
         let mut bad = bytes.clone();
         bad[bytes.len() / 2] ^= 1;
-        assert!(inspect_checkpoint(&bad).unwrap_err().contains("damaged"));
+        assert!(
+            inspect_checkpoint(&bad)
+                .unwrap_err()
+                .to_string()
+                .contains("damaged")
+        );
         assert!(inspect_checkpoint(&bytes[..bytes.len() - 100]).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }

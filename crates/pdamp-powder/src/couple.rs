@@ -105,6 +105,9 @@ pub enum CoupleError {
     /// A checkpoint state does not fit the scenario.
     #[error("{0}")]
     State(String),
+    /// The contact law of a checkpoint state is out of range.
+    #[error(transparent)]
+    Law(#[from] crate::error::ParameterError),
     /// Fixed point did not converge.
     #[error(
         "coupling did not converge at t = {t_s} s: eq. 16 measure {measure:e} after {iterations} iterations"
@@ -439,12 +442,8 @@ impl Coupled {
         st: CoupledState,
     ) -> Result<Self, CoupleError> {
         let bad = |what: &str| CoupleError::State(what.to_string());
-        dynamics
-            .restore_state(st.dynamics)
-            .map_err(|e| CoupleError::State(e.to_string()))?;
-        st.law
-            .validate("coupling state: law.")
-            .map_err(|e| CoupleError::State(e.to_string()))?;
+        dynamics.restore_state(st.dynamics)?;
+        st.law.validate("coupling state: law.")?;
         let ndof = structure.n_dof();
         if [&st.f_ps, &st.dk, &st.f_trial]
             .iter()

@@ -13,6 +13,8 @@
 //! Sign convention: $\mathbf n$ points from particle i to its partner, $g_N$ is the gap
 //! (negative = overlap), forces are those acting on particle i.
 
+use crate::error::ParameterError;
+
 /// Constant parameters of the powder contact law.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -82,12 +84,16 @@ impl PowderLaw {
 
     /// Checks that every value is finite and in its physical range; the error names the key
     /// (with `prefix`), the value and the range.
-    pub fn validate(&self, prefix: &str) -> Result<(), String> {
+    pub fn validate(&self, prefix: &str) -> Result<(), ParameterError> {
         let chk = |ok: bool, key: &str, v: f64, what: &str| {
             if ok {
                 Ok(())
             } else {
-                Err(format!("{prefix}{key}: {what}, got {v}"))
+                Err(ParameterError::out_of_range(
+                    format!("{prefix}{key}"),
+                    v,
+                    what,
+                ))
             }
         };
         let k = self.normal_stiffness_n_m;

@@ -30,6 +30,7 @@ pub mod bed;
 pub mod cantilever;
 pub mod couple;
 pub mod damping;
+pub mod error;
 pub mod fe;
 pub mod fuzz;
 pub mod health;
@@ -38,3 +39,5 @@ pub mod prep;
 pub mod psd;
 pub mod study;
 pub mod vtk;
+
+pub use error::ParameterError;

@@ -22,6 +22,7 @@ use pdamp_dem::{BodyState, Motion, RigidBody, TranslationTrack, Vec3, World, Wor
 use rand::{RngExt, SeedableRng};
 
 use crate::bed::{PARTICLE_MATERIAL, PowderBed, WALL_MATERIAL, powder_world};
+use crate::error::ParameterError;
 use crate::fe::Aabb;
 use crate::health::{self, HealthError};
 use crate::law::PowderLaw;
@@ -185,20 +186,46 @@ impl From<Preparation> for PreparationData {
     }
 }
 
+/// Why a preparation (from a checkpoint) is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PrepError {
+    /// The cavity, the plate or the density of a saved preparation is not finite.
+    #[error("preparation state: cavity, plate or density not finite")]
+    StateNotFinite,
+    /// The time step or the reference energies of a saved preparation are not finite.
+    #[error("preparation state: time step or reference energies not finite")]
+    Inconsistent,
+    /// The contact law of a saved preparation is out of range.
+    #[error(transparent)]
+    Law(#[from] ParameterError),
+    /// The particle state was refused by pdamp-dem.
+    #[error("{0}")]
+    Dem(String),
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<PrepError> for String {
+    fn from(e: PrepError) -> String {
+        e.to_string()
+    }
+}
+
 impl TryFrom<PreparationData> for Preparation {
-    type Error = String;
-    fn try_from(d: PreparationData) -> Result<Self, String> {
+    type Error = PrepError;
+    fn try_from(d: PreparationData) -> Result<Self, PrepError> {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let c = &d.cavity;
         let cavity_ok = finite(&c.min) && finite(&c.max) && (0..3).all(|k| c.min[k] < c.max[k]);
         let plate_ok = finite(&[d.plate.0, d.plate.1, d.plate.2, d.top_start]);
         let density_ok = d.density_kg_m3 > 0.0 && d.density_kg_m3.is_finite();
         if !(cavity_ok && plate_ok && density_ok) {
-            return Err("preparation state: cavity, plate or density not finite".into());
+            return Err(PrepError::StateNotFinite);
         }
         d.law.validate("preparation state: law.")?;
         let mut world = walls_world(&d.cavity, &d.law, d.density_kg_m3, 1.0, d.top_start);
-        world.set_particles_of(&d.world)?;
+        world
+            .set_particles_of(&d.world)
+            .map_err(|e| PrepError::Dem(e.to_string()))?;
         let mut p = Self {
             world,
             plate: d.plate,
@@ -220,7 +247,9 @@ impl TryFrom<PreparationData> for Preparation {
             segment_start: None,
         };
         p.set_plate_track(p.plate, false);
-        p.world.restore_state(d.world)?;
+        p.world
+            .restore_state(d.world)
+            .map_err(|e| PrepError::Dem(e.to_string()))?;
         Ok(p)
     }
 }
@@ -384,13 +413,13 @@ impl Preparation {
 
     /// Checks that a deserialized preparation is self-consistent (the world's checks ran when
     /// it was restored; here the time step and the reference energies).
-    pub fn check_consistency(&self) -> Result<(), String> {
+    pub fn check_consistency(&self) -> Result<(), PrepError> {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let ok = self.world.dt_s > 0.0
             && self.world.dt_s.is_finite()
             && finite(&[self.e_ref, self.e_ref_1g, self.bed_top, self.settled]);
         if !ok {
-            return Err("preparation state: time step or reference energies not finite".into());
+            return Err(PrepError::Inconsistent);
         }
         Ok(())
     }

@@ -2,6 +2,7 @@
 //! description, sampled by pdamp-dem's [`SizeDistribution`] from a seeded ChaCha8 generator, so
 //! that particle sets depend only on the seed.
 
+use crate::error::ParameterError;
 use pdamp_dem::generate::SizeDistribution;
 
 /// Log-normal diameter distribution $\ln D \sim \mathcal N(\ln D_{50}, \sigma^2)$, truncated to
@@ -54,24 +55,32 @@ impl LogNormal {
     }
     /// Checks ranges (finite values; σ ≤ 1 so that the truncated sampling terminates
     /// quickly); the error names the key.
-    pub fn validate(&self, prefix: &str) -> Result<(), String> {
+    pub fn validate(&self, prefix: &str) -> Result<(), ParameterError> {
         if !(self.d50_m > 0.0 && self.d50_m.is_finite()) {
-            return Err(format!(
-                "{prefix}d50_m: must be a finite positive diameter, got {}",
-                self.d50_m
+            return Err(ParameterError::out_of_range(
+                format!("{prefix}d50_m"),
+                self.d50_m,
+                "must be a finite positive diameter",
             ));
         }
         if !(self.sigma >= 0.0 && self.sigma <= 1.0) {
-            return Err(format!(
-                "{prefix}sigma: must be in [0, 1] (Table A.2: 0.2707), got {}",
-                self.sigma
+            return Err(ParameterError::out_of_range(
+                format!("{prefix}sigma"),
+                self.sigma,
+                "must be in [0, 1] (Table A.2: 0.2707)",
             ));
         }
         if !(self.d_min_m > 0.0 && self.d_min_m <= self.d50_m) {
-            return Err(format!("{prefix}d_min_m: must be in (0, d50_m]"));
+            return Err(ParameterError::invalid(
+                format!("{prefix}d_min_m"),
+                "must be in (0, d50_m]",
+            ));
         }
         if !(self.d_max_m >= self.d50_m && self.d_max_m.is_finite()) {
-            return Err(format!("{prefix}d_max_m: must be finite and ≥ d50_m"));
+            return Err(ParameterError::invalid(
+                format!("{prefix}d_max_m"),
+                "must be finite and ≥ d50_m",
+            ));
         }
         Ok(())
     }

@@ -20,7 +20,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::cantilever::{self, CantileverScenario};
+use crate::cantilever::{self, CantileverError, CantileverScenario};
 use crate::damping;
 use pdamp_design::ensemble::EnsembleStat;
 use serde::Serialize;
@@ -75,29 +75,34 @@ impl StudyParameter {
     }
 
     /// The scenario with the parameter set to `v` (validated; the error names the value).
-    pub fn apply(&self, base: &CantileverScenario, v: f64) -> Result<CantileverScenario, String> {
+    pub fn apply(
+        &self,
+        base: &CantileverScenario,
+        v: f64,
+    ) -> Result<CantileverScenario, StudyError> {
         self.apply_unnamed(base, v)
-            .map_err(|e| format!("--values: {} = {v}: {e}", self.name()))
+            .map_err(|source| StudyError::Value {
+                parameter: self.name(),
+                value: v,
+                source: Box::new(source),
+            })
     }
 
     fn apply_unnamed(
         &self,
         base: &CantileverScenario,
         v: f64,
-    ) -> Result<CantileverScenario, String> {
+    ) -> Result<CantileverScenario, ValueError> {
         if !v.is_finite() {
-            return Err("values must be finite numbers".into());
+            return Err(ValueError::NotFinite);
         }
         let mut s = base.clone();
-        let p = s
-            .powder
-            .as_mut()
-            .ok_or("the study needs a [powder] section")?;
+        let p = s.powder.as_mut().ok_or(ValueError::NoPowder)?;
         match self {
             Self::PackingDensity => p.prep.packing_density = v,
             Self::StiffnessFactor => {
                 if !(v > 0.0) {
-                    return Err("the stiffness factor must be positive".into());
+                    return Err(ValueError::StiffnessFactor);
                 }
                 p.law.normal_stiffness_n_m *= v
             }
@@ -106,7 +111,7 @@ impl StudyParameter {
             Self::SurfaceEnergy => p.law.surface_energy_j_m2 = v,
             Self::D50 => {
                 if !(v > 0.0) {
-                    return Err("d50_m must be positive".into());
+                    return Err(ValueError::D50);
                 }
                 let f = v / p.d50_m;
                 p.d50_m = v;
@@ -118,9 +123,7 @@ impl StudyParameter {
                     1.0 => [0.0, 0.0, 9.81],
                     2.0 => [-9.81, 0.0, 0.0],
                     _ => {
-                        return Err(
-                            "orientation values: 0 upright, 1 upside down, 2 horizontal".into()
-                        );
+                        return Err(ValueError::Orientation);
                     }
                 }
             }
@@ -212,8 +215,31 @@ fn table_line(first: f64, r: &StudyRow) -> [f64; 16] {
     ]
 }
 
-/// Why a study refuses to run.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+/// Why a value of the varied parameter is refused ([`StudyParameter::apply`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ValueError {
+    /// The value is not a finite number.
+    #[error("values must be finite numbers")]
+    NotFinite,
+    /// The scenario has no powder to vary.
+    #[error("the study needs a [powder] section")]
+    NoPowder,
+    /// A stiffness factor ≤ 0.
+    #[error("the stiffness factor must be positive")]
+    StiffnessFactor,
+    /// A D50 ≤ 0.
+    #[error("d50_m must be positive")]
+    D50,
+    /// An orientation other than 0, 1 or 2.
+    #[error("orientation values: 0 upright, 1 upside down, 2 horizontal")]
+    Orientation,
+    /// The scenario with the value applied is invalid.
+    #[error(transparent)]
+    Scenario(#[from] CantileverError),
+}
+
+/// Why a study refuses to run or fails.
+#[derive(Debug, thiserror::Error)]
 pub enum StudyError {
     /// A run directory holds results (or an interrupted run) of another scenario.
     #[error(
@@ -239,18 +265,99 @@ pub enum StudyError {
         /// What is wrong.
         why: String,
     },
+    /// A value of the varied parameter is refused.
+    #[error("--values: {parameter} = {value}: {source}")]
+    Value {
+        /// Name of the parameter ([`StudyParameter::name`]).
+        parameter: &'static str,
+        /// The value.
+        value: f64,
+        /// Why.
+        source: Box<ValueError>,
+    },
+    /// No value to run.
+    #[error("--values: give at least one value")]
+    NoValues,
+    /// Zero packings per value.
+    #[error("--packings must be at least 1")]
+    NoPackings,
+    /// An ensemble of fewer than 2 packings.
+    #[error("--packings: an ensemble needs at least 2 packings, got {0}")]
+    TooFewPackings(usize),
+    /// An ensemble of a scenario without powder.
+    #[error("packings: an ensemble needs a [powder] section (the empty beam has no bed)")]
+    NoPowder,
+    /// A negative or non-finite checkpoint interval.
+    #[error("--checkpoint-interval-s: must be finite and ≥ 0, got {0}")]
+    CheckpointInterval(f64),
+    /// A finished run's `summary.json` has neither a digest nor a readable scenario.
+    #[error("no scenario_digest and no readable scenario ({0})")]
+    NoDigest(#[source] serde_json::Error),
+    /// A finished run's `tip.csv` lacks columns.
+    #[error(
+        "{path}: needs the columns time_s and tip_displacement_m; remove {dir} to compute it again"
+    )]
+    TipColumns {
+        /// The file.
+        path: PathBuf,
+        /// The run directory.
+        dir: PathBuf,
+    },
+    /// A finished run's `summary.json` cannot be read.
+    #[error("{source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A finished run's `summary.json` is no JSON.
+    #[error("{source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The decoding error.
+        source: serde_json::Error,
+    },
+    /// `ensemble.json` could not be encoded.
+    #[error("{0}")]
+    Encode(#[source] serde_json::Error),
+    /// An output file could not be written.
+    #[error("{source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A run failed (or its scenario is invalid).
+    #[error(transparent)]
+    Cantilever(#[from] CantileverError),
+    /// A CSV file could not be read or written.
+    #[error(transparent)]
+    Csv(#[from] pdamp_io::csv::CsvError),
+    /// A plot could not be written.
+    #[error(transparent)]
+    Plot(#[from] pdamp_plot::PlotError),
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<StudyError> for String {
+    fn from(e: StudyError) -> String {
+        e.to_string()
+    }
 }
 
 /// Digest of the scenario a finished run's `summary.json` belongs to: its `scenario_digest`
 /// field, or (summaries written before the field existed) the digest of the scenario stored
 /// in it.
-pub fn summary_digest(js: &serde_json::Value) -> Result<String, String> {
+pub fn summary_digest(js: &serde_json::Value) -> Result<String, StudyError> {
     if let Some(d) = js["scenario_digest"].as_str() {
         return Ok(d.to_string());
     }
-    let sc: CantileverScenario = serde_json::from_value(js["scenario"].clone())
-        .map_err(|e| format!("no scenario_digest and no readable scenario ({e})"))?;
-    cantilever::scenario_digest(&sc)
+    let sc: CantileverScenario =
+        serde_json::from_value(js["scenario"].clone()).map_err(StudyError::NoDigest)?;
+    Ok(cantilever::scenario_digest(&sc)?)
 }
 
 /// Scenario digest in the header of a checkpoint file (read without decoding the body);
@@ -290,7 +397,7 @@ fn check_run_dir(dir: &Path, expected: &str) -> Result<bool, StudyError> {
         let text = std::fs::read_to_string(&summary).map_err(|e| unreadable(e.to_string()))?;
         let js: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| unreadable(e.to_string()))?;
-        let found = summary_digest(&js).map_err(unreadable)?;
+        let found = summary_digest(&js).map_err(|e| unreadable(e.to_string()))?;
         if found != expected {
             return Err(foreign("results", found));
         }
@@ -306,15 +413,14 @@ fn check_run_dir(dir: &Path, expected: &str) -> Result<bool, StudyError> {
 }
 
 /// The tip history of a finished run (`tip.csv`: time, displacement).
-fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), String> {
+fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), StudyError> {
     let path = dir.join("tip.csv");
-    let (_, data) = pdamp_io::csv::read_csv_f64(&path).map_err(|e| e.to_string())?;
+    let (_, data) = pdamp_io::csv::read_csv_f64(&path)?;
     if data.iter().any(|r| r.len() < 2) {
-        return Err(format!(
-            "{}: needs the columns time_s and tip_displacement_m; remove {} to compute it again",
-            path.display(),
-            dir.display()
-        ));
+        return Err(StudyError::TipColumns {
+            path,
+            dir: dir.to_path_buf(),
+        });
     }
     Ok((
         data.iter().map(|r| r[0]).collect(),
@@ -323,12 +429,9 @@ fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), String> {
 }
 
 /// The scenario of packing `k`: the powder prepared with [`pdamp_io::prepare::packing_seed`].
-pub fn with_packing(base: &CantileverScenario, k: usize) -> Result<CantileverScenario, String> {
+pub fn with_packing(base: &CantileverScenario, k: usize) -> Result<CantileverScenario, StudyError> {
     let mut s = base.clone();
-    let p = s
-        .powder
-        .as_mut()
-        .ok_or("packings: an ensemble needs a [powder] section (the empty beam has no bed)")?;
+    let p = s.powder.as_mut().ok_or(StudyError::NoPowder)?;
     p.prep.seed = pdamp_io::prepare::packing_seed(p.prep.seed, k);
     Ok(s)
 }
@@ -441,12 +544,12 @@ pub fn study_runs(
     values: &[f64],
     packings: usize,
     out: &Path,
-) -> Result<Vec<StudyRun>, String> {
+) -> Result<Vec<StudyRun>, StudyError> {
     if values.is_empty() {
-        return Err("--values: give at least one value".into());
+        return Err(StudyError::NoValues);
     }
     if packings == 0 {
-        return Err("--packings must be at least 1".into());
+        return Err(StudyError::NoPackings);
     }
     let mut runs = Vec::with_capacity(values.len() * packings);
     for &v in values {
@@ -481,11 +584,9 @@ pub fn ensemble_runs(
     base: &CantileverScenario,
     packings: usize,
     out: &Path,
-) -> Result<Vec<StudyRun>, String> {
+) -> Result<Vec<StudyRun>, StudyError> {
     if packings < 2 {
-        return Err(format!(
-            "--packings: an ensemble needs at least 2 packings, got {packings}"
-        ));
+        return Err(StudyError::TooFewPackings(packings));
     }
     (0..packings)
         .map(|k| {
@@ -504,9 +605,9 @@ impl StudyRun {
     /// Whether its folder holds the finished results of its scenario (`Ok(false)`: nothing,
     /// or an interrupted run of it); a folder of another scenario or an unreadable summary is
     /// an error that names it.
-    pub fn finished(&self) -> Result<bool, String> {
+    pub fn finished(&self) -> Result<bool, StudyError> {
         let digest = cantilever::scenario_digest(&self.scenario)?;
-        check_run_dir(&self.dir, &digest).map_err(|e| e.to_string())
+        check_run_dir(&self.dir, &digest)
     }
 
     /// Runs it in its folder unless finished, continuing an interrupted run from its checkpoint
@@ -516,7 +617,7 @@ impl StudyRun {
         &self,
         checkpoint_interval_s: f64,
         progress: &mut dyn FnMut(&str, f64),
-    ) -> Result<bool, String> {
+    ) -> Result<bool, StudyError> {
         if self.finished()? {
             return Ok(false);
         }
@@ -554,9 +655,9 @@ fn plan_run(
     sc: CantileverScenario,
     dir: PathBuf,
     label: String,
-) -> Result<PlannedRun, String> {
+) -> Result<PlannedRun, StudyError> {
     let digest = cantilever::scenario_digest(&sc)?;
-    let finished = check_run_dir(&dir, &digest).map_err(|e| e.to_string())?;
+    let finished = check_run_dir(&dir, &digest)?;
     Ok(PlannedRun {
         value,
         packing,
@@ -574,11 +675,10 @@ fn run_planned(
     out: &Path,
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<Vec<StudyRow>, String> {
+) -> Result<Vec<StudyRow>, StudyError> {
     if !(options.checkpoint_interval_s >= 0.0 && options.checkpoint_interval_s.is_finite()) {
-        return Err(format!(
-            "--checkpoint-interval-s: must be finite and ≥ 0, got {}",
-            options.checkpoint_interval_s
+        return Err(StudyError::CheckpointInterval(
+            options.checkpoint_interval_s,
         ));
     }
     let mut rows = Vec::new();
@@ -596,11 +696,13 @@ fn run_planned(
         let t_rel = sc.load.rise_s + sc.load.hold_s;
         let (t, x, row) = if run.finished {
             let (t, x) = read_tip(&run.dir)?;
-            let js: serde_json::Value = serde_json::from_str(
-                &std::fs::read_to_string(run.dir.join("summary.json"))
-                    .map_err(|e| e.to_string())?,
-            )
-            .map_err(|e| e.to_string())?;
+            let path = run.dir.join("summary.json");
+            let text = std::fs::read_to_string(&path).map_err(|source| StudyError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            let js: serde_json::Value =
+                serde_json::from_str(&text).map_err(|source| StudyError::Json { path, source })?;
             let res = &js["result"];
             let f = |k: &str| res[k].as_f64().unwrap_or(f64::NAN);
             let prep: Option<crate::prep::PrepReport> =
@@ -639,8 +741,8 @@ fn run_planned(
         ));
         rows.push(row);
     }
-    pdamp_plot::line_plot(out.join("decay"), &decay).map_err(|e| e.to_string())?;
-    pdamp_plot::line_plot(out.join("envelope"), &env).map_err(|e| e.to_string())?;
+    pdamp_plot::line_plot(out.join("decay"), &decay)?;
+    pdamp_plot::line_plot(out.join("envelope"), &env)?;
     Ok(rows)
 }
 
@@ -654,7 +756,7 @@ pub fn run_study(
     out: &Path,
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<Vec<StudyRow>, String> {
+) -> Result<Vec<StudyRow>, StudyError> {
     run_study_packings(base, param, values, 1, out, options, progress)
 }
 
@@ -669,7 +771,7 @@ pub fn run_study_packings(
     out: &Path,
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<Vec<StudyRow>, String> {
+) -> Result<Vec<StudyRow>, StudyError> {
     // every value is validated and every existing run directory checked before any run
     let plan = study_runs(base, param, values, packings, out)?
         .into_iter()
@@ -691,8 +793,7 @@ pub fn run_study_packings(
             line.to_vec()
         }
     });
-    pdamp_io::csv::write_csv_atomic(out.join("table.csv"), &header, lines)
-        .map_err(|e| e.to_string())?;
+    pdamp_io::csv::write_csv_atomic(out.join("table.csv"), &header, lines)?;
     if packings > 1 {
         let mut header = vec![param.name()];
         header.extend(ENSEMBLE_COLUMNS);
@@ -703,8 +804,7 @@ pub fn run_study_packings(
             .chunks(packings)
             .map(|c| ensemble_line(c[0].value, &PowderEnsemble::of(c.to_vec(), seeds.clone())))
             .collect();
-        pdamp_io::csv::write_csv_atomic(out.join("ensemble.csv"), &header, lines)
-            .map_err(|e| e.to_string())?;
+        pdamp_io::csv::write_csv_atomic(out.join("ensemble.csv"), &header, lines)?;
     }
     Ok(rows)
 }
@@ -723,7 +823,7 @@ pub fn run_ensemble(
     out: &Path,
     options: cantilever::RunOptions,
     progress: &mut dyn FnMut(&str, f64),
-) -> Result<PowderEnsemble, String> {
+) -> Result<PowderEnsemble, StudyError> {
     let runs = ensemble_runs(base, packings, out)?;
     let seeds: Vec<u64> = runs.iter().map(|r| seed_of(&r.scenario)).collect();
     let plan = runs
@@ -737,11 +837,11 @@ pub fn run_ensemble(
         out.join("table.csv"),
         &header,
         rows.iter().map(|r| table_line(r.packing as f64, r)),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let e = PowderEnsemble::of(rows, seeds);
-    let json = serde_json::to_string_pretty(&e).map_err(|e| e.to_string())?;
-    pdamp_io::atomic::write_atomic(out.join("ensemble.json"), json.as_bytes())
-        .map_err(|e| e.to_string())?;
+    let json = serde_json::to_string_pretty(&e).map_err(StudyError::Encode)?;
+    let path = out.join("ensemble.json");
+    pdamp_io::atomic::write_atomic(&path, json.as_bytes())
+        .map_err(|source| StudyError::Write { path, source })?;
     Ok(e)
 }

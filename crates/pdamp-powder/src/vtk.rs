@@ -14,6 +14,29 @@ use pdamp_dem::math::Vec3;
 use pdamp_io::vtk::{PointField, PvdSeries, VtkEncoding};
 use std::path::{Path, PathBuf};
 
+/// Why a ParaView frame could not be written (the text starts with `output:`).
+#[derive(Debug, thiserror::Error)]
+pub enum SnapshotError {
+    /// Writing a frame or the collection failed.
+    #[error("output: {0}")]
+    Vtk(#[from] pdamp_io::vtk::VtkError),
+    /// The frame folder could not be created.
+    #[error("output: {path}: {source}")]
+    CreateDir {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
+impl From<SnapshotError> for String {
+    fn from(e: SnapshotError) -> String {
+        e.to_string()
+    }
+}
+
 /// The snapshot series of a coupled powder run.
 #[derive(Debug)]
 pub struct PowderSnapshots {
@@ -59,7 +82,7 @@ impl PowderSnapshots {
 
     /// Continues a run resumed after step `step` (frames of the multiples of the interval up
     /// to `step` exist).
-    pub fn resume_after(&mut self, step: u64) -> Result<(), String> {
+    pub fn resume_after(&mut self, step: u64) -> Result<(), SnapshotError> {
         let n = (step / self.every_steps + 1) as usize;
         let mut entries = Vec::new();
         for k in 0..n {
@@ -67,20 +90,21 @@ impl PowderSnapshots {
             let t = (t * 1e12).round() / 1e12;
             entries.extend(Self::files(k).into_iter().map(|f| (t, f)));
         }
-        self.series =
-            PvdSeries::resume(self.series.path(), entries).map_err(|e| format!("output: {e}"))?;
+        self.series = PvdSeries::resume(self.series.path(), entries)?;
         self.next_index = n;
         Ok(())
     }
 
     /// Writes the frame of step `step` (time `step · dt`) if it is a multiple of the interval.
-    pub fn on_step(&mut self, step: u64, c: &Coupled) -> Result<(), String> {
+    pub fn on_step(&mut self, step: u64, c: &Coupled) -> Result<(), SnapshotError> {
         if !step.is_multiple_of(self.every_steps) {
             return Ok(());
         }
-        let io = |e: pdamp_io::vtk::VtkError| format!("output: {e}");
         let vtk = self.dir.join("vtk");
-        std::fs::create_dir_all(&vtk).map_err(|e| format!("output: {}: {e}", vtk.display()))?;
+        std::fs::create_dir_all(&vtk).map_err(|source| SnapshotError::CreateDir {
+            path: vtk.clone(),
+            source,
+        })?;
         let k = self.next_index;
         let v3 = |a: &[f64; 3]| Vec3::new(a[0], a[1], a[2]);
         let p = &c.world.particles;
@@ -104,8 +128,7 @@ impl PowderSnapshots {
                 ("speed_m_s", PointField::Scalar(&speed)),
             ],
             self.encoding,
-        )
-        .map_err(io)?;
+        )?;
         let d = &c.dynamics.d;
         let nodes = &c.structure.mesh.nodes;
         let u: Vec<Vec3> = (0..nodes.len())
@@ -118,11 +141,9 @@ impl PowderSnapshots {
             &self.triangles,
             &[("displacement_m", PointField::Vector(&u))],
             self.encoding,
-        )
-        .map_err(io)?;
+        )?;
         self.series
-            .add_frame(step as f64 * self.dt_s, &Self::files(k))
-            .map_err(io)?;
+            .add_frame(step as f64 * self.dt_s, &Self::files(k))?;
         self.next_index += 1;
         Ok(())
     }

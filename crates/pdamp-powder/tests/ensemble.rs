@@ -81,6 +81,7 @@ fn ensemble_of_three_packings() {
     assert!(
         study::run_ensemble(&tiny(), 1, &tmp("one"), OPTIONS, &mut |_, _| {})
             .unwrap_err()
+            .to_string()
             .contains("at least 2")
     );
     let mut empty = tiny();
@@ -88,6 +89,7 @@ fn ensemble_of_three_packings() {
     assert!(
         study::run_ensemble(&empty, 2, &tmp("empty"), OPTIONS, &mut |_, _| {})
             .unwrap_err()
+            .to_string()
             .contains("[powder] section")
     );
     let _ = std::fs::remove_dir_all(&out);

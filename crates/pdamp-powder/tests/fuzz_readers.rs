@@ -85,7 +85,9 @@ fn write_checkpoint_seeds() {
     // a preparation stopped at once (the stop request cannot be withdrawn: last)
     let _ = std::fs::remove_dir_all(&dir);
     pdamp_io::checkpoint::request_stop();
-    let e = cantilever::run_in_dir(&sc, &dir, opts, &mut |_, _| {}).unwrap_err();
+    let e = cantilever::run_in_dir(&sc, &dir, opts, &mut |_, _| {})
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with(pdamp_io::checkpoint::INTERRUPTED), "{e}");
     std::fs::copy(&ck, seeds.join("preparing.bin")).unwrap();
     let _ = std::fs::remove_dir_all(&dir);

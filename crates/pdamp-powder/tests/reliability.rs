@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 use pdamp_powder::cantilever::{self, CantileverScenario, RunOptions};
+use pdamp_powder::study::StudyError;
 
 fn tiny_text() -> String {
     std::fs::read_to_string(concat!(
@@ -41,7 +42,7 @@ fn tiny_scenario_runs() {
 
 // ---------------------------------------------------------------- defect 1: study reuse
 
-fn study(sc: &CantileverScenario, out: &std::path::Path) -> Result<Vec<f64>, String> {
+fn study(sc: &CantileverScenario, out: &std::path::Path) -> Result<Vec<f64>, StudyError> {
     pdamp_powder::study::run_study(
         sc,
         pdamp_powder::study::StudyParameter::PackingDensity,
@@ -82,7 +83,7 @@ fn study_refuses_results_of_another_scenario_and_reuses_its_own() {
     // a changed scenario (another friction): refused before anything runs, results kept
     let mut other = sc.clone();
     other.powder.as_mut().unwrap().law.friction = 0.2;
-    let e = study(&other, &out).unwrap_err();
+    let e = study(&other, &out).unwrap_err().to_string();
     assert!(e.contains(&run_dir.display().to_string()), "{e}");
     assert!(
         e.contains("holds results of a different scenario (digest "),
@@ -114,11 +115,11 @@ fn study_refuses_results_of_another_scenario_and_reuses_its_own() {
     )
     .unwrap();
     study(&sc, &out).unwrap();
-    let e = study(&other, &out).unwrap_err();
+    let e = study(&other, &out).unwrap_err().to_string();
     assert!(e.contains("holds results of a different scenario"), "{e}");
     // an interrupted run of another scenario (its checkpoint) is refused as well
     let _ = std::fs::remove_file(run_dir.join("summary.json"));
-    let e = study(&other, &out).unwrap_err();
+    let e = study(&other, &out).unwrap_err().to_string();
     assert!(
         e.contains("holds an interrupted run of a different scenario"),
         "{e}"
@@ -151,7 +152,8 @@ fn study_values_are_validated_before_any_run() {
             },
             &mut |_, _| {},
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("--values") && e.contains(want), "{v}: {e}");
         assert!(
             !out.exists(),
@@ -172,7 +174,8 @@ fn infinite_checkpoint_interval_is_refused_before_writing() {
         },
         &mut |_, _| {},
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("--checkpoint-interval-s"), "{e}");
     assert!(!out.exists());
 }
@@ -329,7 +332,9 @@ fn every_number_is_validated_with_its_key() {
         ),
     ];
     for (section, key, value, want) in cases {
-        let e = CantileverScenario::from_toml(&with(section, key, value)).unwrap_err();
+        let e = CantileverScenario::from_toml(&with(section, key, value))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with(want) || e.contains(want),
             "{section}.{key} = {value}: {e}"
@@ -340,7 +345,9 @@ fn every_number_is_validated_with_its_key() {
 #[test]
 fn sizes_are_bounded_with_a_cost_estimate() {
     // elements: 1 µm walls
-    let e = CantileverScenario::from_toml(&with("beam", "wall_element_m", "1e-7")).unwrap_err();
+    let e = CantileverScenario::from_toml(&with("beam", "wall_element_m", "1e-7"))
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("beam.wall_element_m") && e.contains("elements") && e.contains("GB"),
         "{e}"
@@ -348,13 +355,17 @@ fn sizes_are_bounded_with_a_cost_estimate() {
     // particles: 10 µm powder in the cavity (coarse-graining keeps the time step valid)
     let text =
         with("powder", "d50_m", "1e-5").replace("reference_d50_m = 1e-3", "reference_d50_m = 1e-5");
-    let e = CantileverScenario::from_toml(&text).unwrap_err();
+    let e = CantileverScenario::from_toml(&text)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("particles") && e.contains("GB") && e.contains("of one core"),
         "{e}"
     );
     // steps: 1000 s at 5 µs
-    let e = CantileverScenario::from_toml(&with("run", "duration_s", "1000.0")).unwrap_err();
+    let e = CantileverScenario::from_toml(&with("run", "duration_s", "1000.0"))
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("run.duration_s") && e.contains("steps") && e.contains("h of one core"),
         "{e}"
@@ -364,7 +375,9 @@ fn sizes_are_bounded_with_a_cost_estimate() {
         "output_interval_s = 1e-5",
         "output_interval_s = 1e-5\nvtk_interval_s = 1e-6",
     );
-    let e = CantileverScenario::from_toml(&text).unwrap_err();
+    let e = CantileverScenario::from_toml(&text)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("run.vtk_interval_s") && e.contains("frames"),
         "{e}"

@@ -61,18 +61,21 @@ fn scenario_errors_name_the_key() {
     assert!(
         CantileverScenario::from_toml(&bad)
             .unwrap_err()
+            .to_string()
             .contains("beam.material.youngs_modulus_pa")
     );
     let bad = text.replace("packing_density = 0.58", "packing_density = 0.9");
     assert!(
         CantileverScenario::from_toml(&bad)
             .unwrap_err()
+            .to_string()
             .contains("powder.prep.packing_density")
     );
     let bad = text.replace("duration_s = 0.008", "duration_seconds = 0.008");
     assert!(
         CantileverScenario::from_toml(&bad)
             .unwrap_err()
+            .to_string()
             .contains("duration_seconds")
     );
 }

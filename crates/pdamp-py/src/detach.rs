@@ -33,6 +33,29 @@ impl Progress {
     }
 }
 
+/// An error of library work run from Python: any library error, kept as its text, which
+/// becomes the message of the `RuntimeError` raised in Python. Every error that prints itself
+/// converts into it, so the work can use `?` on the errors of all pdamp crates.
+#[derive(Debug)]
+pub(crate) struct LibraryError {
+    /// The library's message.
+    message: String,
+}
+
+impl<E: std::fmt::Display> From<E> for LibraryError {
+    fn from(e: E) -> Self {
+        Self {
+            message: e.to_string(),
+        }
+    }
+}
+
+impl From<LibraryError> for PyErr {
+    fn from(e: LibraryError) -> PyErr {
+        PyRuntimeError::new_err(e.message)
+    }
+}
+
 /// A rayon pool of `threads` workers (all cores when `None` or 0).
 pub(crate) fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new()
@@ -51,7 +74,7 @@ pub(crate) fn detached<T: Send>(
     py: Python<'_>,
     pool: &rayon::ThreadPool,
     callback: Option<&Bound<'_, PyAny>>,
-    f: impl FnOnce(&Progress) -> Result<T, String> + Send,
+    f: impl FnOnce(&Progress) -> Result<T, LibraryError> + Send,
 ) -> PyResult<T> {
     let progress = Progress::default();
     let mut raised: Option<PyErr> = None;
@@ -93,7 +116,7 @@ pub(crate) fn detached<T: Send>(
         }
     }
     match r {
-        Ok(r) => r.map_err(PyRuntimeError::new_err),
+        Ok(r) => r.map_err(PyErr::from),
         Err(_) => Err(PyRuntimeError::new_err("the simulation panicked")),
     }
 }
@@ -104,11 +127,11 @@ pub(crate) fn detached<T: Send>(
 pub(crate) fn detached_short<T: Send>(
     py: Python<'_>,
     pool: &rayon::ThreadPool,
-    f: impl FnOnce() -> Result<T, String> + Send,
+    f: impl FnOnce() -> Result<T, LibraryError> + Send,
 ) -> PyResult<T> {
     let r = py.detach(|| pool.install(f));
     py.check_signals()?;
-    r.map_err(PyRuntimeError::new_err)
+    r.map_err(PyErr::from)
 }
 
 /// The threads of a [`crate::world::PyWorld`]. Where it can, the Python thread that builds the
@@ -191,7 +214,7 @@ impl WorldPool {
         callback: Option<&Bound<'_, PyAny>>,
         final_phase: &str,
         short: bool,
-        work: impl FnOnce(&mut dyn FnMut(&str, f64) -> bool) -> Result<T, String> + Send,
+        work: impl FnOnce(&mut dyn FnMut(&str, f64) -> bool) -> Result<T, LibraryError> + Send,
     ) -> PyResult<T> {
         let r = if let Some(pool) = self.on_caller() {
             let cb: Option<Py<PyAny>> = callback.map(|c| c.clone().unbind());
@@ -225,7 +248,7 @@ impl WorldPool {
                 return Err(e);
             }
             py.check_signals()?;
-            r.map_err(PyRuntimeError::new_err)
+            r.map_err(PyErr::from)
         } else if short && callback.is_none() {
             let pool = self.own()?;
             detached_short(py, pool, || {

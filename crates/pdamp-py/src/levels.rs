@@ -56,7 +56,7 @@ pub(crate) fn run(
         } else {
             pdamp_io::run::run_scenario(sc, base, &out, options, |phase, f| p.set(phase, f))?;
         }
-        std::fs::read_to_string(out.join("summary.json")).map_err(|e| e.to_string())
+        Ok(std::fs::read_to_string(out.join("summary.json"))?)
     })
 }
 
@@ -83,7 +83,7 @@ pub(crate) fn fields<'py>(
             |f| p.set("settling", f),
             |done, total| p.set("points", done as f64 / total.max(1) as f64),
         )?;
-        pdamp_io::csv::read_csv_f64(out.join("fields.csv")).map_err(|e| e.to_string())
+        Ok(pdamp_io::csv::read_csv_f64(out.join("fields.csv"))?)
     })?;
     columns(py, &header, &rows)
 }
@@ -184,7 +184,7 @@ pub(crate) fn powder_run(
                 &sc, packings, &out, options, &mut tick,
             )?)
         };
-        json.map_err(|e| e.to_string())
+        Ok(json?)
     })
 }
 

@@ -7,6 +7,7 @@ use crate::detach::WorldPool;
 use crate::scenario::PyScenario;
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pdamp_dem::health::HealthError;
 use pdamp_dem::{Motion, TranslationTrack, Vec3, World};
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -61,9 +62,9 @@ impl PyWorld {
     }
 }
 
-/// Health check of the world (the particle or contact at fault named), as text.
-fn health(w: &World) -> Result<(), String> {
-    w.check_health().map_err(|e| e.to_string())
+/// Health check of the world (the particle or contact at fault named).
+fn health(w: &World) -> Result<(), HealthError> {
+    w.check_health()
 }
 
 /// Read-only (n, 3) view of one of the world's vector columns; keeps `owner` alive.
@@ -156,7 +157,7 @@ impl PyWorld {
                     .position(|b| &b.name == name)
                     .ok_or("drive: no body")?;
                 if [u, v, a].iter().any(|x| x.iter().any(|c| !c.is_finite())) {
-                    return Err(format!("drive: {name:?}: every number must be finite"));
+                    return Err(format!("drive: {name:?}: every number must be finite").into());
                 }
                 // Held during settling like any moving body; from t = 0 on in this state.
                 world.bodies[b].motion = Motion::Prescribed(Arc::new(TranslationTrack {
@@ -182,7 +183,7 @@ impl PyWorld {
                     ControlFlow::Continue(())
                 });
                 if let Some(e) = bad {
-                    return Err(format!("settling: {e}"));
+                    return Err(format!("settling: {e}").into());
                 }
                 t = r.ok_or("settling stopped")?;
             }
@@ -264,7 +265,7 @@ impl PyWorld {
                 }
                 ControlFlow::Continue(())
             });
-            bad.map_or(Ok(()), Err)
+            bad.map_or(Ok(()), |e| Err(e.into()))
         };
         self.pool.run(py, progress.as_ref(), "running", false, work)
     }
@@ -483,7 +484,7 @@ impl PyWorld {
     /// Checks the world's health (finite state, overlaps, velocities); raises `RuntimeError`
     /// naming the particle or contact at fault.
     fn check_health(&self) -> PyResult<()> {
-        health(&self.world).map_err(PyRuntimeError::new_err)
+        health(&self.world).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 
     fn __repr__(&self) -> String {

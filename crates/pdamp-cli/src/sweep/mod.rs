@@ -328,7 +328,7 @@ impl Opened {
             Opened::Powder { runs, .. } => match runs[t.index].finished() {
                 Ok(true) => Stored::Done,
                 Ok(false) => stored_error(dir, t),
-                Err(e) => Stored::Corrupt(e),
+                Err(e) => Stored::Corrupt(e.to_string()),
             },
         }
     }
@@ -526,8 +526,11 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
                         run.ran += usize::from(ran);
                         let _ = std::fs::remove_file(dir.join(&task.error));
                     }
-                    Err(e) if e.starts_with(pdamp_io::checkpoint::INTERRUPTED) => bail!("{e}"),
+                    Err(e) if e.to_string().starts_with(pdamp_io::checkpoint::INTERRUPTED) => {
+                        bail!("{e}")
+                    }
                     Err(e) => {
+                        let e = e.to_string();
                         if let Some(parent) = dir.join(&task.error).parent() {
                             std::fs::create_dir_all(parent)?;
                         }

@@ -126,13 +126,13 @@ pub(super) fn collect_powder(
         checkpoint_interval_s: 0.0,
         resume: false,
     };
-    let result: Result<serde_json::Value, String> = match what {
+    let result: Result<serde_json::Value> = match what {
         PowderSweep::Study {
             parameter,
             values,
             packings,
         } => pdamp_powder::study::StudyParameter::from_name(parameter)
-            .ok_or_else(|| format!("unknown study parameter '{parameter}'"))
+            .ok_or_else(|| anyhow::anyhow!("unknown study parameter '{parameter}'"))
             .and_then(|p| {
                 pdamp_powder::study::run_study_packings(
                     base,
@@ -143,18 +143,17 @@ pub(super) fn collect_powder(
                     options,
                     &mut |_, _| {},
                 )
+                .map_err(anyhow::Error::msg)
             })
             .map(|rows| serde_json::to_value(rows).unwrap_or_default()),
         PowderSweep::Ensemble { packings } => {
             pdamp_powder::study::run_ensemble(base, *packings, dir, options, &mut |_, _| {})
+                .map_err(anyhow::Error::msg)
                 .map(|e| serde_json::to_value(e).unwrap_or_default())
         }
     };
     out_dir.set_outcome(&result);
     out_dir.close()?;
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&result.map_err(anyhow::Error::msg)?)?
-    );
+    println!("{}", serde_json::to_string_pretty(&result?)?);
     Ok(())
 }

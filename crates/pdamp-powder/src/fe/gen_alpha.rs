@@ -120,6 +120,26 @@ pub enum DynamicsError {
         /// Relative residual.
         residual: f64,
     },
+    /// A checkpoint state was saved with another time step ([`Dynamics::restore_state`]).
+    #[error("structure state: time step {saved_s} s, the scenario has {scenario_s} s")]
+    StateTimeStep {
+        /// Time step of the state \[s\].
+        saved_s: f64,
+        /// Time step of the scenario \[s\].
+        scenario_s: f64,
+    },
+    /// A checkpoint state has another number of dofs ([`Dynamics::restore_state`]).
+    #[error("structure state: {saved} dofs, the structure has {structure}")]
+    StateDofs {
+        /// Length of a vector of the state.
+        saved: usize,
+        /// Dofs of the structure.
+        structure: usize,
+    },
+    /// The double-precision factor a checkpoint state asks for failed
+    /// ([`Dynamics::restore_state`]).
+    #[error("structure state: {0}")]
+    StateFactor(#[source] SolverError),
 }
 
 /// Newton settings.
@@ -302,19 +322,19 @@ impl Dynamics {
     /// Continues from `st` (saved by [`Dynamics::save_state`] from a `Dynamics` of the same
     /// structure, parameters and time step); the next step is then bit for bit that of the
     /// saved run.
-    pub fn restore_state(&mut self, st: DynamicsState) -> Result<(), String> {
+    pub fn restore_state(&mut self, st: DynamicsState) -> Result<(), DynamicsError> {
         if st.dt.to_bits() != self.dt.to_bits() {
-            return Err(format!(
-                "structure state: time step {} s, the scenario has {} s",
-                st.dt, self.dt
-            ));
+            return Err(DynamicsError::StateTimeStep {
+                saved_s: st.dt,
+                scenario_s: self.dt,
+            });
         }
         let n = self.d.len();
         if let Some(v) = st.vectors.iter().find(|v| v.len() != n) {
-            return Err(format!(
-                "structure state: {} dofs, the structure has {n}",
-                v.len()
-            ));
+            return Err(DynamicsError::StateDofs {
+                saved: v.len(),
+                structure: n,
+            });
         }
         let [d, v, a, d1, v1, a1, fint_n, fext_n, fint1, fext1] = st.vectors;
         (self.d, self.v, self.a, self.d1, self.v1, self.a1) = (d, v, a, d1, v1, a1);
@@ -325,7 +345,7 @@ impl Dynamics {
         self.last_iterations = st.last_iterations;
         if st.double_factor && !self.newton.full_newton {
             self.use_double_factor()
-                .map_err(|e| format!("structure state: {e}"))?;
+                .map_err(DynamicsError::StateFactor)?;
         }
         Ok(())
     }

@@ -302,6 +302,38 @@ pub enum MeshError {
     /// The file has no hex8 elements.
     #[error("no hexahedral (8-node) elements found")]
     NoHexes,
+    /// A node of a built mesh has a non-finite coordinate ([`HexMesh::validate`]).
+    #[error("mesh: node {node} has a non-finite coordinate {coordinates:?}")]
+    NonFiniteNode {
+        /// 0-based node index.
+        node: usize,
+        /// Its coordinates.
+        coordinates: [f64; 3],
+    },
+    /// An element of a built mesh refers to a node index beyond the node list
+    /// ([`HexMesh::validate`]).
+    #[error("mesh: element {element} references node {node}, the mesh has {nodes}")]
+    NodeOutOfRange {
+        /// 0-based element index.
+        element: usize,
+        /// The node index it refers to.
+        node: usize,
+        /// Number of nodes of the mesh.
+        nodes: usize,
+    },
+    /// An element of a built mesh with a non-positive Jacobian determinant
+    /// ([`HexMesh::validate`]).
+    #[error("mesh: element {element} is {kind} (det J = {det:.3e} at {at})")]
+    InvalidElement {
+        /// 0-based element index.
+        element: usize,
+        /// `inverted` (det J < 0) or `degenerate` (det J ≈ 0).
+        kind: &'static str,
+        /// The offending determinant.
+        det: f64,
+        /// Where: `corner k` or `Gauss point q`.
+        at: String,
+    },
 }
 
 fn perr(line: usize, message: impl Into<String>) -> MeshError {
@@ -464,23 +496,24 @@ pub fn check_hex(x: &[[f64; 3]; 8]) -> Result<(), (&'static str, f64, Result<usi
 impl HexMesh {
     /// Checks finite coordinates, node indices in range and a positive Jacobian of every
     /// element (see [`check_hex`]); the error names the element (0-based index).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), MeshError> {
         if let Some(i) = self
             .nodes
             .iter()
             .position(|p| p.iter().any(|v| !v.is_finite()))
         {
-            return Err(format!(
-                "mesh: node {i} has a non-finite coordinate {:?}",
-                self.nodes[i]
-            ));
+            return Err(MeshError::NonFiniteNode {
+                node: i,
+                coordinates: self.nodes[i],
+            });
         }
         for (e, el) in self.elements.iter().enumerate() {
             if let Some(&n) = el.iter().find(|&&n| n >= self.nodes.len()) {
-                return Err(format!(
-                    "mesh: element {e} references node {n}, the mesh has {}",
-                    self.nodes.len()
-                ));
+                return Err(MeshError::NodeOutOfRange {
+                    element: e,
+                    node: n,
+                    nodes: self.nodes.len(),
+                });
             }
             let x = el.map(|n| self.nodes[n]);
             if let Err((kind, det, at)) = check_hex(&x) {
@@ -488,9 +521,12 @@ impl HexMesh {
                     Ok(a) => format!("corner {a}"),
                     Err(q) => format!("Gauss point {q}"),
                 };
-                return Err(format!(
-                    "mesh: element {e} is {kind} (det J = {det:.3e} at {at})"
-                ));
+                return Err(MeshError::InvalidElement {
+                    element: e,
+                    kind,
+                    det,
+                    at,
+                });
             }
         }
         Ok(())
