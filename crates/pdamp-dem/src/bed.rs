@@ -117,7 +117,7 @@ impl Bed {
 }
 
 /// A bed's columns do not fit together or hold a bad value ([`Bed::validate`]).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum BedError {
     /// A column has another length than `position_m`.
     #[error("bed column {column} has {len} entries, position_m has {expected}")]
@@ -139,11 +139,4 @@ pub enum BedError {
         /// What is wrong (starts with the column).
         message: String,
     },
-}
-
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<BedError> for String {
-    fn from(e: BedError) -> String {
-        e.to_string()
-    }
 }

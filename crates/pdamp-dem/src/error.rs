@@ -103,13 +103,6 @@ pub fn leading_key_path(message: &str) -> &str {
     message[..end].trim_end_matches('.')
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<ParameterError> for String {
-    fn from(e: ParameterError) -> String {
-        e.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

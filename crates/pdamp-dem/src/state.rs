@@ -352,13 +352,6 @@ pub enum StateError {
     WallContacts,
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<StateError> for String {
-    fn from(e: StateError) -> String {
-        e.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use crate::contact::{ContactModel, FrictionLaw, NormalLaw};

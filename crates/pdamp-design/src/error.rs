@@ -356,13 +356,6 @@ impl DesignError {
     }
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<DesignError> for String {
-    fn from(e: DesignError) -> String {
-        e.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -448,7 +441,7 @@ mod tests {
         assert_eq!(shared.to_string(), "interrupted");
         assert!(shared.starts_with("interr"));
         assert_eq!(
-            String::from(DesignError::NoDamperSection),
+            DesignError::NoDamperSection.to_string(),
             "scenario has no [damper] section"
         );
     }

@@ -134,13 +134,6 @@ pub enum GpuUnsupported {
     },
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<GpuUnsupported> for String {
-    fn from(e: GpuUnsupported) -> String {
-        e.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,7 +159,7 @@ mod tests {
             "rolling resistance (materials 'steel' and 'glass')"
         );
         assert_eq!(
-            String::from(GpuUnsupported::DrivenBody { body: "b".into() }),
+            GpuUnsupported::DrivenBody { body: "b".into() }.to_string(),
             "body 'b' driven from outside (coupling)"
         );
     }

@@ -72,13 +72,6 @@ pub enum BedFileError {
     Bed(#[from] pdamp_dem::bed::BedError),
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<BedFileError> for String {
-    fn from(e: BedFileError) -> String {
-        e.to_string()
-    }
-}
-
 /// Writes `file` to `path` atomically; `scenario_digest` names the scenario that made it.
 pub fn save_bed(path: &Path, file: &BedFile, scenario_digest: &str) -> Result<(), CheckpointError> {
     checkpoint::save(

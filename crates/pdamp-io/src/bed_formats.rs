@@ -64,6 +64,9 @@ use std::fmt::Write as _;
 /// Errors of the bed readers. Line numbers are 1-based and count every line of the input.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum BedFormatError {
+    /// The bed read is inconsistent (names the particle and column).
+    #[error(transparent)]
+    Bed(#[from] pdamp_dem::bed::BedError),
     /// Something is wrong on one line of the input (a malformed, out-of-range or repeated
     /// entry, an unknown column, …).
     #[error("line {line}: {message}")]
@@ -602,7 +605,7 @@ pub fn read_lammps_data(text: &str, type_materials: &[String]) -> Result<Bed, Be
         velocity_m_s,
         angular_velocity_rad_s,
     };
-    bed.validate().map_err(file_err)?;
+    bed.validate()?;
     Ok(bed)
 }
 
@@ -839,7 +842,7 @@ pub fn read_bed_csv(text: &str, default_material: &str) -> Result<Bed, BedFormat
         bed.velocity_m_s.push(velocity_m_s);
         bed.angular_velocity_rad_s.push(angular_velocity_rad_s);
     }
-    bed.validate().map_err(file_err)?;
+    bed.validate()?;
     Ok(bed)
 }
 

@@ -215,13 +215,6 @@ impl CheckpointError {
     }
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<CheckpointError> for String {
-    fn from(e: CheckpointError) -> String {
-        e.to_string()
-    }
-}
-
 /// Writes `body` with `header` to `path` atomically.
 pub fn save<T: Serialize>(
     path: &Path,

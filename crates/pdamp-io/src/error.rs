@@ -109,10 +109,3 @@ impl InputError {
         }
     }
 }
-
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<InputError> for String {
-    fn from(e: InputError) -> String {
-        e.to_string()
-    }
-}

@@ -49,13 +49,6 @@ impl PrepareError {
     }
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<PrepareError> for String {
-    fn from(e: PrepareError) -> String {
-        e.to_string()
-    }
-}
-
 /// A settled bed in its world.
 #[derive(Debug, Clone)]
 pub struct PreparedBed {

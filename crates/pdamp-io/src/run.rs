@@ -595,13 +595,6 @@ impl RunError {
     }
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<RunError> for String {
-    fn from(e: RunError) -> String {
-        e.to_string()
-    }
-}
-
 /// Decodes a `run` checkpoint file of any scenario and returns its simulated time, s (for
 /// inspection and fuzzing; never panics).
 pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, CheckpointError> {

@@ -1096,9 +1096,9 @@ impl Scenario {
         // Work and memory before anything is allocated (one run or one damper point).
         crate::estimate::Estimate::of(&s, 1, rayon::current_num_threads())
             .check()
-            .map_err(|m| {
+            .map_err(|e| {
                 let text = std::fs::read_to_string(path).ok();
-                ScenarioError::invalid(path, text.as_deref(), m)
+                ScenarioError::at_key(path, text.as_deref(), e.key(), e.to_string())
             })?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         let world = s

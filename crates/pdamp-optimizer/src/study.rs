@@ -259,7 +259,7 @@ impl DesignStudy {
         for (i, &x) in d.positions_m.iter().enumerate() {
             let key = format!("damper.positions_m[{i}]");
             pdamp_structure::scenario::on_beam(&key, x, beam.length_m)
-                .map_err(|m| self.input(&key, m))?;
+                .map_err(|m| self.input(&key, m.to_string()))?;
             let mut st = spec.clone();
             st.points.retain(|p| p.name != POSITION_POINT);
             st.points.push(PointSpec {
@@ -495,7 +495,7 @@ impl DesignStudy {
                 }
                 if let Some(l) = &self.load {
                     if let Err(m) = self.structure.point(&l.excitation_point) {
-                        return Err(self.input("scenario analysis.excitation_point", m));
+                        return Err(self.input("scenario analysis.excitation_point", m.to_string()));
                     }
                     self.positive("scenario analysis force", l.force_n.abs(), 1e12)?;
                 }
@@ -588,12 +588,12 @@ impl DesignStudy {
         }
         for (i, p) in d.points.iter().enumerate() {
             if let Err(m) = self.structure.point(p) {
-                return Err(self.input(format!("damper.points[{i}]"), m));
+                return Err(self.input(format!("damper.points[{i}]"), m.to_string()));
             }
         }
         let output = self.structure.point(&self.free.output_point);
         if let Err(m) = output {
-            return Err(self.input("scenario analysis.output_point", m));
+            return Err(self.input("scenario analysis.output_point", m.to_string()));
         }
         if d.container_lengths_m.is_empty() {
             return Err(self.input("damper.container_lengths_m", "give at least one length"));

@@ -490,13 +490,6 @@ pub enum CantileverError {
     },
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<CantileverError> for String {
-    fn from(e: CantileverError) -> String {
-        e.to_string()
-    }
-}
-
 /// A cantilever scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -43,10 +43,3 @@ impl ParameterError {
         }
     }
 }
-
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<ParameterError> for String {
-    fn from(e: ParameterError) -> String {
-        e.to_string()
-    }
-}

@@ -203,13 +203,6 @@ pub enum PrepError {
     Dem(String),
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<PrepError> for String {
-    fn from(e: PrepError) -> String {
-        e.to_string()
-    }
-}
-
 impl TryFrom<PreparationData> for Preparation {
     type Error = PrepError;
     fn try_from(d: PreparationData) -> Result<Self, PrepError> {

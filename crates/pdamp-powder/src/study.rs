@@ -341,13 +341,6 @@ pub enum StudyError {
     Plot(#[from] pdamp_plot::PlotError),
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<StudyError> for String {
-    fn from(e: StudyError) -> String {
-        e.to_string()
-    }
-}
-
 /// Digest of the scenario a finished run's `summary.json` belongs to: its `scenario_digest`
 /// field, or (summaries written before the field existed) the digest of the scenario stored
 /// in it.

@@ -30,13 +30,6 @@ pub enum SnapshotError {
     },
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<SnapshotError> for String {
-    fn from(e: SnapshotError) -> String {
-        e.to_string()
-    }
-}
-
 /// The snapshot series of a coupled powder run.
 #[derive(Debug)]
 pub struct PowderSnapshots {

@@ -306,10 +306,3 @@ wrap!(
     Json(serde_json::Error),
     Signal(pdamp_signal::SignalError),
 );
-
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<StructureError> for String {
-    fn from(e: StructureError) -> String {
-        e.to_string()
-    }
-}

@@ -97,13 +97,6 @@ pub enum MatrixMarketError {
     Sparse(#[from] crate::sparse::SparseError),
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<MatrixMarketError> for String {
-    fn from(e: MatrixMarketError) -> String {
-        e.to_string()
-    }
-}
-
 /// A sparse matrix as triplets (0-based).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CooMatrix {

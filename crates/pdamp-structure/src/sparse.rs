@@ -82,13 +82,6 @@ pub enum SparseError {
     },
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<SparseError> for String {
-    fn from(e: SparseError) -> String {
-        e.to_string()
-    }
-}
-
 /// `solver = "auto"` uses the sparse solver above this many active dof.
 pub const AUTO_SPARSE_ABOVE_DOF: usize = 1500;
 

@@ -63,10 +63,3 @@ pub enum PackingError {
         in_top_layer: bool,
     },
 }
-
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<PackingError> for String {
-    fn from(e: PackingError) -> String {
-        e.to_string()
-    }
-}

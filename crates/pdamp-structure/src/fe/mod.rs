@@ -98,13 +98,6 @@ pub enum FeError {
     Sparse(#[from] SparseError),
 }
 
-/// Transitional: lets callers that still return `Result<_, String>` use `?` (issue 30).
-impl From<FeError> for String {
-    fn from(e: FeError) -> String {
-        e.to_string()
-    }
-}
-
 /// One nodal degree of freedom.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
