@@ -313,7 +313,7 @@ pub enum StateError {
     BedInconsistent,
     /// A bed state's neighbour list is inconsistent.
     #[error("bed state: {0}")]
-    BedNeighbors(#[source] NeighborListError),
+    BedNeighbors(NeighborListError),
     /// The checkpoint has another number of particles than the scenario builds.
     #[error("checkpoint has {checkpoint} particles, the scenario builds {scenario}")]
     ParticleCount {
@@ -343,7 +343,7 @@ pub enum StateError {
     NeighborsInconsistent,
     /// The checkpoint's neighbour list is inconsistent.
     #[error("checkpoint {0}")]
-    CheckpointNeighbors(#[source] NeighborListError),
+    CheckpointNeighbors(NeighborListError),
     /// Time step, time or gravity not finite.
     #[error("checkpoint time step, time or gravity not finite")]
     ClockNotFinite,

@@ -226,7 +226,7 @@ impl Damper {
         // The damper section is checked before the (costly) bed preparation.
         container_of(scenario)?;
         let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))
-            .map_err(DesignError::io)?;
+            .map_err(DesignError::from)?;
         Self::from_prepared(scenario, prepared)
     }
 
@@ -377,7 +377,7 @@ impl Damper {
         let resumed = match checkpointing {
             Some(c) if c.resume => {
                 match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)
-                    .map_err(DesignError::io)?
+                    .map_err(DesignError::from)?
                 {
                     Some(PointCheckpoint::Running(p)) => Some(p),
                     Some(PointCheckpoint::Finished) => {
@@ -398,7 +398,7 @@ impl Damper {
                 });
             }
             let p = *p;
-            w.restore_state(p.world).map_err(DesignError::dem)?;
+            w.restore_state(p.world).map_err(DesignError::from)?;
             times = p.times;
             force = p.force;
             velocity = p.velocity;
@@ -482,7 +482,7 @@ impl Damper {
                             wall_time_s: wall_before + start.elapsed().as_secs_f64(),
                         };
                         ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
-                            .map_err(DesignError::io)
+                            .map_err(DesignError::from)
                     });
                     if let Err(e) = r {
                         save_error = Some(e);

@@ -262,22 +262,26 @@ pub enum DesignError {
         #[source]
         source: pdamp_plot::PlotError,
     },
-    /// An error of `pdamp-io` (scenario, bed preparation, checkpoints), text unchanged.
-    #[error("{0}")]
-    Io(String),
-    /// An output error of `pdamp-io` (a prepared bed that cannot be saved).
+    /// The bed cannot be prepared or a prepared bed read back.
+    #[error(transparent)]
+    Prepare(#[from] pdamp_io::prepare::PrepareError),
+    /// A point's checkpoint cannot be written or read back.
+    #[error(transparent)]
+    Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
+    /// A prepared bed cannot be saved.
     #[error("output: {0}")]
-    IoOutput(String),
-    /// An error of `pdamp-dem` (a world state that does not fit the scenario), text unchanged.
-    #[error("{0}")]
-    Dem(String),
+    IoOutput(pdamp_io::checkpoint::CheckpointError),
+    /// A checkpoint's world state does not fit the scenario.
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
 }
 
 impl DesignError {
-    /// The text of an error wrapped from another crate (whose kind is known only by its text).
+    /// The text of a stored failure (a point's error read back from its file, known only by
+    /// its text).
     fn foreign_text(&self) -> Option<&str> {
         match self {
-            DesignError::Io(s) | DesignError::Dem(s) | DesignError::StoredFailure(s) => Some(s),
+            DesignError::StoredFailure(s) => Some(s),
             _ => None,
         }
     }
@@ -290,7 +294,8 @@ impl DesignError {
             | DesignError::WriteCsv { .. }
             | DesignError::ReadSummary { .. }
             | DesignError::VtkFrames(_)
-            | DesignError::IoOutput(_) => true,
+            | DesignError::IoOutput(_)
+            | DesignError::Prepare(pdamp_io::prepare::PrepareError::Output(_)) => true,
             DesignError::Batch(e) => e.is_output(),
             e => e.foreign_text().is_some_and(|s| s.starts_with("output:")),
         }
@@ -304,6 +309,7 @@ impl DesignError {
             | DesignError::Interrupted
             | DesignError::FieldInterrupted { .. } => true,
             DesignError::Batch(e) => e.is_interrupted(),
+            DesignError::Prepare(e) => e.to_string().starts_with(INTERRUPTED),
             e => e.foreign_text().is_some_and(|s| s.starts_with(INTERRUPTED)),
         }
     }
@@ -314,7 +320,9 @@ impl DesignError {
         match self {
             DesignError::CheckpointFinished { .. }
             | DesignError::CheckpointOtherPoint { .. }
-            | DesignError::CheckpointFieldGrid => true,
+            | DesignError::CheckpointFieldGrid
+            | DesignError::Checkpoint(_)
+            | DesignError::State(_) => true,
             DesignError::Batch(e) => e.is_checkpoint(),
             e => e
                 .foreign_text()
@@ -343,16 +351,6 @@ impl DesignError {
     pub(crate) fn plot(stem: impl Into<PathBuf>) -> impl FnOnce(pdamp_plot::PlotError) -> Self {
         let stem = stem.into();
         move |source| DesignError::Plot { stem, source }
-    }
-
-    /// Wraps an error of `pdamp-io` (rule 4 of issue 30: upgraded to `#[from]` later).
-    pub(crate) fn io(e: impl std::fmt::Display) -> Self {
-        DesignError::Io(e.to_string())
-    }
-
-    /// Wraps an error of `pdamp-dem` (rule 4 of issue 30: upgraded to `#[from]` later).
-    pub(crate) fn dem(e: impl std::fmt::Display) -> Self {
-        DesignError::Dem(e.to_string())
     }
 }
 
@@ -432,10 +430,24 @@ mod tests {
 
     #[test]
     fn wrapped_texts_keep_their_kind() {
-        assert!(DesignError::Io("output: no space".into()).is_output());
-        assert!(DesignError::Io("interrupted: settling".into()).is_interrupted());
-        assert!(DesignError::Dem("checkpoint has 3 particles".into()).is_checkpoint());
-        assert!(!DesignError::Io("scenario: bad key".into()).is_output());
+        use pdamp_io::prepare::PrepareError;
+        let no_space = std::io::Error::other("no space");
+        let e = DesignError::Prepare(PrepareError::Output(no_space.into()));
+        assert!(e.is_output() && !e.is_checkpoint());
+        assert_eq!(e.to_string(), "output: no space");
+        let e = DesignError::State(pdamp_dem::state::StateError::ParticleCount {
+            checkpoint: 3,
+            scenario: 4,
+        });
+        assert!(e.is_checkpoint() && !e.is_output());
+        assert_eq!(
+            e.to_string(),
+            "checkpoint has 3 particles, the scenario builds 4"
+        );
+        let e = DesignError::Checkpoint(pdamp_io::checkpoint::CheckpointError::Damaged);
+        assert!(e.is_checkpoint() && !e.is_interrupted());
+        let bad = pdamp_io::InputError::message("scenario.x: bad key");
+        assert!(!DesignError::Prepare(PrepareError::Input(bad)).is_output());
         let shared = DesignError::Batch(Arc::new(DesignError::Interrupted));
         assert!(shared.is_interrupted());
         assert_eq!(shared.to_string(), "interrupted");

@@ -353,12 +353,12 @@ impl PointObserver for MotionRecorder {
             fd_slot: self.fd_slot,
             fd_work: self.fd_work,
         })
-        .map_err(crate::DesignError::io)
+        .map_err(crate::DesignError::from)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> Result<(), crate::DesignError> {
         let s: RecorderState =
-            pdamp_io::checkpoint::decode_part(bytes).map_err(crate::DesignError::io)?;
+            pdamp_io::checkpoint::decode_part(bytes).map_err(crate::DesignError::from)?;
         if s.fields.len() != self.fields.len()
             || s.fields
                 .iter()

@@ -250,7 +250,7 @@ pub fn finished_damper_summary(
     use pdamp_io::checkpoint as ck;
     let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
     match ck::load::<PointCheckpoint>(&out.join(ck::CHECKPOINT_FILE), POINT_KIND, &digest)
-        .map_err(DesignError::io)?
+        .map_err(DesignError::from)?
     {
         Some(PointCheckpoint::Finished) => std::fs::read_to_string(out.join("summary.json"))
             .map(Some)
@@ -415,7 +415,7 @@ pub fn run_damper_scenario_with(
         &ck::CheckpointHeader::new(POINT_KIND, &digest),
         &PointCheckpoint::Finished,
     )
-    .map_err(DesignError::io)?;
+    .map_err(DesignError::from)?;
     Ok(summary)
 }
 
@@ -551,18 +551,18 @@ pub fn field_damper(
     };
     let path = prepared_bed_path(dir, k);
     if let Some(prepared) =
-        pdamp_io::prepare::load_prepared(&path, &sk, base_dir).map_err(DesignError::io)?
+        pdamp_io::prepare::load_prepared(&path, &sk, base_dir).map_err(DesignError::from)?
     {
         return Damper::from_prepared(&sk, prepared);
     }
     let mut progress = progress;
     let prepared = pdamp_io::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))
-        .map_err(DesignError::io)?;
+        .map_err(DesignError::from)?;
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(DesignError::write(parent))?;
     }
     pdamp_io::prepare::save_prepared(&path, &prepared, &sk, base_dir)
-        .map_err(|e| DesignError::IoOutput(e.to_string()))?;
+        .map_err(DesignError::IoOutput)?;
     Damper::from_prepared(&sk, prepared)
 }
 

@@ -46,20 +46,20 @@ pub struct BedFile {
 #[derive(Debug, thiserror::Error)]
 pub enum BedFileError {
     /// The file cannot be read.
-    #[error("cannot read bed '{}': {source}", path.display())]
+    #[error("cannot read bed '{}': {cause}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
         /// Cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file was read but is refused.
-    #[error("bed '{}': {source}", path.display())]
+    #[error("bed '{}': {cause}", path.display())]
     InFile {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: Box<BedFileError>,
+        cause: Box<BedFileError>,
     },
     /// No bed-file magic at the start.
     #[error("not a pdamp bed file")]
@@ -85,11 +85,11 @@ pub fn save_bed(path: &Path, file: &BedFile, scenario_digest: &str) -> Result<()
 pub fn load_bed(path: &Path) -> Result<BedFile, BedFileError> {
     let bytes = std::fs::read(path).map_err(|e| BedFileError::Read {
         path: path.to_path_buf(),
-        source: e,
+        cause: e,
     })?;
     decode_bed(&bytes).map_err(|e| BedFileError::InFile {
         path: path.to_path_buf(),
-        source: Box::new(e),
+        cause: Box::new(e),
     })
 }
 

@@ -44,12 +44,12 @@ pub enum BenchError {
     )]
     NotSettledBed(std::path::PathBuf),
     /// A file of the LIGGGHTS case cannot be written.
-    #[error("{}: {source}", dir.display())]
+    #[error("{}: {cause}", dir.display())]
     Write {
         /// The case directory.
         dir: std::path::PathBuf,
         /// Cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
 }
 
@@ -231,7 +231,7 @@ pub fn write_liggghts_case(world: &World, steps: u64, dir: &Path) -> Result<(), 
     use std::fmt::Write;
     let err = |e: std::io::Error| BenchError::Write {
         dir: dir.to_path_buf(),
-        source: e,
+        cause: e,
     };
     std::fs::create_dir_all(dir).map_err(err)?;
     let n = world.particles.len();

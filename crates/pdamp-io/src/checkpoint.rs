@@ -146,20 +146,20 @@ const MAGIC: &[u8; 8] = b"PDAMPCK\0";
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
     /// The file cannot be read or written.
-    #[error("checkpoint {}: {source}", path.display())]
+    #[error("checkpoint {}: {cause}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// Cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file was read but is refused.
-    #[error("checkpoint {}: {source}", path.display())]
+    #[error("checkpoint {}: {cause}", path.display())]
     InFile {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: Box<CheckpointError>,
+        cause: Box<CheckpointError>,
     },
     /// No checkpoint magic at the start (or too short).
     #[error("not a pdamp checkpoint")]
@@ -210,7 +210,7 @@ impl CheckpointError {
     pub fn in_file(path: &Path, why: CheckpointError) -> Self {
         Self::InFile {
             path: path.to_path_buf(),
-            source: Box::new(why),
+            cause: Box::new(why),
         }
     }
 }
@@ -228,7 +228,7 @@ pub fn save<T: Serialize>(
     bytes.extend_from_slice(sum.as_bytes());
     crate::atomic::write_atomic(path, &bytes).map_err(|e| CheckpointError::Io {
         path: path.to_path_buf(),
-        source: e,
+        cause: e,
     })
 }
 
@@ -245,7 +245,7 @@ pub fn load<T: for<'de> Deserialize<'de>>(
         Err(e) => {
             return Err(CheckpointError::Io {
                 path: path.to_path_buf(),
-                source: e,
+                cause: e,
             });
         }
     };

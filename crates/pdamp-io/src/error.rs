@@ -1,5 +1,7 @@
 //! Errors of a scenario's inputs that name the key they come from: a value out of range
-//! ([`pdamp_dem::ParameterError`]) or a file a key names that cannot be read or used. File-level
+//! ([`pdamp_dem::ParameterError`]) or a file a key names that cannot be read or used. The
+//! cause of a wrapped error is part of the message (not `source()`), so that a chain printer
+//! (`anyhow`'s `{:#}`) shows it once. File-level
 //! errors (which scenario file, which line) are [`crate::scenario::ScenarioError`].
 
 use pdamp_dem::ParameterError;
@@ -18,33 +20,33 @@ pub enum InputError {
     #[error(transparent)]
     Toml(#[from] toml::de::Error),
     /// The file a key names cannot be read.
-    #[error("{key}: cannot read '{}': {source}", path.display())]
+    #[error("{key}: cannot read '{}': {cause}", path.display())]
     Read {
         /// The key that names the file.
         key: String,
         /// The file.
         path: PathBuf,
         /// Cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file a key names was read but cannot be used.
-    #[error("{key}: '{}': {source}", path.display())]
+    #[error("{key}: '{}': {cause}", path.display())]
     File {
         /// The key that names the file.
         key: String,
         /// The file.
         path: PathBuf,
         /// What is wrong with it.
-        source: Source,
+        cause: Source,
     },
     /// What a key describes cannot be built (a packing that does not fit, a bed that does not
     /// match its group, …).
-    #[error("{key}: {source}{hint}")]
+    #[error("{key}: {cause}{hint}")]
     At {
         /// The key.
         key: String,
         /// Cause.
-        source: Source,
+        cause: Source,
         /// How to fix it (empty, or starting with `; `).
         hint: String,
     },
@@ -55,7 +57,7 @@ impl InputError {
     pub fn at(key: impl Into<String>, source: impl Into<Source>) -> Self {
         Self::At {
             key: key.into(),
-            source: source.into(),
+            cause: source.into(),
             hint: String::new(),
         }
     }
@@ -68,7 +70,7 @@ impl InputError {
     ) -> Self {
         Self::At {
             key: key.into(),
-            source: source.into(),
+            cause: source.into(),
             hint: hint.into(),
         }
     }
@@ -82,7 +84,7 @@ impl InputError {
         Self::File {
             key: key.into(),
             path: path.into(),
-            source: source.into(),
+            cause: source.into(),
         }
     }
 
@@ -91,7 +93,7 @@ impl InputError {
         Self::Read {
             key: key.into(),
             path: path.into(),
-            source,
+            cause: source,
         }
     }
 

@@ -25,16 +25,16 @@ pub enum PrepareError {
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
     /// A saved prepared bed cannot be used.
-    #[error("prepared bed {}: {source}", path.display())]
+    #[error("prepared bed {}: {cause}", path.display())]
     Prepared {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: Source,
+        cause: Source,
     },
     /// An output file cannot be written.
     #[error("output: {0}")]
-    Output(#[source] Source),
+    Output(Source),
     /// The summary does not serialise.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
@@ -44,7 +44,7 @@ impl PrepareError {
     fn prepared(path: impl Into<PathBuf>, source: impl Into<Source>) -> Self {
         Self::Prepared {
             path: path.into(),
-            source: source.into(),
+            cause: source.into(),
         }
     }
 }
@@ -181,8 +181,8 @@ pub fn load_prepared(
     let digest = crate::run::scenario_content_digest(scenario, base_dir);
     let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest).map_err(
         |e| match e {
-            CheckpointError::Io { path, source } => PrepareError::prepared(path, source),
-            CheckpointError::InFile { path, source } => PrepareError::prepared(path, *source),
+            CheckpointError::Io { path, cause } => PrepareError::prepared(path, cause),
+            CheckpointError::InFile { path, cause } => PrepareError::prepared(path, *cause),
             e => PrepareError::Checkpoint(e),
         },
     )?

@@ -554,13 +554,13 @@ pub enum RunError {
     NoState,
     /// An output file cannot be written.
     #[error("output: {0}")]
-    Output(#[source] crate::error::Source),
+    Output(crate::error::Source),
     /// A ParaView file or series cannot be written or continued.
     #[error(transparent)]
     Vtk(#[from] crate::vtk::VtkError),
     /// The summary of a finished run cannot be read back.
     #[error("summary.json: {0}")]
-    Summary(#[source] serde_json::Error),
+    Summary(serde_json::Error),
     /// A result does not serialise.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
