@@ -423,8 +423,8 @@ pub enum CantileverError {
     #[error("scenario: {0}")]
     Digest(#[source] toml::ser::Error),
     /// A checkpoint could not be written, read or decoded (pdamp-io).
-    #[error("{0}")]
-    Io(String),
+    #[error(transparent)]
+    Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
     /// The run was stopped on request after its checkpoint was written.
     #[error("{0}")]
     Interrupted(ck::Interrupted),
@@ -918,7 +918,7 @@ struct Checkpointing {
 
 impl Checkpointing {
     fn save(&self, phase: &Phase) -> Result<(), CantileverError> {
-        ck::save(&self.path, &self.header, phase).map_err(|e| CantileverError::Io(e.to_string()))
+        ck::save(&self.path, &self.header, phase).map_err(CantileverError::from)
     }
     fn interrupted(&self, time_s: f64) -> CantileverError {
         CantileverError::Interrupted(ck::Interrupted {
@@ -931,8 +931,7 @@ impl Checkpointing {
 /// Decodes a `pdamp powder run` checkpoint of any scenario and returns its phase and
 /// simulated time \[s\] (for inspection and fuzzing; never panics).
 pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), CantileverError> {
-    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)
-        .map_err(|e| CantileverError::Io(e.to_string()))?;
+    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None).map_err(CantileverError::from)?;
     Ok(match phase {
         Phase::Preparing(p) => ("preparing", p.time_s()),
         Phase::Running(r) => ("running", r.coupled.dynamics.t),
@@ -943,8 +942,7 @@ pub fn inspect_checkpoint(bytes: &[u8]) -> Result<(&'static str, f64), Cantileve
 /// Decodes a `pdamp powder run` checkpoint of any scenario that holds a preparation in
 /// progress and checks its consistency (for fuzzing; never panics).
 pub fn decode_preparation(bytes: &[u8]) -> Result<Preparation, CantileverError> {
-    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None)
-        .map_err(|e| CantileverError::Io(e.to_string()))?;
+    let phase = ck::decode::<Phase>(bytes, CHECKPOINT_KIND, None).map_err(CantileverError::from)?;
     match phase {
         Phase::Preparing(p) => {
             p.check_consistency()?;
@@ -993,8 +991,7 @@ pub fn run_in_dir(
         interval_s: options.checkpoint_interval_s,
     };
     let resumed: Option<Phase> = if options.resume {
-        ck::load(&c.path, CHECKPOINT_KIND, &digest)
-            .map_err(|e| CantileverError::Io(e.to_string()))?
+        ck::load(&c.path, CHECKPOINT_KIND, &digest).map_err(CantileverError::from)?
     } else {
         None
     };

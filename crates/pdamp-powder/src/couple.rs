@@ -105,6 +105,9 @@ pub enum CoupleError {
     /// A checkpoint state does not fit the scenario.
     #[error("{0}")]
     State(String),
+    /// The particles' state does not fit the world (pdamp-dem).
+    #[error(transparent)]
+    WorldState(#[from] pdamp_dem::state::StateError),
     /// The contact law of a checkpoint state is out of range.
     #[error(transparent)]
     Law(#[from] crate::error::ParameterError),
@@ -328,9 +331,7 @@ impl Coupled {
             [g.x, g.y, g.z],
             dynamics.dt,
         )?;
-        world
-            .adopt_particles(&bed.world.save_state())
-            .map_err(|e| CoupleError::State(e.to_string()))?;
+        world.adopt_particles(&bed.world.save_state())?;
         world.initialize();
         let mut c = Self::assemble(
             structure,
@@ -469,12 +470,8 @@ impl Coupled {
         if !vertices.is_empty() {
             world.move_wall_vertices(BODY, WALL, &vertices)?;
         }
-        world
-            .set_particles_of(&st.world)
-            .map_err(|e| CoupleError::State(e.to_string()))?;
-        world
-            .restore_state(st.world)
-            .map_err(|e| CoupleError::State(e.to_string()))?;
+        world.set_particles_of(&st.world)?;
+        world.restore_state(st.world)?;
         let mut c = Self::assemble(
             structure,
             dynamics,

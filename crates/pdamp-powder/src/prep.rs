@@ -199,8 +199,8 @@ pub enum PrepError {
     #[error(transparent)]
     Law(#[from] ParameterError),
     /// The particle state was refused by pdamp-dem.
-    #[error("{0}")]
-    Dem(String),
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
 }
 
 impl TryFrom<PreparationData> for Preparation {
@@ -216,9 +216,7 @@ impl TryFrom<PreparationData> for Preparation {
         }
         d.law.validate("preparation state: law.")?;
         let mut world = walls_world(&d.cavity, &d.law, d.density_kg_m3, 1.0, d.top_start);
-        world
-            .set_particles_of(&d.world)
-            .map_err(|e| PrepError::Dem(e.to_string()))?;
+        world.set_particles_of(&d.world)?;
         let mut p = Self {
             world,
             plate: d.plate,
@@ -240,9 +238,7 @@ impl TryFrom<PreparationData> for Preparation {
             segment_start: None,
         };
         p.set_plate_track(p.plate, false);
-        p.world
-            .restore_state(d.world)
-            .map_err(|e| PrepError::Dem(e.to_string()))?;
+        p.world.restore_state(d.world)?;
         Ok(p)
     }
 }

@@ -581,8 +581,7 @@ fn coupled_run(
         }
         let worlds = std::iter::once(st.world).chain(st.more_worlds);
         for (r, ws) in runs.iter_mut().zip(worlds) {
-            r.w.restore_state(ws)
-                .map_err(|e| StructureError::Dem(e.to_string()))?;
+            r.w.restore_state(ws).map_err(StructureError::State)?;
         }
         (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
         hist.time_s = st.time;

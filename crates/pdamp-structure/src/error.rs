@@ -206,14 +206,12 @@ pub enum StructureError {
     /// `#[from]` once pdamp-io's errors are typed).
     #[error("{0}")]
     PdampIo(String),
-    /// An error of pdamp-dem, as its text (issue 30: becomes `#[from]` once pdamp-dem's errors
-    /// are typed).
-    #[error("{0}")]
-    Dem(String),
-    /// An error of pdamp-design, as its text (issue 30: becomes `#[from]` once pdamp-design's
-    /// errors are typed).
-    #[error("{0}")]
-    Design(String),
+    /// A checkpoint's world state does not fit the scenario's bed (pdamp-dem).
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
+    /// A damper's bed cannot be made (pdamp-design).
+    #[error(transparent)]
+    Design(Box<pdamp_design::DesignError>),
     /// A signal-processing error (peak search).
     #[error("{0}")]
     Signal(pdamp_signal::SignalError),

@@ -139,7 +139,7 @@ pub fn run_couple(
         }
         let d =
             pdamp_design::Damper::from_scenario(&sc, p.parent().unwrap_or(Path::new(".")), |_| {})
-                .map_err(|e| in_damper(StructureError::Design(e.to_string())))?;
+                .map_err(|e| in_damper(StructureError::Design(Box::new(e))))?;
         dem_beds.push((
             point.clone(),
             d,
