@@ -330,12 +330,6 @@ impl DesignError {
         }
     }
 
-    /// Transitional (issue 30): lets callers that still test the text of a `String` error keep
-    /// doing so; prefer [`Self::is_output`] and [`Self::is_interrupted`].
-    pub fn starts_with(&self, prefix: &str) -> bool {
-        self.to_string().starts_with(prefix)
-    }
-
     pub(crate) fn write(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> Self {
         let path = path.into();
         move |source| DesignError::Write { path, source }
@@ -451,7 +445,6 @@ mod tests {
         let shared = DesignError::Batch(Arc::new(DesignError::Interrupted));
         assert!(shared.is_interrupted());
         assert_eq!(shared.to_string(), "interrupted");
-        assert!(shared.starts_with("interr"));
         assert_eq!(
             DesignError::NoDamperSection.to_string(),
             "scenario has no [damper] section"

@@ -213,7 +213,7 @@ pub(super) fn execute_field_tasks(
                 let _ = std::fs::remove_file(dir.join(&bed_task.error));
                 d
             }
-            Err(e) if e.starts_with("output:") => bail!("{e}"),
+            Err(e) if e.is_output() => bail!("{e}"),
             Err(e) => {
                 let msg = format!("the bed of packing {k} could not be prepared: {e}");
                 pdamp_io::atomic::write_atomic(dir.join(&bed_task.error), msg.as_bytes())?;
