@@ -567,7 +567,7 @@ fn coupled_run(
     let header = ck.map(|c| cp::CheckpointHeader::new(COUPLE_KIND, &c.inputs_digest));
     if let Some(c) = ck.filter(|c| c.resume)
         && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)
-            .map_err(|e| StructureError::PdampIo(e.to_string()))?
+            .map_err(StructureError::from)?
     {
         if st.more_worlds.len() + 1 != runs.len() {
             return Err(StructureError::invalid(
@@ -609,10 +609,10 @@ fn coupled_run(
     if let Some(s) = snapshots.as_mut() {
         if first > 1 {
             s.resume_after((first - 1) as u64, dt, &runs[0].w)
-                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
+                .map_err(StructureError::from)?;
         } else {
             s.on_step(0, 0.0, &runs[0].w)
-                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
+                .map_err(StructureError::from)?;
         }
     }
     let every = sample_every.max(1);
@@ -647,7 +647,7 @@ fn coupled_run(
         }
         if let Some(s) = snapshots.as_mut() {
             s.on_step(step as u64, t1, &runs[0].w)
-                .map_err(|e| StructureError::PdampIo(e.to_string()))?;
+                .map_err(StructureError::from)?;
         }
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);
@@ -671,7 +671,7 @@ fn coupled_run(
                     more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
                     more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
                 };
-                cp::save(&c.path, h, &st).map_err(|e| StructureError::PdampIo(e.to_string()))?;
+                cp::save(&c.path, h, &st).map_err(StructureError::from)?;
                 if stop {
                     return Err(StructureError::Interrupted(cp::Interrupted {
                         time_s: it.time_s,

@@ -202,10 +202,12 @@ pub enum StructureError {
     /// A JSON value could not be written.
     #[error("{0}")]
     Json(serde_json::Error),
-    /// An error of pdamp-io (checkpoints, snapshots), as its text (issue 30: becomes
-    /// `#[from]` once pdamp-io's errors are typed).
-    #[error("{0}")]
-    PdampIo(String),
+    /// A checkpoint cannot be written or read back (pdamp-io).
+    #[error(transparent)]
+    Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
+    /// The VTK frames of a coupled run cannot be written (pdamp-io).
+    #[error(transparent)]
+    Snapshots(#[from] pdamp_io::run::RunError),
     /// A checkpoint's world state does not fit the scenario's bed (pdamp-dem).
     #[error(transparent)]
     State(#[from] pdamp_dem::state::StateError),

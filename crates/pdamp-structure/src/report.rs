@@ -299,7 +299,7 @@ pub fn run_couple(
                 let mut done: Vec<SegmentHistory> = match (&dem, options.resume) {
                     (Some(_), true) => {
                         pdamp_io::checkpoint::load(&ck.path, SEGMENTS_KIND, &ck.inputs_digest)
-                            .map_err(|e| StructureError::PdampIo(e.to_string()))?
+                            .map_err(StructureError::from)?
                             .unwrap_or_default()
                     }
                     _ => Vec::new(),
@@ -340,7 +340,7 @@ pub fn run_couple(
                                 ),
                                 &done,
                             )
-                            .map_err(|e| StructureError::PdampIo(e.to_string()))?;
+                            .map_err(StructureError::from)?;
                             let _ = std::fs::remove_file(&cki.path);
                             h
                         }
