@@ -24,6 +24,7 @@
 
 use crate::generate::{CellGrid, orthonormal_frame};
 use crate::math::Vec3;
+use crate::particles::ParticleSet;
 use crate::world::World;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -127,7 +128,31 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
         grid.insert(i as u32, x);
     }
 
-    // Contacts.
+    let (coordination, wall_contacts, rattlers) = contact_counts(world, &grid);
+    s.mean_coordination_number = coordination;
+    s.mean_wall_contacts = wall_contacts;
+    s.rattler_fraction = rattlers;
+    let (bottom, surface) = bottom_and_surface(p, (e1, e2, up), d_mean);
+    s.bed_bottom_m = bottom;
+    s.bed_surface_m = surface;
+    s.bed_height_m = surface - bottom;
+    let bed_box = (lo.add_scalar(-r_max), hi.add_scalar(r_max));
+    let (free_volume, fraction, fraction_bulk) =
+        packing_fractions(world, &grid, bed_box, up, (bottom, surface), d_mean);
+    s.free_volume_below_surface_m3 = free_volume;
+    s.packing_fraction = fraction;
+    s.packing_fraction_bulk = fraction_bulk;
+    if let Some(d) = direction.filter(|d| d.norm() > 0.0 && d.iter().all(|c| c.is_finite())) {
+        clearance_along(world, d.normalize(), up, (lo, hi), &mut s);
+    }
+    s
+}
+
+/// Mean contacts per particle with other particles and with walls, and the fraction of
+/// particles without any contact (rattlers).
+fn contact_counts(world: &World, grid: &CellGrid) -> (f64, f64, f64) {
+    let p = &world.particles;
+    let n = p.len();
     let mut pp = vec![0u32; n];
     for i in 0..n {
         grid.for_each_near(&p.position[i], |j| {
@@ -153,11 +178,21 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
             }
         }
     }
-    s.mean_coordination_number = pp.iter().map(|&k| k as f64).sum::<f64>() / n as f64;
-    s.mean_wall_contacts = wall.iter().map(|&k| k as f64).sum::<f64>() / n as f64;
-    s.rattler_fraction = (0..n).filter(|&i| pp[i] + wall[i] == 0).count() as f64 / n as f64;
+    (
+        pp.iter().map(|&k| k as f64).sum::<f64>() / n as f64,
+        wall.iter().map(|&k| k as f64).sum::<f64>() / n as f64,
+        (0..n).filter(|&i| pp[i] + wall[i] == 0).count() as f64 / n as f64,
+    )
+}
 
-    // Bottom and surface along `up`.
+/// The bed's lowest particle bottom and its surface along `up`: the mean of the highest tops
+/// over a lateral grid of cells two mean diameters wide.
+fn bottom_and_surface(
+    p: &ParticleSet,
+    (e1, e2, up): (Vec3, Vec3, Vec3),
+    d_mean: f64,
+) -> (f64, f64) {
+    let n = p.len();
     let along = |x: &Vec3| [x.dot(&e1), x.dot(&e2), x.dot(&up)];
     let bottom = (0..n)
         .map(|i| p.position[i].dot(&up) - p.radius[i])
@@ -183,12 +218,22 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
     }
     let filled: Vec<f64> = top.into_iter().filter(|t| t.is_finite()).collect();
     let surface = filled.iter().sum::<f64>() / filled.len() as f64;
-    s.bed_bottom_m = bottom;
-    s.bed_surface_m = surface;
-    s.bed_height_m = surface - bottom;
+    (bottom, surface)
+}
 
-    // Packing fraction by Monte Carlo in the bed's bounding box (grown by r_max).
-    let (box_lo, box_hi) = (lo.add_scalar(-r_max), hi.add_scalar(r_max));
+/// Packing fraction by Monte Carlo in the bed's bounding box `(box_lo, box_hi)`: the free
+/// volume below the surface, the solid fraction of it, and the bulk fraction away from the
+/// walls, the bottom and the surface by 1.5 mean diameters (`NaN` with under 1 000 samples).
+fn packing_fractions(
+    world: &World,
+    grid: &CellGrid,
+    (box_lo, box_hi): (Vec3, Vec3),
+    up: Vec3,
+    (bottom, surface): (f64, f64),
+    d_mean: f64,
+) -> (f64, f64, f64) {
+    let p = &world.particles;
+    let mut scratch = Vec::new();
     let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_bed5);
     let margin = 1.5 * d_mean;
     let (mut free, mut free_solid, mut bulk, mut bulk_solid) = (0usize, 0usize, 0usize, 0usize);
@@ -211,63 +256,78 @@ pub fn bed_statistics(world: &World, direction: Option<Vec3>) -> BedStatistics {
         }
     }
     let box_volume = (box_hi - box_lo).product();
-    s.free_volume_below_surface_m3 = box_volume * free as f64 / PACKING_SAMPLES as f64;
-    s.packing_fraction = free_solid as f64 / free.max(1) as f64;
-    if bulk >= 1000 {
-        s.packing_fraction_bulk = bulk_solid as f64 / bulk as f64;
-    }
+    let bulk_fraction = if bulk >= 1000 {
+        bulk_solid as f64 / bulk as f64
+    } else {
+        f64::NAN
+    };
+    (
+        box_volume * free as f64 / PACKING_SAMPLES as f64,
+        free_solid as f64 / free.max(1) as f64,
+        bulk_fraction,
+    )
+}
 
-    // Clearance along the excitation direction.
-    if let Some(d) = direction.filter(|d| d.norm() > 0.0 && d.iter().all(|c| c.is_finite())) {
-        let e = d.normalize();
-        let (mut s_lo, mut s_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        let mut centroid = Vec3::zeros();
-        for i in 0..n {
-            let t = p.position[i].dot(&e);
-            s_lo = s_lo.min(t - p.radius[i]);
-            s_hi = s_hi.max(t + p.radius[i]);
-            centroid += p.position[i];
-        }
-        centroid /= n as f64;
-        let reach = 10.0 * ((hi - lo).norm() + 2.0 * r_max);
-        let free_to = |sign: f64, scratch: &mut Vec<_>| -> f64 {
-            // March in steps of a quarter radius, then bisect the wall crossing.
-            let step = 0.25 * r_max.max(1e-12);
-            let is_free = |t: f64, sc: &mut Vec<_>| {
-                world
-                    .wall_overlap(&(centroid + e * (sign * t)), 0.0, sc)
-                    .is_none()
-            };
-            let mut t = 0.0;
-            while t < reach && is_free(t + step, scratch) {
-                t += step;
-            }
-            if t >= reach {
-                return f64::INFINITY;
-            }
-            let (mut a, mut b) = (t, t + step);
-            for _ in 0..50 {
-                let m = 0.5 * (a + b);
-                if is_free(m, scratch) {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            a
-        };
-        let length = if world.wall_overlap(&centroid, 0.0, &mut scratch).is_none() {
-            free_to(1.0, &mut scratch) + free_to(-1.0, &mut scratch)
-        } else {
-            f64::NAN
-        };
-        s.direction = Some([e.x, e.y, e.z]);
-        s.bed_span_along_direction_m = Some([s_lo, s_hi]);
-        s.container_length_along_direction_m = Some(length);
-        s.clearance_m = Some(length - (s_hi - s_lo));
-        if e.dot(&up).abs() > 1.0 - 1e-6 {
-            s.clearance_to_surface_m = Some(length - s.bed_height_m);
-        }
+/// The clearance along the unit direction `e`: the bed's span along it, the container's free
+/// length through the bed's centroid (marched and bisected to the walls) and their difference
+/// (also to the surface when `e` is vertical).
+fn clearance_along(
+    world: &World,
+    e: Vec3,
+    up: Vec3,
+    (lo, hi): (Vec3, Vec3),
+    s: &mut BedStatistics,
+) {
+    let p = &world.particles;
+    let n = p.len();
+    let r_max = p.max_radius();
+    let mut scratch = Vec::new();
+    let (mut s_lo, mut s_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut centroid = Vec3::zeros();
+    for i in 0..n {
+        let t = p.position[i].dot(&e);
+        s_lo = s_lo.min(t - p.radius[i]);
+        s_hi = s_hi.max(t + p.radius[i]);
+        centroid += p.position[i];
     }
-    s
+    centroid /= n as f64;
+    let reach = 10.0 * ((hi - lo).norm() + 2.0 * r_max);
+    let free_to = |sign: f64, scratch: &mut Vec<_>| -> f64 {
+        // March in steps of a quarter radius, then bisect the wall crossing.
+        let step = 0.25 * r_max.max(1e-12);
+        let is_free = |t: f64, sc: &mut Vec<_>| {
+            world
+                .wall_overlap(&(centroid + e * (sign * t)), 0.0, sc)
+                .is_none()
+        };
+        let mut t = 0.0;
+        while t < reach && is_free(t + step, scratch) {
+            t += step;
+        }
+        if t >= reach {
+            return f64::INFINITY;
+        }
+        let (mut a, mut b) = (t, t + step);
+        for _ in 0..50 {
+            let m = 0.5 * (a + b);
+            if is_free(m, scratch) {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        a
+    };
+    let length = if world.wall_overlap(&centroid, 0.0, &mut scratch).is_none() {
+        free_to(1.0, &mut scratch) + free_to(-1.0, &mut scratch)
+    } else {
+        f64::NAN
+    };
+    s.direction = Some([e.x, e.y, e.z]);
+    s.bed_span_along_direction_m = Some([s_lo, s_hi]);
+    s.container_length_along_direction_m = Some(length);
+    s.clearance_m = Some(length - (s_hi - s_lo));
+    if e.dot(&up).abs() > 1.0 - 1e-6 {
+        s.clearance_to_surface_m = Some(length - s.bed_height_m);
+    }
 }

@@ -115,19 +115,32 @@ impl World {
     /// O(N + contacts); meant to be called every few hundred steps.
     pub fn check_health(&self) -> Result<(), HealthError> {
         debug_assert!(!self.step_pending(), "state read with a half kick pending");
+        self.check_finite()?;
+        self.check_pair_overlaps()?;
+        self.check_wall_overlaps()?;
+        self.check_energy()
+    }
+
+    /// The error of a health check at the current time, about particle `i` (with its position).
+    fn health_error(&self, i: Option<usize>, message: String) -> HealthError {
         let p = &self.particles;
-        let err = |i: Option<usize>, message: String| HealthError {
+        HealthError {
             time_s: self.time_s,
             particle: i,
             position_m: i.map(|i| [p.position[i].x, p.position[i].y, p.position[i].z]),
             message,
-        };
+        }
+    }
+
+    /// Every position, velocity and spin finite.
+    fn check_finite(&self) -> Result<(), HealthError> {
+        let p = &self.particles;
         for i in 0..p.len() {
             let bad_x = !p.position[i].iter().all(|c| c.is_finite());
             let bad_v = !p.velocity[i].iter().all(|c| c.is_finite())
                 || !p.angular_velocity[i].iter().all(|c| c.is_finite());
             if bad_x || bad_v {
-                return Err(err(
+                return Err(self.health_error(
                     Some(i),
                     format!(
                         "non-finite {} (id {}); {}",
@@ -138,6 +151,12 @@ impl World {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// No particle–particle overlap beyond [`MAX_RELATIVE_OVERLAP`] of the smaller radius.
+    fn check_pair_overlaps(&self) -> Result<(), HealthError> {
+        let p = &self.particles;
         // Particle–particle overlaps.
         let mut worst = (0.0, usize::MAX, usize::MAX);
         for k in 0..self.neighbors.num_pairs() {
@@ -153,7 +172,7 @@ impl World {
         }
         if worst.0 > MAX_RELATIVE_OVERLAP {
             let (rel, i, j) = worst;
-            return Err(err(
+            return Err(self.health_error(
                 Some(i),
                 format!(
                     "particles {i} and {j} overlap by {:.0} % of the smaller radius (runaway \
@@ -164,6 +183,12 @@ impl World {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// No particle deeper in a wall than the limit of its pair of materials.
+    fn check_wall_overlaps(&self) -> Result<(), HealthError> {
+        let p = &self.particles;
         // Particle–wall overlaps (from the last force evaluation).
         let mut out = Vec::new();
         for (i, slots) in self.wall_slots.iter().enumerate() {
@@ -179,7 +204,7 @@ impl World {
                     &self.materials[wall.material as usize],
                 );
                 if let Some(c) = out.iter().find(|c| c.overlap_m > limit * p.radius[i]) {
-                    return Err(err(
+                    return Err(self.health_error(
                         Some(i),
                         format!(
                             "particle {i} penetrates wall '{}' of body '{}' by {:.0} % of its \
@@ -200,6 +225,12 @@ impl World {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Dissipation never negative, no particle escaped, the ledger closed (to [`MAX_CLOSURE_ERROR`] of the energy turnover).
+    fn check_energy(&self) -> Result<(), HealthError> {
+        let p = &self.particles;
         let l = &self.ledger;
         let scale = l
             .turnover_j()
@@ -240,7 +271,7 @@ impl World {
             } else {
                 cause(self)
             };
-            return Err(err(
+            return Err(self.health_error(
                 i,
                 format!(
                     "energy is being created: the {what} is {d:.3e} J (negative, against \
@@ -249,13 +280,13 @@ impl World {
             ));
         }
         if let Some(e) = self.escaped_particle() {
-            return Err(err(Some(e.0), e.1));
+            return Err(self.health_error(Some(e.0), e.1));
         }
         let closure = l.closure_error_j();
         if !closure.is_finite() || (scale > 0.0 && closure.abs() > MAX_CLOSURE_ERROR * scale) {
             // Blame the fastest particle.
             let i = fastest(p);
-            return Err(err(
+            return Err(self.health_error(
                 i,
                 format!(
                     "energy balance broken (residual {:.3e} J against {:.3e} J of energy \
