@@ -1358,8 +1358,17 @@ impl Scenario {
     /// (`particles[0].size.radius_m …`, located by [`ScenarioError::invalid`]) and says how
     /// to fix it.
     pub fn validate(&self) -> Result<(), ParameterError> {
+        self.validate_simulation_and_output()?;
+        self.validate_materials_and_contact()?;
+        self.validate_bodies()?;
+        self.validate_damper()?;
+        self.validate_fields()?;
+        self.validate_settle_and_particles()
+    }
+
+    /// `[simulation]` and `[output]`.
+    fn validate_simulation_and_output(&self) -> Result<(), ParameterError> {
         let s = &self.simulation;
-        let finite_pos = |v: f64| v.is_finite() && v > 0.0;
         if !(s.duration_s.is_finite() && s.duration_s >= 0.0) {
             return Err(ParameterError::from_message(format!(
                 "simulation.duration_s must be a finite time >= 0 in seconds, got {}",
@@ -1422,6 +1431,11 @@ impl Scenario {
                 self.output.vtk_interval_s
             )));
         }
+        Ok(())
+    }
+
+    /// `[[materials]]` (unique names) and `[contact]` with its pairs.
+    fn validate_materials_and_contact(&self) -> Result<(), ParameterError> {
         if self.materials.is_empty() {
             return Err(ParameterError::from_message(
                 "materials: at least one material is needed; add a [[materials]] table with name, \
@@ -1464,6 +1478,11 @@ impl Scenario {
                 .validate()
                 .map_err(|e| e.under(&format!("contact.pairs[{k}].")))?;
         }
+        Ok(())
+    }
+
+    /// `[[bodies]]`: unique names, motions, walls.
+    fn validate_bodies(&self) -> Result<(), ParameterError> {
         for (b, body) in self.bodies.iter().enumerate() {
             if self.bodies[..b].iter().any(|o| o.name == body.name) {
                 return Err(ParameterError::from_message(format!(
@@ -1521,6 +1540,11 @@ impl Scenario {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `[damper]`: the container body, the excitation and the cycles.
+    fn validate_damper(&self) -> Result<(), ParameterError> {
         if let Some(d) = &self.damper {
             if !self.bodies.iter().any(|b| b.name == d.container_body) {
                 let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
@@ -1664,6 +1688,11 @@ impl Scenario {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `[fields]`: a damper and exactly one amplitude axis.
+    fn validate_fields(&self) -> Result<(), ParameterError> {
         if let Some(f) = &self.fields {
             if self.damper.is_none() {
                 return Err(ParameterError::from_message(
@@ -1685,6 +1714,11 @@ impl Scenario {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `[settle]` and every `[[particles]]` group.
+    fn validate_settle_and_particles(&self) -> Result<(), ParameterError> {
         if let Some(st) = &self.settle {
             if !(st.max_duration_s.is_finite() && st.max_duration_s >= 0.0) {
                 return Err(ParameterError::from_message(format!(
@@ -2184,6 +2218,11 @@ impl Scenario {
         })
         .map_err(|e| InputError::at(format!("particles[{g}].placement"), e))
     }
+}
+
+/// Finite and positive.
+fn finite_pos(v: f64) -> bool {
+    v.is_finite() && v > 0.0
 }
 
 /// Fails if two particles overlap by more than 1e-9 of the smaller radius at the start.
