@@ -111,3 +111,62 @@ impl InputError {
         }
     }
 }
+
+/// Why a run (or its settling) stopped without finishing; [`RunError::Interrupted`] is a stop
+/// on request after the checkpoint was written.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scenario's world cannot be built.
+    #[error(transparent)]
+    Input(#[from] crate::InputError),
+    /// A checkpoint cannot be written or read back.
+    #[error(transparent)]
+    Checkpoint(#[from] crate::checkpoint::CheckpointError),
+    /// The checkpoint does not fit the scenario's world.
+    #[error(transparent)]
+    State(#[from] pdamp_dem::state::StateError),
+    /// A checkpoint of a running phase without the world's state.
+    #[error("checkpoint without state")]
+    NoState,
+    /// An output file cannot be written.
+    #[error("output: {0}")]
+    Output(crate::error::Source),
+    /// A ParaView file or series cannot be written or continued.
+    #[error(transparent)]
+    Vtk(#[from] crate::vtk::VtkError),
+    /// The summary of a finished run cannot be read back.
+    #[error("summary.json: {0}")]
+    Summary(serde_json::Error),
+    /// A result does not serialise.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// Stopped on request; the checkpoint is on disk (the text starts with
+    /// [`crate::checkpoint::INTERRUPTED`]).
+    #[error(transparent)]
+    Interrupted(#[from] crate::checkpoint::Interrupted),
+    /// A health check failed; `failure.json` names the particle.
+    #[error(
+        "{health} (during {phase}; outputs written so far are kept in {}, see failure.json)",
+        out_dir.display()
+    )]
+    Failed {
+        /// What the check found.
+        health: pdamp_dem::health::HealthError,
+        /// `settling` or `running`.
+        phase: &'static str,
+        /// The output directory.
+        out_dir: PathBuf,
+    },
+}
+
+impl RunError {
+    /// [`RunError::Output`].
+    pub fn output(e: impl Into<crate::error::Source>) -> Self {
+        Self::Output(e.into())
+    }
+
+    /// Whether the run was stopped on request with its checkpoint written.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, Self::Interrupted(_))
+    }
+}
