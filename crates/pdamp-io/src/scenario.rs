@@ -1813,78 +1813,7 @@ impl Scenario {
         progress: &mut dyn FnMut(&str, f64),
     ) -> Result<(World, Vec<pdamp_dem::drop_down::DropDownReport>), InputError> {
         let mut reports = Vec::new();
-        let mut model = self.contact.default.clone();
-        model.prepare();
-        let mut world = World::new(self.materials.clone(), model, self.simulation.time_step_s);
-        for p in &self.contact.pairs {
-            let a = self.material_index(&p.materials[0], "contact.pairs")?;
-            let b = self.material_index(&p.materials[1], "contact.pairs")?;
-            world.set_contact_model(a, b, p.model.clone());
-        }
-        world.gravity_m_s2 = Vec3::from(self.simulation.gravity_m_s2);
-        world.integrator = self.simulation.integrator.clone();
-        for (bi, b) in self.bodies.iter().enumerate() {
-            let motion = match &b.motion {
-                MotionSpec::Fixed => Motion::Fixed,
-                MotionSpec::Harmonic(h) => Motion::Prescribed(Arc::new(h.clone())),
-                MotionSpec::Driven => Motion::Driven,
-            };
-            let mut body = RigidBody::new(
-                &b.name,
-                BodyState::at_rest(Vec3::from(b.position_m)),
-                motion,
-            );
-            for (wi, w) in b.walls.iter().enumerate() {
-                let mat = self.material_index(&w.material, "walls")?;
-                let geometry = match &w.geometry {
-                    GeometrySpec::Plane(g) => Geometry::Plane(g.clone()),
-                    GeometrySpec::BoxInside(g) => Geometry::BoxInside(g.clone()),
-                    GeometrySpec::CylinderInside(g) => Geometry::CylinderInside(g.clone()),
-                    GeometrySpec::CylinderOutside(g) => Geometry::CylinderOutside(g.clone()),
-                    GeometrySpec::BoxOutside(b) => {
-                        if b.half_extents_m
-                            .iter()
-                            .any(|h| !(*h > 0.0 && h.is_finite()))
-                        {
-                            return Err(InputError::message(format!(
-                                "bodies[{bi}].walls[{wi}].geometry.half_extents_m must be > 0, got {:?}",
-                                b.half_extents_m
-                            )));
-                        }
-                        let mut m = pdamp_dem::walls::TriMesh::box_inside(
-                            Vec3::from(b.center_m),
-                            Vec3::from(b.half_extents_m),
-                        );
-                        m.flip_normals();
-                        Geometry::Mesh(m)
-                    }
-                    GeometrySpec::Stl(s) => {
-                        let path = base_dir.join(&s.path);
-                        let mut mesh = crate::stl::read_stl(&path).map_err(|e| {
-                            InputError::at(format!("bodies[{bi}].walls[{wi}].geometry.path"), e)
-                        })?;
-                        mesh = mesh
-                            .transformed(s.scale, Vec3::from(s.translation_m))
-                            .map_err(|e| {
-                                InputError::at(
-                                    format!("bodies[{bi}].walls[{wi}].geometry.scale"),
-                                    e,
-                                )
-                            })?;
-                        if s.flip_normals {
-                            mesh.flip_normals();
-                        }
-                        Geometry::Mesh(mesh)
-                    }
-                };
-                body.walls.push(pdamp_dem::Wall {
-                    geometry,
-                    material: mat,
-                    name: w.name.clone(),
-                });
-            }
-            world.add_body(body);
-        }
+        let mut world = self.world_with_bodies(base_dir)?;
         let up = -world.gravity_m_s2;
         let up = if up.norm() > 0.0 {
             up.normalize()
@@ -1969,31 +1898,7 @@ impl Scenario {
                 }
                 continue;
             }
-            let pos = match pl.method {
-                PlacementMethod::Grid => grid_packing(region, &radii, pl.gap_m, &up),
-                PlacementMethod::Tight => tight_packing(region, &radii, pl.gap_m, &up),
-                _ => {
-                    let layering = pl.layer_height_m.map(|h| Layering {
-                        up,
-                        layer_height_m: h,
-                    });
-                    let scratch = std::cell::RefCell::new(Vec::new());
-                    let blocked = |x: &Vec3, r: f64| {
-                        world
-                            .wall_overlap(x, r, &mut scratch.borrow_mut())
-                            .is_some()
-                    };
-                    random_insertion_clear_of(
-                        region,
-                        &radii,
-                        seed,
-                        1000,
-                        layering.as_ref(),
-                        &blocked,
-                    )
-                }
-            }
-            .map_err(fix)?;
+            let pos = packed_positions(&world, pl, region, &radii, seed, &up).map_err(fix)?;
             // Number the group's particles by layers of cells (spatial neighbours close in
             // memory: the DEM's pair loop then finds its partners in cache).
             let r_max = radii.iter().cloned().fold(0.0, f64::max);
@@ -2018,25 +1923,7 @@ impl Scenario {
             tolerance,
             settled_bed && !bed_from_file,
         )?;
-        // Check mode: the drop-down groups' particles far away in a row (for counts, masses
-        // and the time-step check below), not dropped.
-        let far = world
-            .bodies
-            .iter()
-            .flat_map(|b| b.walls.iter().filter_map(|w| w.geometry.bounding_box()))
-            .fold(1.0f64, |a, (lo, hi)| a.max(lo.amax()).max(hi.amax()));
-        let pitch = 4.0
-            * placeholders
-                .iter()
-                .flat_map(|(_, r)| r.iter())
-                .fold(0.0f64, |a, &b| a.max(b));
-        let mut x = 1e3 * far;
-        for (mat, radii) in placeholders {
-            for r in radii {
-                world.add_particle(Vec3::new(x, 0.0, 0.0), r, mat);
-                x += pitch;
-            }
-        }
+        add_placeholders(&mut world, placeholders);
         if let Some(state) = bed_state {
             // The saved state continues exactly when the bed was made in this container; a bed
             // from another scenario keeps the positions, velocities and spins set above.
@@ -2045,6 +1932,90 @@ impl Scenario {
         if let Some(skin) = self.simulation.skin_m {
             world.set_skin(skin);
         }
+        self.check_time_step(&world)?;
+        Ok((world, reports))
+    }
+
+    /// The world of the scenario without particles: materials, contact laws, gravity,
+    /// integrator, and the bodies with their walls (STL paths relative to `base_dir`).
+    fn world_with_bodies(&self, base_dir: &Path) -> Result<World, InputError> {
+        let mut model = self.contact.default.clone();
+        model.prepare();
+        let mut world = World::new(self.materials.clone(), model, self.simulation.time_step_s);
+        for p in &self.contact.pairs {
+            let a = self.material_index(&p.materials[0], "contact.pairs")?;
+            let b = self.material_index(&p.materials[1], "contact.pairs")?;
+            world.set_contact_model(a, b, p.model.clone());
+        }
+        world.gravity_m_s2 = Vec3::from(self.simulation.gravity_m_s2);
+        world.integrator = self.simulation.integrator.clone();
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let motion = match &b.motion {
+                MotionSpec::Fixed => Motion::Fixed,
+                MotionSpec::Harmonic(h) => Motion::Prescribed(Arc::new(h.clone())),
+                MotionSpec::Driven => Motion::Driven,
+            };
+            let mut body = RigidBody::new(
+                &b.name,
+                BodyState::at_rest(Vec3::from(b.position_m)),
+                motion,
+            );
+            for (wi, w) in b.walls.iter().enumerate() {
+                let mat = self.material_index(&w.material, "walls")?;
+                let geometry = match &w.geometry {
+                    GeometrySpec::Plane(g) => Geometry::Plane(g.clone()),
+                    GeometrySpec::BoxInside(g) => Geometry::BoxInside(g.clone()),
+                    GeometrySpec::CylinderInside(g) => Geometry::CylinderInside(g.clone()),
+                    GeometrySpec::CylinderOutside(g) => Geometry::CylinderOutside(g.clone()),
+                    GeometrySpec::BoxOutside(b) => {
+                        if b.half_extents_m
+                            .iter()
+                            .any(|h| !(*h > 0.0 && h.is_finite()))
+                        {
+                            return Err(InputError::message(format!(
+                                "bodies[{bi}].walls[{wi}].geometry.half_extents_m must be > 0, got {:?}",
+                                b.half_extents_m
+                            )));
+                        }
+                        let mut m = pdamp_dem::walls::TriMesh::box_inside(
+                            Vec3::from(b.center_m),
+                            Vec3::from(b.half_extents_m),
+                        );
+                        m.flip_normals();
+                        Geometry::Mesh(m)
+                    }
+                    GeometrySpec::Stl(s) => {
+                        let path = base_dir.join(&s.path);
+                        let mut mesh = crate::stl::read_stl(&path).map_err(|e| {
+                            InputError::at(format!("bodies[{bi}].walls[{wi}].geometry.path"), e)
+                        })?;
+                        mesh = mesh
+                            .transformed(s.scale, Vec3::from(s.translation_m))
+                            .map_err(|e| {
+                                InputError::at(
+                                    format!("bodies[{bi}].walls[{wi}].geometry.scale"),
+                                    e,
+                                )
+                            })?;
+                        if s.flip_normals {
+                            mesh.flip_normals();
+                        }
+                        Geometry::Mesh(mesh)
+                    }
+                };
+                body.walls.push(pdamp_dem::Wall {
+                    geometry,
+                    material: mat,
+                    name: w.name.clone(),
+                });
+            }
+            world.add_body(body);
+        }
+        Ok(world)
+    }
+
+    /// The time step against the shortest contact time of the built world (velocity Verlet).
+    fn check_time_step(&self, world: &World) -> Result<(), InputError> {
         if !world.particles.is_empty() {
             let tc = world.min_contact_time_s(self.simulation.check_impact_velocity_m_s);
             let ratio = self.simulation.time_step_s / tc;
@@ -2063,7 +2034,7 @@ impl Scenario {
                 )));
             }
         }
-        Ok((world, reports))
+        Ok(())
     }
 }
 
@@ -2319,4 +2290,56 @@ fn check_inside_walls(
         }
     }
     Ok(())
+}
+
+/// Lattice or random positions of a group's particles in `region` (random ones clear of the
+/// walls of `world`).
+fn packed_positions(
+    world: &World,
+    pl: &PlacementSpec,
+    region: &Region,
+    radii: &[f64],
+    seed: u64,
+    up: &Vec3,
+) -> Result<Vec<Vec3>, pdamp_dem::generate::PackingError> {
+    let up = *up;
+    match pl.method {
+        PlacementMethod::Grid => grid_packing(region, radii, pl.gap_m, &up),
+        PlacementMethod::Tight => tight_packing(region, radii, pl.gap_m, &up),
+        _ => {
+            let layering = pl.layer_height_m.map(|h| Layering {
+                up,
+                layer_height_m: h,
+            });
+            let scratch = std::cell::RefCell::new(Vec::new());
+            let blocked = |x: &Vec3, r: f64| {
+                world
+                    .wall_overlap(x, r, &mut scratch.borrow_mut())
+                    .is_some()
+            };
+            random_insertion_clear_of(region, radii, seed, 1000, layering.as_ref(), &blocked)
+        }
+    }
+}
+
+/// Check mode: the drop-down groups' particles far away in a row (for counts, masses and the
+/// time-step check), not dropped.
+fn add_placeholders(world: &mut World, placeholders: Vec<(u16, Vec<f64>)>) {
+    let far = world
+        .bodies
+        .iter()
+        .flat_map(|b| b.walls.iter().filter_map(|w| w.geometry.bounding_box()))
+        .fold(1.0f64, |a, (lo, hi)| a.max(lo.amax()).max(hi.amax()));
+    let pitch = 4.0
+        * placeholders
+            .iter()
+            .flat_map(|(_, r)| r.iter())
+            .fold(0.0f64, |a, &b| a.max(b));
+    let mut x = 1e3 * far;
+    for (mat, radii) in placeholders {
+        for r in radii {
+            world.add_particle(Vec3::new(x, 0.0, 0.0), r, mat);
+            x += pitch;
+        }
+    }
 }
