@@ -623,7 +623,6 @@ pub fn run_scenario(
     mut progress: impl FnMut(&str, f64),
 ) -> Result<RunSummary, RunError> {
     use crate::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
-    let io = RunError::output;
     let mut world = scenario.build_world(base_dir)?;
     let digest = scenario_content_digest(scenario, base_dir);
     let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
@@ -636,12 +635,11 @@ pub fn run_scenario(
     if let Some(c) = &resumed
         && c.phase == RunPhase::Finished
     {
-        let text = std::fs::read_to_string(out_dir.join("summary.json")).map_err(io)?;
-        return serde_json::from_str(&text).map_err(RunError::Summary);
+        return finished_summary(out_dir);
     }
     crate::provenance::Provenance::of(scenario)
         .write(scenario, out_dir)
-        .map_err(io)?;
+        .map_err(RunError::output)?;
     let start = std::time::Instant::now();
     let wall_before = resumed.as_ref().map_or(0.0, |c| c.wall_time_s);
     let wall = |start: &std::time::Instant| wall_before + start.elapsed().as_secs_f64();
@@ -657,54 +655,19 @@ pub fn run_scenario(
     let mut health: Option<pdamp_dem::health::HealthError> = None;
 
     // Settling (fresh, or resumed in the middle of it).
-    let mut state = match resumed {
-        Some(mut c) if c.phase == RunPhase::Running => {
-            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
-            Some(c)
-        }
-        Some(mut c) => {
-            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
-            world.gravity_m_s2 = main_gravity;
-            None
-        }
-        None => None,
-    };
+    let mut state = restore_resumed(&mut world, resumed, main_gravity)?;
     let settle_t = match (&state, &scenario.settle) {
         (Some(c), _) => c.settle_time_s,
-        (None, Some(spec)) => {
-            let mut err = None;
-            let max = spec.max_duration_s;
-            let r = settle_with_or_break(&mut world, spec, main_gravity, |w| {
-                progress("settling", w.time_s / max);
-                if let Err(e) = w.check_health() {
-                    health = Some(e);
-                    return ControlFlow::Break(());
-                }
-                let stop = ck::stop_requested();
-                if stop || timer.due() {
-                    if let Err(e) =
-                        ck::save(&ck_path, &header, &RunCheckpoint::settling(w, wall(&start)))
-                    {
-                        err = Some(e);
-                        return ControlFlow::Break(());
-                    }
-                    if stop {
-                        return ControlFlow::Break(());
-                    }
-                }
-                ControlFlow::Continue(())
-            });
-            if let Some(e) = err {
-                return Err(e.into());
-            }
-            if let Some(h) = health.take() {
-                return Err(report_failure(out_dir, "settling", &h));
-            }
-            match r {
-                Some(t) => t,
-                None => return Err(interrupted(world.time_s)),
-            }
-        }
+        (None, Some(spec)) => settle_phase(
+            &mut world,
+            spec,
+            main_gravity,
+            &mut progress,
+            &mut timer,
+            (&ck_path, &header),
+            &|| wall(&start),
+            out_dir,
+        )?,
         (None, None) => 0.0,
     };
 
@@ -714,56 +677,14 @@ pub fn run_scenario(
     let vtk_encoding: VtkEncoding = scenario.output.vtk_format.into();
     let e_every = scenario.output.energy_interval_s;
     let csvio = RunError::output;
-    let pvd_path = out_dir.join("particles.pvd");
-    let (mut csv, mut series, mut snap, mut next_e, mut next_v, steps0) = match state.take() {
-        Some(c) => {
-            let csv = crate::csv::CsvWriter::resume(
-                out_dir.join("energy.csv"),
-                &ENERGY_COLUMNS,
-                c.energy_csv_bytes,
-                c.energy_rows,
-            )
-            .map_err(csvio)?;
-            let series = if vtk_every > 0.0 {
-                std::fs::create_dir_all(&vtk_dir).map_err(io)?;
-                Some(PvdSeries::resume(&pvd_path, c.pvd)?)
-            } else {
-                None
-            };
-            (
-                csv,
-                series,
-                c.snapshot,
-                c.next_energy_s,
-                c.next_vtk_s,
-                c.steps_at_start,
-            )
-        }
-        None => {
-            world.initialize();
-            // The bed the main run starts from (measured once; a resumed run reads it back).
-            let stats = bed_statistics(&world, crate::prepare::excitation_direction(scenario));
-            let json = serde_json::to_string_pretty(&stats)?;
-            crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes())
-                .map_err(io)?;
-            let mut series = if vtk_every > 0.0 {
-                std::fs::create_dir_all(&vtk_dir).map_err(io)?;
-                Some(PvdSeries::new(&pvd_path))
-            } else {
-                None
-            };
-            let mut csv =
-                CsvWriter::create(out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(csvio)?;
-            csv.write_row(&ledger_row(&world)).map_err(csvio)?;
-            let mut snap = 0usize;
-            if let Some(s) = series.as_mut() {
-                write_snapshot_with(&world, &vtk_dir, snap, vtk_encoding)?;
-                s.add_frame(world.time_s, &snapshot_files(&world, snap))?;
-                snap += 1;
-            }
-            (csv, series, snap, e_every, vtk_every, world.counters.steps)
-        }
-    };
+    let MainOutputs {
+        mut csv,
+        mut series,
+        mut snap,
+        next_energy_s: mut next_e,
+        next_vtk_s: mut next_v,
+        steps_at_start: steps0,
+    } = open_outputs(state.take(), &mut world, scenario, out_dir, vtk_encoding)?;
     let t_end = scenario.simulation.duration_s;
     let mut err: Option<RunError> = None;
     let mut stopped = false;
@@ -790,17 +711,9 @@ pub fn run_scenario(
             && w.time_s >= next_v - 1e-12
         {
             w.complete_step();
-            match write_snapshot_with(w, &vtk_dir, snap, vtk_encoding) {
-                Ok(_) => {
-                    if let Err(e) = s.add_frame(w.time_s, &snapshot_files(w, snap)) {
-                        err = Some(RunError::output(e));
-                        return ControlFlow::Break(());
-                    }
-                }
-                Err(e) => {
-                    err = Some(RunError::output(e));
-                    return ControlFlow::Break(());
-                }
+            if let Err(e) = write_frame(w, &vtk_dir, snap, vtk_encoding, s) {
+                err = Some(e);
+                return ControlFlow::Break(());
             }
             snap += 1;
             next_v += vtk_every;
@@ -848,12 +761,217 @@ pub fn run_scenario(
     csv.sync().map_err(csvio)?;
     let wall_s = wall(&start);
     let steps = world.counters.steps - steps0;
+    let summary = run_summary(scenario, &world, &digest, settle_t, steps, wall_s, out_dir);
+    write_finished(&summary, &world, out_dir, (&ck_path, &header), wall_s)?;
+    Ok(summary)
+}
+
+/// The settling before the main run ([`settle_with_or_break`]) under the health check, with
+/// checkpoints when `timer` is due or a stop is requested. Returns the settling time, s.
+#[allow(clippy::too_many_arguments)]
+fn settle_phase(
+    world: &mut World,
+    spec: &crate::scenario::SettleSpec,
+    main_gravity: Vec3,
+    progress: &mut dyn FnMut(&str, f64),
+    timer: &mut crate::checkpoint::CheckpointTimer,
+    (ck_path, header): (&Path, &crate::checkpoint::CheckpointHeader),
+    wall: &dyn Fn() -> f64,
+    out_dir: &Path,
+) -> Result<f64, RunError> {
+    use crate::checkpoint as ck;
+    let mut health = None;
+    let mut err = None;
+    let max = spec.max_duration_s;
+    let r = settle_with_or_break(world, spec, main_gravity, |w| {
+        progress("settling", w.time_s / max);
+        if let Err(e) = w.check_health() {
+            health = Some(e);
+            return ControlFlow::Break(());
+        }
+        let stop = ck::stop_requested();
+        if stop || timer.due() {
+            if let Err(e) = ck::save(ck_path, header, &RunCheckpoint::settling(w, wall())) {
+                err = Some(e);
+                return ControlFlow::Break(());
+            }
+            if stop {
+                return ControlFlow::Break(());
+            }
+        }
+        ControlFlow::Continue(())
+    });
+    if let Some(e) = err {
+        return Err(e.into());
+    }
+    if let Some(h) = health.take() {
+        return Err(report_failure(out_dir, "settling", &h));
+    }
+    r.ok_or_else(|| {
+        RunError::Interrupted(ck::Interrupted {
+            time_s: world.time_s,
+            path: ck_path.to_path_buf(),
+        })
+    })
+}
+
+/// The summary of a run that had finished (resumed after its end).
+fn finished_summary(out_dir: &Path) -> Result<RunSummary, RunError> {
+    let text = std::fs::read_to_string(out_dir.join("summary.json")).map_err(RunError::output)?;
+    serde_json::from_str(&text).map_err(RunError::Summary)
+}
+
+/// Writes `summary.json` and the checkpoint that marks the run finished.
+fn write_finished(
+    summary: &RunSummary,
+    world: &World,
+    out_dir: &Path,
+    (ck_path, header): (&Path, &crate::checkpoint::CheckpointHeader),
+    wall_s: f64,
+) -> Result<(), RunError> {
+    let json = serde_json::to_string_pretty(summary)?;
+    crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes())
+        .map_err(RunError::output)?;
+    let done = RunCheckpoint {
+        phase: RunPhase::Finished,
+        world: None,
+        ..RunCheckpoint::settling(world, wall_s)
+    };
+    crate::checkpoint::save(ck_path, header, &done)?;
+    Ok(())
+}
+
+/// Puts the state of checkpoint `resumed` back into `world`: a checkpoint of the main run is
+/// returned (its outputs continue), one of the settling is consumed (the run gravity set again).
+fn restore_resumed(
+    world: &mut World,
+    resumed: Option<RunCheckpoint>,
+    main_gravity: Vec3,
+) -> Result<Option<RunCheckpoint>, RunError> {
+    Ok(match resumed {
+        Some(mut c) if c.phase == RunPhase::Running => {
+            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
+            Some(c)
+        }
+        Some(mut c) => {
+            world.restore_state(c.world.take().ok_or(RunError::NoState)?)?;
+            world.gravity_m_s2 = main_gravity;
+            None
+        }
+        None => None,
+    })
+}
+
+/// The outputs of the main run and where it stands ([`open_outputs`]).
+struct MainOutputs {
+    csv: EnergyCsv,
+    series: Option<PvdSeries>,
+    /// Index of the next VTK frame.
+    snap: usize,
+    /// Time of the next energy row, s.
+    next_energy_s: f64,
+    /// Time of the next VTK frame, s.
+    next_vtk_s: f64,
+    /// Step count when the main run started.
+    steps_at_start: u64,
+}
+
+/// The outputs of the main run: continued at the checkpoint `resumed` (files cut back to it),
+/// or opened afresh after initialising `world`. Returns the writers, the next frame, the next
+/// energy and VTK times, and the step count at the start of the main run.
+fn open_outputs(
+    resumed: Option<RunCheckpoint>,
+    world: &mut World,
+    scenario: &Scenario,
+    out_dir: &Path,
+    vtk_encoding: VtkEncoding,
+) -> Result<MainOutputs, RunError> {
+    let csvio = RunError::output;
+    let vtk_dir = out_dir.join("vtk");
+    let pvd_path = out_dir.join("particles.pvd");
+    let vtk_every = scenario.output.vtk_interval_s;
+    let e_every = scenario.output.energy_interval_s;
+    Ok(match resumed {
+        Some(c) => {
+            let csv = CsvWriter::resume(
+                out_dir.join("energy.csv"),
+                &ENERGY_COLUMNS,
+                c.energy_csv_bytes,
+                c.energy_rows,
+            )
+            .map_err(csvio)?;
+            let series = resume_series(vtk_every > 0.0, &vtk_dir, &pvd_path, c.pvd)?;
+            MainOutputs {
+                csv,
+                series,
+                snap: c.snapshot,
+                next_energy_s: c.next_energy_s,
+                next_vtk_s: c.next_vtk_s,
+                steps_at_start: c.steps_at_start,
+            }
+        }
+        None => {
+            world.initialize();
+            let (csv, series, snap) =
+                open_fresh_outputs(world, scenario, out_dir, &pvd_path, vtk_encoding)?;
+            MainOutputs {
+                csv,
+                series,
+                snap,
+                next_energy_s: e_every,
+                next_vtk_s: vtk_every,
+                steps_at_start: world.counters.steps,
+            }
+        }
+    })
+}
+
+/// The ParaView series of a resumed run (its VTK directory made again if missing), or none
+/// without VTK output.
+fn resume_series(
+    vtk: bool,
+    vtk_dir: &Path,
+    pvd_path: &Path,
+    entries: Vec<(f64, String)>,
+) -> Result<Option<PvdSeries>, RunError> {
+    if !vtk {
+        return Ok(None);
+    }
+    std::fs::create_dir_all(vtk_dir).map_err(RunError::output)?;
+    Ok(Some(PvdSeries::resume(pvd_path, entries)?))
+}
+
+/// Writes snapshot `snap` of `w` and adds it to the series.
+fn write_frame(
+    w: &World,
+    vtk_dir: &Path,
+    snap: usize,
+    encoding: VtkEncoding,
+    series: &mut PvdSeries,
+) -> Result<(), RunError> {
+    write_snapshot_with(w, vtk_dir, snap, encoding).map_err(RunError::output)?;
+    series
+        .add_frame(w.time_s, &snapshot_files(w, snap))
+        .map_err(RunError::output)
+}
+
+/// `summary.json` of a finished run: counts, timings, the ledger and its closure, overlaps,
+/// contacts and the bed statistics written at the start of the main run.
+fn run_summary(
+    scenario: &Scenario,
+    world: &World,
+    digest: &str,
+    settle_t: f64,
+    steps: u64,
+    wall_s: f64,
+    out_dir: &Path,
+) -> RunSummary {
     let l = world.ledger;
     let scale = l.turnover_j().max(1e-300);
-    let summary = RunSummary {
+    RunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: scenario.title.clone(),
-        scenario_digest: digest.clone(),
+        scenario_digest: digest.to_string(),
         seed: scenario.simulation.seed,
         threads: rayon::current_num_threads(),
         particles: world.particles.len(),
@@ -869,20 +987,49 @@ pub fn run_scenario(
         max_relative_overlap: world.max_relative_overlap(),
         contacts_pp: world.num_pp_contacts(),
         contacts_pw: world.num_pw_contacts(),
-        bed_height_m: bed_height_m(&world),
+        bed_height_m: bed_height_m(world),
         bed: std::fs::read_to_string(out_dir.join(BED_STATISTICS_FILE))
             .ok()
             .and_then(|t| serde_json::from_str(&t).ok()),
+    }
+}
+
+/// The writer of `energy.csv`.
+type EnergyCsv = CsvWriter<std::io::BufWriter<std::fs::File>>;
+
+/// The outputs of a main run started afresh: the bed statistics it starts from (measured once;
+/// a resumed run reads them back), `energy.csv` with its first row and, with VTK output, the
+/// series with its first frame. Returns the writers and the next frame's index.
+fn open_fresh_outputs(
+    world: &World,
+    scenario: &Scenario,
+    out_dir: &Path,
+    pvd_path: &Path,
+    vtk_encoding: VtkEncoding,
+) -> Result<(EnergyCsv, Option<PvdSeries>, usize), RunError> {
+    let io = RunError::output;
+    let csvio = RunError::output;
+    let vtk_dir = out_dir.join("vtk");
+    let vtk_every = scenario.output.vtk_interval_s;
+    // The bed the main run starts from (measured once; a resumed run reads it back).
+    let stats = bed_statistics(world, crate::prepare::excitation_direction(scenario));
+    let json = serde_json::to_string_pretty(&stats)?;
+    crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes()).map_err(io)?;
+    let mut series = if vtk_every > 0.0 {
+        std::fs::create_dir_all(&vtk_dir).map_err(io)?;
+        Some(PvdSeries::new(pvd_path))
+    } else {
+        None
     };
-    let json = serde_json::to_string_pretty(&summary)?;
-    crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes()).map_err(io)?;
-    let done = RunCheckpoint {
-        phase: RunPhase::Finished,
-        world: None,
-        ..RunCheckpoint::settling(&world, wall_s)
-    };
-    ck::save(&ck_path, &header, &done)?;
-    Ok(summary)
+    let mut csv = CsvWriter::create(out_dir.join("energy.csv"), &ENERGY_COLUMNS).map_err(csvio)?;
+    csv.write_row(&ledger_row(world)).map_err(csvio)?;
+    let mut snap = 0usize;
+    if let Some(s) = series.as_mut() {
+        write_snapshot_with(world, &vtk_dir, snap, vtk_encoding)?;
+        s.add_frame(world.time_s, &snapshot_files(world, snap))?;
+        snap += 1;
+    }
+    Ok((csv, series, snap))
 }
 
 #[cfg(test)]
