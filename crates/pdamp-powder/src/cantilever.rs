@@ -518,6 +518,13 @@ impl CantileverScenario {
     /// names the key, the value and the fix.
     pub fn validate(&self) -> Result<(), CantileverError> {
         self.beam.validate()?;
+        self.validate_load_and_run()?;
+        self.validate_powder()?;
+        self.validate_cost()
+    }
+
+    /// `[load]` and `[run]` (time step, gravity, output, coupling).
+    fn validate_load_and_run(&self) -> Result<(), CantileverError> {
         let (l, r) = (&self.load, &self.run);
         let e = self.beam.material.youngs_modulus_pa;
         if !(l.pressure_pa.is_finite() && l.pressure_pa.abs() <= 1e-3 * e) {
@@ -611,6 +618,11 @@ impl CantileverScenario {
             )
             .into());
         }
+        Ok(())
+    }
+
+    /// `[powder]`: law, size distribution, density, preparation, fit in the cavity.
+    fn validate_powder(&self) -> Result<(), CantileverError> {
         if let Some(p) = &self.powder {
             p.law.validate("powder.law.")?;
             p.psd().validate("powder.")?;
@@ -684,6 +696,12 @@ impl CantileverScenario {
                 .into());
             }
         }
+        Ok(())
+    }
+
+    /// Particles, steps, samples and frames within the limits, and the time step against the stiffest contact.
+    fn validate_cost(&self) -> Result<(), CantileverError> {
+        let r = &self.run;
         let est = self.estimate();
         if est.particles > MAX_PARTICLES as f64 {
             return Err(CantileverError::TooLarge {
