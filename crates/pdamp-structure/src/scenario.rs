@@ -1473,6 +1473,13 @@ impl StructureSpec {
     /// # Errors
     /// The first invalid value.
     pub fn validate(&self) -> Result<(), StructureError> {
+        self.validate_modes()?;
+        self.validate_model_and_damping()?;
+        self.validate_points()
+    }
+
+    /// Mode count, frequency floor, a single mode or given modal data.
+    fn validate_modes(&self) -> Result<(), StructureError> {
         count("structure.n_modes", self.n_modes, 1, MAX_MODES)?;
         non_negative(
             "structure.min_frequency_hz",
@@ -1561,6 +1568,11 @@ impl StructureSpec {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The beam or Matrix Market model and the damping.
+    fn validate_model_and_damping(&self) -> Result<(), StructureError> {
         if let Some(b) = &self.beam {
             b.validate()?;
         }
@@ -1592,6 +1604,11 @@ impl StructureSpec {
                 non_negative("structure.damping.rayleigh_beta_s", b, 1.0, "s")?;
             }
         }
+        Ok(())
+    }
+
+    /// The named points: unique names, dofs, on the beam or at a node.
+    fn validate_points(&self) -> Result<(), StructureError> {
         let mut names = std::collections::HashSet::new();
         for (i, p) in self.points.iter().enumerate() {
             let key = format!("structure.points[{i}]");
