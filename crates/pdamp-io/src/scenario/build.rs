@@ -71,13 +71,19 @@ impl Scenario {
                 let (bed, state) = self.read_bed_for_group(g, &path, pl, &grp.material)?;
                 self.check_bed_against_group(g, &path, &bed, count, grp)?;
                 for i in 0..bed.len() {
-                    let m = self.material_index(
-                        &bed.materials[bed.material[i] as usize],
-                        &format!(
-                            "particles[{g}].placement.path: particle {i} of {}",
-                            path.display()
-                        ),
-                    )?;
+                    let m = self
+                        .material_index(
+                            &bed.materials[bed.material[i] as usize],
+                            &format!(
+                                "particles[{g}].placement.path: particle {i} of {}",
+                                path.display()
+                            ),
+                        )
+                        .map_err(|e| {
+                            // located at the key, the particle and file only in the message
+                            let key = format!("particles[{g}].placement.path");
+                            ParameterError::invalid(key, e.to_string())
+                        })?;
                     let id = world.add_particle(bed.position_m[i], bed.radius_m[i], m);
                     world.particles.velocity[id] = bed.velocity_m_s[i];
                     world.particles.angular_velocity[id] = bed.angular_velocity_rad_s[i];
