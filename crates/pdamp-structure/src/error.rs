@@ -205,9 +205,10 @@ pub enum StructureError {
     /// A checkpoint cannot be written or read back (pdamp-io).
     #[error(transparent)]
     Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
-    /// The VTK frames of a coupled run cannot be written (pdamp-io).
+    /// The VTK frames of a coupled run cannot be written (pdamp-io; boxed: a run error carries
+    /// a whole health report).
     #[error(transparent)]
-    Snapshots(#[from] pdamp_io::run::RunError),
+    Snapshots(Box<pdamp_io::run::RunError>),
     /// A checkpoint's world state does not fit the scenario's bed (pdamp-dem).
     #[error(transparent)]
     State(#[from] pdamp_dem::state::StateError),
@@ -223,6 +224,12 @@ fn quoted(path: Option<&Path>) -> String {
     match path {
         Some(p) => format!(" '{}'", p.display()),
         None => String::new(),
+    }
+}
+
+impl From<pdamp_io::run::RunError> for StructureError {
+    fn from(e: pdamp_io::run::RunError) -> Self {
+        StructureError::Snapshots(Box::new(e))
     }
 }
 
