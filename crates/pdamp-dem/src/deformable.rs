@@ -82,7 +82,7 @@ impl World {
         };
         out.clear();
         out.resize(m.num_vertices(), Vec3::zeros());
-        for slots in &self.wall_slots {
+        for slots in &self.pass.wall_slots {
             for s in slots
                 .iter()
                 .filter(|s| s.body as usize == body && s.wall as usize == wall)

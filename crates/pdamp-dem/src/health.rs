@@ -191,7 +191,7 @@ impl World {
         let p = &self.particles;
         // Particle–wall overlaps (from the last force evaluation).
         let mut out = Vec::new();
-        for (i, slots) in self.wall_slots.iter().enumerate() {
+        for (i, slots) in self.pass.wall_slots.iter().enumerate() {
             for s in slots {
                 let b = &self.bodies[s.body as usize];
                 let wall = &b.walls[s.wall as usize];

@@ -99,7 +99,7 @@ impl World {
             counters: self.counters,
             neighbors: self.neighbors.clone(),
             contacts: self.pp_contacts(),
-            wall_slots: self.wall_slots.clone(),
+            wall_slots: self.pass.wall_slots.clone(),
             gear: self.gear.clone(),
             initialized: self.initialized,
         }
@@ -177,8 +177,8 @@ impl World {
         p.external_force.clone_from(&s.external_force);
         self.neighbors = s.neighbors.clone();
         self.set_pp_contacts(&s.contacts);
-        self.wall_slots.clear();
-        self.wall_ref.clear();
+        self.pass.wall_slots.clear();
+        self.pass.wall_ref.clear();
         self.initialized = false;
         Ok(())
     }
@@ -272,9 +272,9 @@ impl World {
         self.counters = s.counters;
         self.neighbors = s.neighbors;
         self.set_pp_contacts(&s.contacts);
-        self.wall_slots = s.wall_slots;
+        self.pass.wall_slots = s.wall_slots;
         // The wall pass visits the candidates and the particles with wall contacts: recompute.
-        self.wall_ref.clear();
+        self.pass.wall_ref.clear();
         self.gear = s.gear;
         self.initialized = s.initialized;
         Ok(())
@@ -429,7 +429,7 @@ mod tests {
     fn wall_candidates_change_nothing() {
         let run = |skip: bool| {
             let mut w = shaken_box(4);
-            w.wall_skip = skip;
+            w.pass.wall_skip = skip;
             let mut wall_contacts = 0;
             for _ in 0..20000 {
                 w.step();
@@ -499,7 +499,7 @@ mod tests {
         };
         w.step();
         // (`block_start` holds the first chunk of every block and the end: at least 2 blocks)
-        assert!(w.block_start.len() > 2, "{:?}", w.block_start);
+        assert!(w.pass.block_start.len() > 2, "{:?}", w.pass.block_start);
         let m_total: f64 = w.particles.mass.iter().sum();
         let (p0, dt, steps) = (momentum(&w), w.dt_s, 8000);
         let (mut f_prev, mut impulse) = (w.bodies[0].contact_force_n, Vec3::zeros());

@@ -2,8 +2,9 @@
 //! 128-byte contact states addressed from the pair list, plus orphans carried over a rebuild
 //! of the neighbour list; collecting and restoring them for checkpoints.
 
+use super::ForcePass;
 use super::state::{NO_CONTACT, PP_CHUNK, PairState};
-use crate::world::World;
+use crate::neighbor::NeighborList;
 
 /// A particle–particle contact that was active (touching, or within the adhesion range) at the
 /// last force evaluation: the partners `i < j` and the contact state.
@@ -84,7 +85,7 @@ impl PpChunk {
     }
 }
 
-impl World {
+impl ForcePass {
     /// Adds the particles that hold wall contacts but are missing from the wall pass's list
     /// (after wall contacts were restored from a backup); keeps the list ascending.
     pub(crate) fn include_wall_holders(&mut self) {
@@ -107,9 +108,12 @@ impl World {
 
     /// All active particle–particle contacts, sorted by `(i, j)`, appended to `out` (those of
     /// partners that no longer exist are dropped).
-    pub(crate) fn collect_pp_contacts(&self, out: &mut Vec<PpContact>) {
-        let nl = &self.neighbors;
-        let n = self.particles.len();
+    pub(crate) fn collect_pp_contacts(
+        &self,
+        nl: &NeighborList,
+        n: usize,
+        out: &mut Vec<PpContact>,
+    ) {
         // The particles the list and the slabs were built for.
         let n_list = nl.row_start.len().saturating_sub(1);
         let start = out.len();
@@ -144,18 +148,10 @@ impl World {
         }
     }
 
-    /// All active particle–particle contacts, sorted by `(i, j)`.
-    pub(crate) fn pp_contacts(&self) -> Vec<PpContact> {
-        let mut v = Vec::new();
-        self.collect_pp_contacts(&mut v);
-        v
-    }
-
     /// Replaces the active particle–particle contacts (sorted by `(i, j)`) and attaches them to
     /// the pairs of the current neighbour list; contacts whose pair is not in the list (or whose
     /// partners no longer exist) are closed by the next force evaluation.
-    pub(crate) fn set_pp_contacts(&mut self, contacts: &[PpContact]) {
-        let n = self.particles.len();
+    pub(crate) fn set_pp_contacts(&mut self, nl: &NeighborList, n: usize, contacts: &[PpContact]) {
         let nchunks = n.div_ceil(PP_CHUNK);
         self.pp_chunks.resize_with(nchunks, PpChunk::default);
         for c in self.pp_chunks.iter_mut() {
@@ -164,7 +160,6 @@ impl World {
             c.free.clear();
             c.orphans.clear();
         }
-        let nl = &self.neighbors;
         let list_ok = nl.row_start.len() == n + 1;
         self.pair_contact.clear();
         self.pair_contact

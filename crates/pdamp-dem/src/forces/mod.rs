@@ -1,16 +1,19 @@
 //! Force evaluation: contact kinematics [D Eq. 2.12–2.27], contact laws, torques [D Eq. 2.86–2.89],
 //! gravity, loads on rigid bodies, and the per-contact work that feeds the energy ledger.
 
-use crate::body::BodyState;
+use crate::body::{BodyState, RigidBody};
 use crate::energy::EnergyIncrements;
-use crate::math::Vec3;
-use crate::world::World;
+use crate::interaction::InteractionTable;
+use crate::math::{Rotation, Vec3};
+use crate::neighbor::NeighborList;
+use crate::particles::ParticleSet;
 use blocks::{BlockAcc, BlockParts, BlockSlices, force_blocks, split_blocks};
 use contacts::fit_contact_store;
 use pair_pass::{PairContext, PairRows};
 use prefetch::prefetch_at;
 use rayon::prelude::*;
 use state::pack_kinematics;
+use wall_repeat::WallRepeat;
 
 mod blocks;
 mod contacts;
@@ -18,8 +21,9 @@ mod pair_pass;
 mod prefetch;
 mod state;
 mod wall_pass;
+pub(crate) mod wall_repeat;
 
-pub(crate) use blocks::{SecondOutput, SecondShares};
+pub(crate) use blocks::SecondShares;
 pub(crate) use contacts::PpChunk;
 pub use contacts::PpContact;
 pub(crate) use pair_pass::PAIR_SCRATCH;
@@ -27,24 +31,121 @@ pub(crate) use state::{Kin, PP_CHUNK};
 pub use state::{PairState, WallSlot};
 pub(crate) use wall_pass::{add_wall_loads, refresh_wall_candidates, wall_contacts_of};
 
-impl World {
-    /// Evaluates all forces and torques at the current state. `dt` is the step that led to this
-    /// state (0 for the initial evaluation): it integrates history variables and contact work.
-    /// Returns the energy increments of this evaluation.
-    pub(crate) fn evaluate_forces(&mut self, dt: f64) -> EnergyIncrements {
-        self.evaluate_forces_with(dt, false)
-    }
+/// The force pass [D Sect. 2.2–2.4]: what it keeps from one evaluation to the next (the contact
+/// history of particle pairs and walls, the block layout of the pair pass, the particles that
+/// may touch a wall) and its scratch. The world owns one and hands it its particles, laws,
+/// neighbour list and bodies ([`ForceInputs`]) at every evaluation.
+#[derive(Debug, Clone)]
+pub(crate) struct ForcePass {
+    /// Active particle–particle contacts, by chunks of first partners, with the pair loop's
+    /// scratch.
+    pub(crate) pp_chunks: Vec<PpChunk>,
+    /// For every neighbour pair: slot of its contact in the slab of the first partner's chunk,
+    /// or `NO_CONTACT`.
+    pub(crate) pair_contact: Vec<u32>,
+    /// The particle–wall contacts of every particle.
+    pub(crate) wall_slots: Vec<Vec<WallSlot>>,
+    /// Outputs of the contacts whose second partner lies in a later block of the pair pass
+    /// (see `force_blocks`): list `b × C + c` holds those of block `b` for chunk `c` (of `C`
+    /// chunks of first partners), in pair-loop order.
+    pub(crate) cross_out: Vec<Vec<blocks::SecondOutput>>,
+    /// Contact force and torque on every rigid body from the wall contacts of each block of
+    /// the pair pass (`K` lists of one entry per body), added in block order.
+    pub(crate) block_loads: Vec<Vec<(Vec3, Vec3)>>,
+    /// First chunk of every block of the pair pass, and the end (`K + 1` entries).
+    pub(crate) block_start: Vec<usize>,
+    /// Block of every chunk of first partners.
+    pub(crate) chunk_block: Vec<u32>,
+    /// Particles that may touch a wall or hold wall contacts, ascending (rebuilt with the
+    /// candidates).
+    pub(crate) wall_list: Vec<u32>,
+    /// Particles that may touch a wall before the candidates are rebuilt (see
+    /// `refresh_wall_candidates`); the others skip the wall search.
+    pub(crate) wall_candidate: Vec<bool>,
+    /// Body poses and neighbour-list build count when the candidates were computed.
+    pub(crate) wall_ref: Vec<(Vec3, Rotation, usize, f64)>,
+    pub(crate) wall_ref_builds: u64,
+    /// Refreshes of the wall candidates since the world was built (diagnostic, not saved).
+    pub(crate) wall_refreshes: u64,
+    /// Use the wall candidates (switched off only by tests comparing both paths).
+    pub(crate) wall_skip: bool,
+    /// Scratch of the contact remap at neighbour-list rebuilds.
+    pub(crate) remap_scratch: Vec<PpContact>,
+    /// The forces and torques being summed (scratch; after [`ForcePass::install_forces`] the
+    /// previous ones).
+    pub(crate) scratch_force: Vec<Vec3>,
+    pub(crate) scratch_torque: Vec<Vec3>,
+    /// Positions and radii packed per particle for the pair loop (scratch).
+    pub(crate) scratch_xr: Vec<[f64; 4]>,
+    /// Velocities, masses and spins packed per particle for the pair loop (scratch).
+    pub(crate) scratch_kin: Vec<Kin>,
+    /// `scratch_xr`/`scratch_kin` hold the current state (packed by the drift of a
+    /// velocity-Verlet step; consumed by the next force evaluation).
+    pub(crate) packed: bool,
+    /// Scratch: the bodies' states over the step being evaluated.
+    pub(crate) scratch_body_step: Vec<BodyState>,
+    /// Scratch: external work and wall energies of every block of the pair pass.
+    pub(crate) scratch_block_out: Vec<(f64, EnergyIncrements)>,
+    /// What a repetition of the last step's particle–wall pass needs (only when switched on
+    /// with `World::set_wall_pass_repeatable`).
+    pub(crate) wall_repeat: Option<Box<WallRepeat>>,
+}
 
-    /// [`World::evaluate_forces`]; with `defer_shares`, the forces and torques that second
-    /// partners receive from earlier blocks of the pair pass are left for the caller to add,
-    /// chunk by chunk, with [`SecondShares`] (before anything reads the forces): the second
-    /// half-kick of velocity Verlet does, one parallel loop less.
-    pub(crate) fn evaluate_forces_with(&mut self, dt: f64, defer_shares: bool) -> EnergyIncrements {
-        let t_pairs = self.tick();
-        let World {
+impl Default for ForcePass {
+    fn default() -> Self {
+        Self {
+            pp_chunks: Vec::new(),
+            pair_contact: Vec::new(),
+            wall_slots: Vec::new(),
+            cross_out: Vec::new(),
+            block_loads: Vec::new(),
+            block_start: Vec::new(),
+            chunk_block: Vec::new(),
+            wall_list: Vec::new(),
+            wall_candidate: Vec::new(),
+            wall_ref: Vec::new(),
+            wall_ref_builds: 0,
+            wall_refreshes: 0,
+            wall_skip: true,
+            remap_scratch: Vec::new(),
+            scratch_force: Vec::new(),
+            scratch_torque: Vec::new(),
+            scratch_xr: Vec::new(),
+            scratch_kin: Vec::new(),
+            packed: false,
+            scratch_body_step: Vec::new(),
+            scratch_block_out: Vec::new(),
+            wall_repeat: None,
+        }
+    }
+}
+
+/// What the force pass reads from the world.
+pub(crate) struct ForceInputs<'a> {
+    pub(crate) particles: &'a ParticleSet,
+    pub(crate) interactions: &'a InteractionTable,
+    pub(crate) neighbors: &'a NeighborList,
+    pub(crate) bodies: &'a [RigidBody],
+    /// Gravitational acceleration, m/s².
+    pub(crate) gravity_m_s2: Vec3,
+}
+
+impl ForcePass {
+    /// The block pass of a force evaluation at the current state: gravity, external loads,
+    /// particle–particle and particle–wall contacts, in parallel over blocks. `dt` is the step
+    /// that led to this state (0 for the initial evaluation): it integrates history variables
+    /// and contact work. The new forces and torques are left in `scratch_force`/
+    /// `scratch_torque` (without the shares of second partners from earlier blocks, see
+    /// [`ForcePass::install_forces`]); returns the number of blocks.
+    pub(crate) fn run_blocks(&mut self, inputs: &ForceInputs, dt: f64) -> usize {
+        let ForceInputs {
             particles: p,
             interactions,
-            neighbors,
+            neighbors: nl,
+            bodies,
+            gravity_m_s2: g,
+        } = *inputs;
+        let ForcePass {
             cross_out,
             block_loads,
             block_start,
@@ -53,8 +154,6 @@ impl World {
             pair_contact,
             pp_chunks,
             wall_slots,
-            bodies,
-            gravity_m_s2,
             wall_candidate,
             wall_ref,
             wall_ref_builds,
@@ -66,11 +165,10 @@ impl World {
             scratch_block_out: block_out,
             packed,
             wall_repeat,
+            scratch_force: force,
+            scratch_torque: torque,
             ..
         } = self;
-        let p = &*p;
-        let interactions = &*interactions;
-        let nl = &*neighbors;
         let n = p.len();
 
         // 1. Particle–particle contacts, in parallel over blocks of chunks of particles (rows
@@ -100,9 +198,6 @@ impl World {
         let kin = &*kin;
         let uniform = interactions.hm_uniform();
         let kernel = crate::hm_block::kernel();
-        let g = *gravity_m_s2;
-        let mut force = std::mem::take(&mut self.scratch_force);
-        let mut torque = std::mem::take(&mut self.scratch_torque);
         force.resize(n, Vec3::zeros());
         torque.resize(n, Vec3::zeros());
         // Walls: the particles that may touch one (a sorted list), handled by the block task
@@ -137,7 +232,6 @@ impl World {
         cross_out.resize_with(nblocks * nchunks, Vec::new);
         block_loads.resize_with(nblocks, Vec::new);
         let block_start = &*block_start;
-        let bodies_ref = &*bodies;
         let wall_list_ref = &*wall_list;
         block_out.clear();
         block_out.resize(nblocks, (0.0, EnergyIncrements::default()));
@@ -172,7 +266,7 @@ impl World {
                 },
                 nl,
                 gravity: g,
-                bodies: bodies_ref,
+                bodies,
                 body_step,
                 wall_list: wall_list_ref,
                 block_start,
@@ -187,25 +281,14 @@ impl World {
                     *result = pass.run(b, part);
                 });
         }
-        self.finish_force_pass(force, torque, nblocks, defer_shares, t_pairs)
+        nblocks
     }
 
-    /// After the block tasks: the shares of second partners from earlier blocks, the earliest
+    /// After the block pass: the shares of second partners from earlier blocks, the earliest
     /// first (or, with `defer_shares`, by the caller, see [`SecondShares`]); the new forces and
-    /// torques swapped in (the old ones kept as scratch); the loads on the bodies and the
-    /// energy increments summed in block order.
-    fn finish_force_pass(
-        &mut self,
-        mut force: Vec<Vec3>,
-        mut torque: Vec<Vec3>,
-        nblocks: usize,
-        defer_shares: bool,
-        t_pairs: Option<std::time::Instant>,
-    ) -> EnergyIncrements {
-        let t_particles = self.profile.map(|_| std::time::Instant::now());
-        if let (Some(pr), Some(t)) = (self.profile.as_mut(), t_pairs) {
-            pr.pair_forces_s += t.elapsed().as_secs_f64();
-        }
+    /// torques swapped into `particles` (the old ones kept as scratch).
+    pub(crate) fn install_forces(&mut self, particles: &mut ParticleSet, defer_shares: bool) {
+        let (force, torque) = (&mut self.scratch_force, &mut self.scratch_torque);
         if !defer_shares {
             let shares = SecondShares {
                 lists: &self.cross_out,
@@ -217,23 +300,14 @@ impl World {
                 .enumerate()
                 .for_each(|(c, (f, t))| shares.add_to_chunk(c, f, t));
         }
-        std::mem::swap(&mut self.particles.force, &mut force);
-        std::mem::swap(&mut self.particles.torque, &mut torque);
-        self.scratch_force = force;
-        self.scratch_torque = torque;
-
-        self.tock(t_particles, |p| &mut p.particle_forces_s);
-        let t_loads = self.tick();
-        self.sum_body_loads(nblocks);
-        let inc = self.sum_increments();
-        self.tock(t_loads, |p| &mut p.energies_s);
-        inc
+        std::mem::swap(&mut particles.force, force);
+        std::mem::swap(&mut particles.torque, torque);
     }
 
     /// The loads on the rigid bodies: the sums of the first `nblocks` blocks of the pair pass
     /// (each in particle order), in block order.
-    pub(crate) fn sum_body_loads(&mut self, nblocks: usize) {
-        for (k, b) in self.bodies.iter_mut().enumerate() {
+    pub(crate) fn sum_body_loads(&self, bodies: &mut [RigidBody], nblocks: usize) {
+        for (k, b) in bodies.iter_mut().enumerate() {
             b.contact_force_n = Vec3::zeros();
             b.contact_torque_nm = Vec3::zeros();
             for l in &self.block_loads[..nblocks] {
@@ -267,9 +341,9 @@ mod tests;
 struct BlockPass<'a> {
     /// Particles, laws and packed kinematics of the pair pass.
     ctx: PairContext<'a>,
-    nl: &'a crate::neighbor::NeighborList,
+    nl: &'a NeighborList,
     gravity: Vec3,
-    bodies: &'a [crate::body::RigidBody],
+    bodies: &'a [RigidBody],
     /// The bodies' poses and velocities over the step.
     body_step: &'a [BodyState],
     /// The particles that may touch a wall, sorted.

@@ -8,8 +8,10 @@ use super::prefetch::{prefetch, prefetch_at};
 use super::state::{Kin, NO_CONTACT, PairState, WallSlot, account};
 use crate::contact::{ContactForce, ContactHistory, ContactKinematics, PairProps};
 use crate::hm_block::{HmInput, HmOutput, HmState, LANES};
+use crate::interaction::InteractionTable;
 use crate::material::{effective_mass, effective_radius};
 use crate::math::{Vec3, tangential_part};
+use crate::particles::ParticleSet;
 use crate::walls::WallContact;
 
 /// Scratch of the pair loop, one per worker thread (kept between steps: no allocation once
@@ -312,7 +314,7 @@ impl PairContext<'_> {
             self.reach,
             self.dt,
         );
-        let (lo, hi, q0) = (rows.lo, rows.hi, rows.q0);
+        let (hi, q0) = (rows.hi, rows.q0);
         let second_c = &rows.second[q0..rows.row_start[hi] as usize];
         let PpChunk {
             slab,
@@ -328,29 +330,7 @@ impl PairContext<'_> {
             ..
         } = scratch;
         // 1. Scan.
-        if scan_pair.len() < second_c.len() {
-            scan_pair.resize(second_c.len(), 0);
-            scan_first.resize(second_c.len(), 0);
-        }
-        // (slices taken once: the loop keeps their bounds in registers instead of reloading
-        // the vectors' headers after every store, 1.5–2 % of a step)
-        let np = second_c.len();
-        let (sp, sf, pcs) = (&mut scan_pair[..np], &mut scan_first[..np], &pc[..np]);
-        let mut na = 0usize;
-        for (i, w) in (lo..hi).zip(rows.row_start[lo..=hi].windows(2)) {
-            let [xi0, xi1, xi2, ri0] = xr[i];
-            let ri = ri0 + reach;
-            let (a, b) = (w[0] as usize - q0, w[1] as usize - q0);
-            for (qq, (&j, &slot)) in (a..b).zip(second_c[a..b].iter().zip(&pcs[a..b])) {
-                let [xj0, xj1, xj2, rj] = xr[j as usize];
-                let (d0, d1, d2) = (xi0 - xj0, xi1 - xj1, xi2 - xj2);
-                let dist2 = (d0 * d0 + d1 * d1) + d2 * d2;
-                let cut = ri + rj;
-                sp[na] = qq as u32;
-                sf[na] = i as u32;
-                na += ((dist2 < cut * cut) | (slot != NO_CONTACT)) as usize;
-            }
-        }
+        let na = scan_pairs(rows, second_c, xr, reach, pc, scan_pair, scan_first);
         // 2. Contacts, in list order.
         let mut sum = (0.0, 0.0, 0.0);
         let mut alloc = |slab: &mut Vec<SlabState>, free: &mut Vec<u32>, i: usize, j: usize| {
@@ -441,16 +421,68 @@ impl PairContext<'_> {
         }
         batch.flush(self.kernel, dt, slab, acc, &mut sum);
         // Contacts that left the neighbour list: close their work integral.
-        for k in orphans.drain(..) {
-            let (i, j) = (k.i as usize, k.j as usize);
-            let d = p.position[i] - p.position[j];
-            let mut st = k.state;
-            let (_, x, y, _) =
-                evaluate_pair(p, interactions, i, j, d, d.norm(), false, &mut st, dt);
-            sum.0 += x;
-            sum.1 += y;
-        }
+        close_orphans(p, interactions, orphans, dt, &mut sum);
         *sums = sum;
+    }
+}
+
+/// The scan of the pair pass: tests every pair of the rows for contact (squared distance
+/// against the sum of the radii plus the adhesion range `reach`) without branching and keeps
+/// the pairs that touch or had a contact (`scan_pair`: index into `second_c`, `scan_first`:
+/// first partner); returns how many.
+#[inline(always)]
+fn scan_pairs(
+    rows: &PairRows,
+    second_c: &[u32],
+    xr: &[[f64; 4]],
+    reach: f64,
+    pc: &[u32],
+    scan_pair: &mut Vec<u32>,
+    scan_first: &mut Vec<u32>,
+) -> usize {
+    let (lo, hi, q0) = (rows.lo, rows.hi, rows.q0);
+    if scan_pair.len() < second_c.len() {
+        scan_pair.resize(second_c.len(), 0);
+        scan_first.resize(second_c.len(), 0);
+    }
+    // (slices taken once: the loop keeps their bounds in registers instead of reloading
+    // the vectors' headers after every store, 1.5–2 % of a step)
+    let np = second_c.len();
+    let (sp, sf, pcs) = (&mut scan_pair[..np], &mut scan_first[..np], &pc[..np]);
+    let mut na = 0usize;
+    for (i, w) in (lo..hi).zip(rows.row_start[lo..=hi].windows(2)) {
+        let [xi0, xi1, xi2, ri0] = xr[i];
+        let ri = ri0 + reach;
+        let (a, b) = (w[0] as usize - q0, w[1] as usize - q0);
+        for (qq, (&j, &slot)) in (a..b).zip(second_c[a..b].iter().zip(&pcs[a..b])) {
+            let [xj0, xj1, xj2, rj] = xr[j as usize];
+            let (d0, d1, d2) = (xi0 - xj0, xi1 - xj1, xi2 - xj2);
+            let dist2 = (d0 * d0 + d1 * d1) + d2 * d2;
+            let cut = ri + rj;
+            sp[na] = qq as u32;
+            sf[na] = i as u32;
+            na += ((dist2 < cut * cut) | (slot != NO_CONTACT)) as usize;
+        }
+    }
+    na
+}
+
+/// Closes the work integral of the contacts that left the neighbour list (`orphans`, emptied):
+/// their force falls to zero; the dissipated work goes to `sum`.
+fn close_orphans(
+    p: &ParticleSet,
+    interactions: &InteractionTable,
+    orphans: &mut Vec<PpContact>,
+    dt: f64,
+    sum: &mut (f64, f64, f64),
+) {
+    for k in orphans.drain(..) {
+        let (i, j) = (k.i as usize, k.j as usize);
+        let d = p.position[i] - p.position[j];
+        let mut st = k.state;
+        let (_, x, y, _) = evaluate_pair(p, interactions, i, j, d, d.norm(), false, &mut st, dt);
+        sum.0 += x;
+        sum.1 += y;
     }
 }
 

@@ -215,27 +215,8 @@ pub(crate) fn wall_contacts_of(
             for c in contacts.iter() {
                 let normal = bs.vector_to_world(&c.normal);
                 let point = bs.point_to_world(&c.point);
-                // Inherit history: same feature first, then the closest normal on the same wall.
-                let mut state = PairState::default();
-                let mut prev_point = point;
-                let mut best: Option<(usize, f64)> = None;
-                for (k, s) in slots.iter().enumerate() {
-                    if s.body as usize == bi && s.wall as usize == wi && s.state.active {
-                        let score = if s.feature == c.feature {
-                            2.0
-                        } else {
-                            s.normal.dot(&normal)
-                        };
-                        if score > 0.9 && best.is_none_or(|(_, b)| score > b) {
-                            best = Some((k, score));
-                        }
-                    }
-                }
-                if let Some((k, _)) = best {
-                    state = slots[k].state;
-                    prev_point = slots[k].point;
-                    slots[k].state.active = false; // consumed
-                }
+                let (state, prev_point) =
+                    inherit_wall_history(slots, (bi, wi), c.feature, &normal, point);
                 fresh.push(WallSlot {
                     body: bi as u16,
                     wall: wi as u16,
@@ -304,7 +285,59 @@ pub(crate) fn wall_contacts_of(
             }
         }
     }
-    // Contacts that ended during this step: close their work integral (force falls to zero).
+    close_ended_wall_contacts(slots, bodies, body_step, (r, &v, &w), dt, inc);
+    // Copied back rather than swapped: every particle keeps its own buffer (allocated once),
+    // so the wall pass reads the same memory step after step.
+    slots.clear();
+    slots.extend_from_slice(fresh);
+}
+
+/// The history a new wall contact inherits from the contacts of the last evaluation on the
+/// same wall (`(body, wall)`): that of the same feature first, otherwise that of the closest
+/// normal (cosine above 0.9), which is consumed; with the previous contact point (`point` for
+/// a fresh contact).
+#[inline]
+fn inherit_wall_history(
+    slots: &mut [WallSlot],
+    (bi, wi): (usize, usize),
+    feature: u32,
+    normal: &Vec3,
+    point: Vec3,
+) -> (PairState, Vec3) {
+    let mut state = PairState::default();
+    let mut prev_point = point;
+    let mut best: Option<(usize, f64)> = None;
+    for (k, s) in slots.iter().enumerate() {
+        if s.body as usize == bi && s.wall as usize == wi && s.state.active {
+            let score = if s.feature == feature {
+                2.0
+            } else {
+                s.normal.dot(normal)
+            };
+            if score > 0.9 && best.is_none_or(|(_, b)| score > b) {
+                best = Some((k, score));
+            }
+        }
+    }
+    if let Some((k, _)) = best {
+        state = slots[k].state;
+        prev_point = slots[k].point;
+        slots[k].state.active = false; // consumed
+    }
+    (state, prev_point)
+}
+
+/// Contacts of the particle (radius `r`, velocity `v`, spin `w`) that ended during this step:
+/// their work integral is closed (the force falls to zero).
+fn close_ended_wall_contacts(
+    slots: &mut [WallSlot],
+    bodies: &[crate::body::RigidBody],
+    body_step: &[BodyState],
+    (r, v, w): (f64, &Vec3, &Vec3),
+    dt: f64,
+    inc: &mut EnergyIncrements,
+) {
+    let (v, w) = (*v, *w);
     for s in slots.iter_mut().filter(|s| s.state.active) {
         let bs = &body_step[s.body as usize];
         let mut v_wall = bs.point_velocity(&s.point);
@@ -331,8 +364,4 @@ pub(crate) fn wall_contacts_of(
         inc.dissipated_normal_pw_j += dn;
         inc.dissipated_tangential_pw_j += dtan;
     }
-    // Copied back rather than swapped: every particle keeps its own buffer (allocated once),
-    // so the wall pass reads the same memory step after step.
-    slots.clear();
-    slots.extend_from_slice(fresh);
 }

@@ -1,6 +1,6 @@
 //! Errors of the packing generators.
 
-use super::lattice::Lattice;
+use super::Lattice;
 use crate::ParameterError;
 
 // ------------------------------------------------------------------------------------------------

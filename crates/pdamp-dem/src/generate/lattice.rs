@@ -1,23 +1,11 @@
 //! Regular packings filled layer by layer from the bottom ([D Fig. 2.2a]): simple cubic
 //! ([`grid_packing`]) and hexagonal close packing ([`tight_packing`]).
 
+use super::Lattice;
 use super::error::PackingError;
 use super::region::{Region, orthonormal_frame};
 use crate::ParameterError;
 use crate::math::Vec3;
-use serde::{Deserialize, Serialize};
-
-/// Lattice of a regular packing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Lattice {
-    /// Simple cubic grid (solid fraction π/6 ≈ 0.524 for equal spheres).
-    SimpleCubic,
-    /// Hexagonal close packing, triangular layers stacked ABAB (π/(3√2) ≈ 0.740).
-    Hcp,
-    /// Face-centred cubic, triangular layers stacked ABC (π/(3√2) ≈ 0.740).
-    Fcc,
-}
 
 /// Relative tolerance (of the spacing) for lattice sites touching the region boundary.
 const LATTICE_TOL: f64 = 1e-9;

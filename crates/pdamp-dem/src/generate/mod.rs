@@ -21,10 +21,22 @@ mod size;
 pub use error::PackingError;
 pub(crate) use insertion::CellGrid;
 pub use insertion::{Layering, random_insertion, random_insertion_clear_of};
-pub use lattice::{Lattice, grid_packing, lattice_sites, tight_packing};
+pub use lattice::{grid_packing, lattice_sites, tight_packing};
 pub use order::{LAYER_TILE_CELLS, layer_order, morton_order};
 pub use region::{Region, orthonormal_frame};
 pub use size::{SizeDistribution, normal_cdf, normal_quantile};
+
+/// Lattice of a regular packing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Lattice {
+    /// Simple cubic grid (solid fraction π/6 ≈ 0.524 for equal spheres).
+    SimpleCubic,
+    /// Hexagonal close packing, triangular layers stacked ABAB (π/(3√2) ≈ 0.740).
+    Hcp,
+    /// Face-centred cubic, triangular layers stacked ABC (π/(3√2) ≈ 0.740).
+    Fcc,
+}
 
 #[cfg(test)]
 mod tests;

@@ -1,10 +1,10 @@
 //! The simulation world: particles, materials, contact models, rigid bodies with walls, and the
 //! time loop state. `World::step` advances by one time step with the chosen integrator.
 
-use crate::body::{BodyState, RigidBody};
+use crate::body::RigidBody;
 use crate::contact::{ContactModel, PairProps};
 use crate::energy::{EnergyIncrements, EnergyLedger};
-use crate::forces::{PpChunk, PpContact, WallSlot};
+use crate::forces::{ForcePass, PpContact, WallSlot};
 use crate::integrate::{GearState, Integrator};
 use crate::interaction::InteractionTable;
 use crate::material::{Material, effective_mass, effective_radius};
@@ -12,6 +12,8 @@ use crate::math::Vec3;
 use crate::neighbor::NeighborList;
 use crate::particles::ParticleSet;
 use rayon::prelude::*;
+
+mod step;
 
 /// Counters of work done, for diagnostics and benchmarks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -69,65 +71,19 @@ pub struct World {
     /// Phase timing, collected when `Some` (see [`PhaseTimes`]).
     pub profile: Option<PhaseTimes>,
     pub(crate) neighbors: NeighborList,
-    /// Outputs of the contacts whose second partner lies in a later block of the pair pass
-    /// (see `force_blocks`): list `b × C + c` holds those of block `b` for chunk `c` (of `C`
-    /// chunks of first partners), in pair-loop order.
-    pub(crate) cross_out: Vec<Vec<crate::forces::SecondOutput>>,
-    /// Contact force and torque on every rigid body from the wall contacts of each block of
-    /// the pair pass (`K` lists of one entry per body), added in block order.
-    pub(crate) block_loads: Vec<Vec<(Vec3, Vec3)>>,
-    /// First chunk of every block of the pair pass, and the end (`K + 1` entries).
-    pub(crate) block_start: Vec<usize>,
-    /// Block of every chunk of first partners.
-    pub(crate) chunk_block: Vec<u32>,
-    /// Particles that may touch a wall or hold wall contacts, ascending (rebuilt with the
-    /// candidates).
-    pub(crate) wall_list: Vec<u32>,
-    /// For every neighbour pair: slot of its contact in the slab of the first partner's chunk,
-    /// or `NO_CONTACT`.
-    pub(crate) pair_contact: Vec<u32>,
-    /// Particles that may touch a wall before the candidates are rebuilt (see
-    /// `refresh_wall_candidates`); the others skip the wall search.
-    pub(crate) wall_candidate: Vec<bool>,
-    /// Body poses and neighbour-list build count when the candidates were computed.
-    pub(crate) wall_ref: Vec<(Vec3, crate::math::Rotation, usize, f64)>,
-    pub(crate) wall_ref_builds: u64,
-    /// Refreshes of the wall candidates since the world was built (diagnostic, not saved).
-    pub(crate) wall_refreshes: u64,
-    /// Use the wall candidates (switched off only by tests comparing both paths).
-    pub(crate) wall_skip: bool,
-    /// Scratch of the contact remap at neighbour-list rebuilds.
-    pub(crate) remap_scratch: Vec<crate::forces::PpContact>,
-    /// Active particle–particle contacts, by chunks of first partners, with the pair loop's
-    /// scratch.
-    pub(crate) pp_chunks: Vec<PpChunk>,
-    pub(crate) wall_slots: Vec<Vec<WallSlot>>,
-    pub(crate) scratch_force: Vec<Vec3>,
+    /// The force pass: contact history of pairs and walls, block layout, wall candidates and
+    /// the pass's scratch (see [`ForcePass`]).
+    pub(crate) pass: ForcePass,
     /// Per-block kinetic and potential energy (scratch of `refresh_state_energies`).
     pub(crate) scratch_energy: Vec<[f64; 2]>,
-    /// Positions and radii packed per particle for the pair loop (scratch).
-    pub(crate) scratch_xr: Vec<[f64; 4]>,
     /// Largest squared displacement since the last neighbour build, per chunk of the drift
     /// (scratch).
     pub(crate) scratch_top: Vec<f64>,
-    /// Scratch: the bodies' states over the step being evaluated.
-    pub(crate) scratch_body_step: Vec<BodyState>,
-    /// Scratch: external work and wall energies of every block of the pair pass.
-    pub(crate) scratch_block_out: Vec<(f64, EnergyIncrements)>,
-    /// Velocities, masses and spins packed per particle for the pair loop (scratch).
-    pub(crate) scratch_kin: Vec<crate::forces::Kin>,
-    pub(crate) scratch_torque: Vec<Vec3>,
     pub(crate) gear: Option<GearState>,
     pub(crate) initialized: bool,
-    /// `scratch_xr`/`scratch_kin` hold the current state (packed by the drift of a
-    /// velocity-Verlet step; consumed by the next force evaluation).
-    pub(crate) packed: bool,
     /// Half the time step of the last velocity-Verlet step while its second half kick is
     /// pending (see [`World::step_deferred`]), s.
     pub(crate) pending_half_kick_s: Option<f64>,
-    /// What a repetition of the last step's particle–wall pass needs (only when switched on
-    /// with [`World::set_wall_pass_repeatable`]).
-    pub(crate) wall_repeat: Option<Box<crate::wall_repeat::WallRepeat>>,
 }
 
 /// Kinetic energy (translation + rotation) and `m g·x` of one particle, J.
@@ -168,33 +124,12 @@ impl World {
             counters: Counters::default(),
             profile: None,
             neighbors: NeighborList::new(0.0),
-            cross_out: Vec::new(),
-            block_loads: Vec::new(),
-            block_start: Vec::new(),
-            chunk_block: Vec::new(),
-            wall_list: Vec::new(),
-            pair_contact: Vec::new(),
-            remap_scratch: Vec::new(),
-            wall_candidate: Vec::new(),
-            wall_ref: Vec::new(),
-            wall_ref_builds: 0,
-            wall_refreshes: 0,
-            wall_skip: true,
-            pp_chunks: Vec::new(),
-            wall_slots: Vec::new(),
-            scratch_force: Vec::new(),
+            pass: ForcePass::default(),
             scratch_energy: Vec::new(),
-            scratch_xr: Vec::new(),
             scratch_top: Vec::new(),
-            scratch_body_step: Vec::new(),
-            scratch_block_out: Vec::new(),
-            scratch_kin: Vec::new(),
-            scratch_torque: Vec::new(),
             gear: None,
             initialized: false,
-            packed: false,
             pending_half_kick_s: None,
-            wall_repeat: None,
         }
     }
 
@@ -231,23 +166,23 @@ impl World {
 
     /// Number of touching particle–particle contacts.
     pub fn num_pp_contacts(&self) -> usize {
-        self.pp_chunks.iter().map(|c| c.len()).sum()
+        self.pass.pp_chunks.iter().map(|c| c.len()).sum()
     }
 
     /// Number of touching particle–wall contacts.
     pub fn num_pw_contacts(&self) -> usize {
-        self.wall_slots.iter().map(|s| s.len()).sum()
+        self.pass.wall_slots.iter().map(|s| s.len()).sum()
     }
 
     /// Refreshes of the particles' wall candidates since the world was built (at neighbour-list
     /// rebuilds and when a body has moved by one skin; not kept in checkpoints).
     pub fn wall_candidate_refreshes(&self) -> u64 {
-        self.wall_refreshes
+        self.pass.wall_refreshes
     }
 
     /// Number of wall contacts of particle `i` at the last evaluation.
     pub fn num_wall_contacts_of(&self, i: usize) -> usize {
-        self.wall_slots.get(i).map_or(0, |s| s.len())
+        self.pass.wall_slots.get(i).map_or(0, |s| s.len())
     }
 
     /// Largest overlap relative to the smaller radius over all particle–particle contacts.
@@ -371,7 +306,34 @@ impl World {
     /// The particle–wall contacts of every particle with their state (see
     /// [`World::particle_contacts`]).
     pub fn wall_contacts(&self) -> &[Vec<WallSlot>] {
-        &self.wall_slots
+        &self.pass.wall_slots
+    }
+
+    /// All active particle–particle contacts, sorted by `(i, j)`, appended to `out` (see
+    /// `ForcePass::collect_pp_contacts`).
+    pub(crate) fn collect_pp_contacts(&self, out: &mut Vec<PpContact>) {
+        self.pass
+            .collect_pp_contacts(&self.neighbors, self.particles.len(), out);
+    }
+
+    /// All active particle–particle contacts, sorted by `(i, j)`.
+    pub(crate) fn pp_contacts(&self) -> Vec<PpContact> {
+        let mut v = Vec::new();
+        self.collect_pp_contacts(&mut v);
+        v
+    }
+
+    /// Replaces the active particle–particle contacts (sorted by `(i, j)`) and attaches them to
+    /// the pairs of the current neighbour list (see `ForcePass::set_pp_contacts`).
+    pub(crate) fn set_pp_contacts(&mut self, contacts: &[PpContact]) {
+        self.pass
+            .set_pp_contacts(&self.neighbors, self.particles.len(), contacts);
+    }
+
+    /// Adds the particles that hold wall contacts but are missing from the wall pass's list
+    /// (after wall contacts were restored from a backup).
+    pub(crate) fn include_wall_holders(&mut self) {
+        self.pass.include_wall_holders();
     }
 
     /// Prepares neighbour lists and evaluates the initial forces (called by the first step).
@@ -397,8 +359,8 @@ impl World {
                 m.max_interaction_gap_m(&props)
             })
             .fold(0.0, f64::max);
-        self.wall_slots.resize(n, Vec::new());
-        self.wall_ref.clear();
+        self.pass.wall_slots.resize(n, Vec::new());
+        self.pass.wall_ref.clear();
         self.neighbors.builds = 0;
         self.update_neighbors();
         for b in self.bodies.iter_mut() {
@@ -453,13 +415,13 @@ impl World {
     fn rebuild_neighbors(&mut self) {
         // Contacts are attached to the pairs of the list: take them off, rebuild, put them
         // back onto the new pairs (in (i, j) order, which also compacts the slabs).
-        let mut contacts = std::mem::take(&mut self.remap_scratch);
+        let mut contacts = std::mem::take(&mut self.pass.remap_scratch);
         contacts.clear();
         self.collect_pp_contacts(&mut contacts);
         self.neighbors
             .rebuild(&self.particles.position, &self.particles.radius);
         self.set_pp_contacts(&contacts);
-        self.remap_scratch = contacts;
+        self.pass.remap_scratch = contacts;
         self.counters.neighbor_builds += 1;
     }
 
@@ -533,7 +495,7 @@ impl World {
                 self.step_gear(&params)
             }
         };
-        if let Some(r) = self.wall_repeat.as_deref_mut() {
+        if let Some(r) = self.pass.wall_repeat.as_deref_mut() {
             r.step_taken(
                 &self.ledger,
                 matches!(self.integrator, Integrator::VelocityVerlet),
