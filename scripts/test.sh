@@ -82,7 +82,8 @@ else
   echo "ERROR: no Python environment with maturin: the Python package was not tested" >&2
   status=1
 fi
-# Lints are part of the tests: clippy with every warning an error (issue 30).
+# Lints are part of the tests: formatting, and clippy with every warning an error (issue 30).
+cargo fmt --all --check || status=$?
 cargo clippy --release --workspace --all-targets -- -D warnings || status=$?
 # … and the API documentation builds without a warning (broken links, unclosed tags).
 RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --workspace || status=$?
