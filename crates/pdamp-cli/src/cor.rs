@@ -113,7 +113,7 @@ pub fn run(a: CorArgs) -> Result<()> {
     let vs = check_cor_request(a.sphere_radius_m, &a.velocities_m_s, model, a.repeat)
         .map_err(flag_error)?;
     let inputs: Vec<&std::path::Path> = a.materials.as_deref().into_iter().collect();
-    let mut dir = crate::open_out(
+    let mut dir = crate::outputs::open_out(
         &a.out,
         false,
         a.overwrite,
