@@ -10,7 +10,7 @@ use pdamp_plot::{LinePlot, Series, line_plot};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Level 3 of [`write_outputs`]: coupled DEM of the best designs (every container its own
+/// Level 3 of [`super::write_outputs`]: coupled DEM of the best designs (every container its own
 /// dropped bed in one run), `dem.csv`, for max_damping `dem_damping_curve.csv` and the DEM
 /// curves in `damping.png`, for the forced objectives `dem_resonance.csv`.
 pub(super) fn dem_level(
