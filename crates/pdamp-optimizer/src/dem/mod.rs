@@ -231,7 +231,7 @@ fn run_one(
 /// Runs the coupled DEM of `d` on `[verification] packings` beds in `out/dem/design_RANK` and
 /// returns the objective of each: the stroke at the evaluation time (min_stroke), or ζ(X) of
 /// every mode from a free decay over the amplitude range (max_damping, one run per mode and
-/// packing, [`DecayPlan`] × [`DEM_DECAY_MARGIN`]), or each mode's resonance from a sine sweep
+/// packing, [`DecayPlan`](crate::fidelity::DecayPlan) × [`DEM_DECAY_MARGIN`]), or each mode's resonance from a sine sweep
 /// (min_frf_peak, max_resonance_damping, [`crate::resonance_sweep`]). `level1` is the design's time-simulation
 /// evaluation (compared in the result). The cost (particles × steps) is reported through
 /// `progress` before the first run.
@@ -571,16 +571,26 @@ fn resonance_sweeps(
             }
         }
     }
-    collect_resonances(
-        result,
-        modes,
-        v.packings,
-        peak_objective,
-        &level1_modes,
-        &plans,
-        &peaks,
-        replanned,
-    );
+    result.resonances = mode_resonances(modes, &level1_modes, &plans, &peaks, replanned);
+    // the objective of every packing: the mean over the modes of the relative peak
+    // (min_frf_peak) or of ζ (max_resonance_damping)
+    let n = modes.len() as f64;
+    result.values = (0..v.packings)
+        .map(|p| {
+            result
+                .resonances
+                .iter()
+                .map(|r| {
+                    if peak_objective {
+                        r.relative_peak[p]
+                    } else {
+                        r.damping_ratio[p]
+                    }
+                })
+                .sum::<f64>()
+                / n
+        })
+        .collect();
     Ok(())
 }
 
@@ -619,24 +629,20 @@ fn plan_resonance_sweeps(
     Ok((plans, level1_modes))
 }
 
-/// Each mode's resonance over the packings (relative peak, ζ, frequency) beside level 1's, and
-/// the objective of every packing: the mean over the modes of the relative peak
-/// (min_frf_peak) or of ζ (max_resonance_damping).
-fn collect_resonances(
-    result: &mut DemVerification,
+/// Each mode's resonance over the packings (relative peak, ζ, frequency) beside level 1's.
+fn mode_resonances(
     modes: &[usize],
-    packings: usize,
-    peak_objective: bool,
     level1_modes: &[Level1Resonance],
     plans: &[SweepPlan],
     peaks: &[Vec<forced::PeakDamping>],
     mut replanned: Vec<Option<String>>,
-) {
+) -> Vec<DemResonance> {
+    let mut resonances = Vec::new();
     for (i, &m) in modes.iter().enumerate() {
         let (steady, zeta, bare) = level1_modes[i];
         let rel_peak: Vec<f64> = peaks[i].iter().map(|p| p.max_amplitude_m / bare).collect();
         let zetas: Vec<f64> = peaks[i].iter().map(|p| p.damping_ratio).collect();
-        result.resonances.push(DemResonance {
+        resonances.push(DemResonance {
             mode: m,
             relative_peak_stat: EnsembleStat::of(&rel_peak),
             relative_peak: rel_peak,
@@ -648,23 +654,7 @@ fn collect_resonances(
             replanned: replanned[i].take(),
         });
     }
-    let n = modes.len() as f64;
-    result.values = (0..packings)
-        .map(|p| {
-            result
-                .resonances
-                .iter()
-                .map(|r| {
-                    if peak_objective {
-                        r.relative_peak[p]
-                    } else {
-                        r.damping_ratio[p]
-                    }
-                })
-                .sum::<f64>()
-                / n
-        })
-        .collect();
+    resonances
 }
 
 /// Reads `decay.csv` or `response.csv` (time_s, displacement_m, …) of a coupled run.

@@ -120,10 +120,10 @@ pub fn write_outputs(
     let d = f.search.detuning;
     let detune = write_robustness(space, &top[0].design, out)?;
     let (mut plot, mut plots) = level1_damping_curves(space, &verified, out)?;
-    if let Some(bh) = &bare_hist {
-        if decay_plot(space, &verified, bh, out)? {
-            plots.push("decay.png");
-        }
+    if let Some(bh) = &bare_hist
+        && decay_plot(space, &verified, bh, out)?
+    {
+        plots.push("decay.png");
     }
     // level 3: coupled DEM on the best designs, an ensemble of dropped beds each
     let dem = dem_level(space, &top, out, &mut plot, &mut plots, progress)?;
