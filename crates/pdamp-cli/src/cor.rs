@@ -10,12 +10,12 @@
 //! - `cor.png` / `cor.svg`: ε over v.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use pdamp_impact::study::{CorError, CorModel, check_cor_request, checked_cor_curve};
-use pdamp_impact::{FeOptions, MaterialSet, MeshDensity, Partner};
+use pdamp_impact::{CorPoint, FeOptions, MaterialSet, MeshDensity, Partner};
 use pdamp_plot::{Axis, LinePlot, Marker, Series, line_plot};
 
 /// Arguments of `pdamp cor`.
@@ -96,24 +96,12 @@ pub fn run(a: CorArgs) -> Result<()> {
     } else {
         Partner::Wall(set.get(&a.wall)?)
     };
-    let density = match a.mesh {
-        MeshArg::Coarse => MeshDensity::Coarse,
-        MeshArg::Medium => MeshDensity::Medium,
-        MeshArg::Fine => MeshDensity::Fine,
-    };
-    let model = match a.model {
-        ModelArg::Fe => CorModel::Fe(FeOptions::with_density(density)),
-        ModelArg::Hertz => CorModel::Hertz,
-        ModelArg::Thornton => CorModel::Thornton {
-            pressure_factor: a.thornton_pressure_factor,
-        },
-        ModelArg::Viscoelastic => CorModel::Viscoelastic,
-    };
+    let model = impact_model(&a);
     // Checked before the output directory is opened: a bad input leaves nothing behind.
     let vs = check_cor_request(a.sphere_radius_m, &a.velocities_m_s, model, a.repeat)
         .map_err(flag_error)?;
     let inputs: Vec<&std::path::Path> = a.materials.as_deref().into_iter().collect();
-    let mut dir = crate::open_out(
+    let mut dir = crate::outputs::open_out(
         &a.out,
         false,
         a.overwrite,
@@ -146,8 +134,50 @@ pub fn run(a: CorArgs) -> Result<()> {
     let elapsed = start.elapsed().as_secs_f64();
 
     let first: Vec<_> = pts.iter().filter(|p| p.impact == 1).collect();
+    write_first_impacts(&a.out, &first)?;
+    write_every_impact(&a.out, &pts)?;
+    plot_cor(&a, &sphere.name, &vs, &pts)?;
+    traced.write(&a.out)?;
+    dir.set_status(pdamp_io::output_dir::RunStatus::Finished);
+    dir.close()?;
+    let fe_times: Vec<f64> = pts
+        .iter()
+        .filter_map(|p| p.fe.as_ref().map(|r| r.wall_time_s))
+        .collect();
+    let summary = serde_json::json!({
+        "out": a.out.display().to_string(),
+        "points": pts.len(),
+        "wall_time_s": elapsed,
+        "mean_run_time_per_impact_s": if fe_times.is_empty() { f64::NAN } else { fe_times.iter().sum::<f64>() / fe_times.len() as f64 },
+        "velocity_m_s": first.iter().map(|p| p.velocity_m_s).collect::<Vec<_>>(),
+        "restitution": first.iter().map(|p| p.restitution).collect::<Vec<_>>(),
+    });
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    Ok(())
+}
+
+/// The impact model of the arguments (the FE model with its mesh density).
+fn impact_model(a: &CorArgs) -> CorModel {
+    let density = match a.mesh {
+        MeshArg::Coarse => MeshDensity::Coarse,
+        MeshArg::Medium => MeshDensity::Medium,
+        MeshArg::Fine => MeshDensity::Fine,
+    };
+    match a.model {
+        ModelArg::Fe => CorModel::Fe(FeOptions::with_density(density)),
+        ModelArg::Hertz => CorModel::Hertz,
+        ModelArg::Thornton => CorModel::Thornton {
+            pressure_factor: a.thornton_pressure_factor,
+        },
+        ModelArg::Viscoelastic => CorModel::Viscoelastic,
+    }
+}
+
+/// `cor.csv` (the first impacts, the ε(v) table) and `gonthier_table.toml` (the same table as a
+/// `gonthier-table` normal law, ε clipped to (0, 1]).
+fn write_first_impacts(out: &Path, first: &[&CorPoint]) -> Result<()> {
     pdamp_io::csv::write_csv_atomic(
-        a.out.join("cor.csv"),
+        out.join("cor.csv"),
         &[
             "velocity_m_s",
             "restitution",
@@ -167,7 +197,7 @@ pub fn run(a: CorArgs) -> Result<()> {
     let mut toml = String::from(
         "# ε(v) from `pdamp cor`; paste into [contact] or a [[contact.pairs]] entry of a scenario\n",
     );
-    let list = |f: &dyn Fn(&pdamp_impact::CorPoint) -> f64| {
+    let list = |f: &dyn Fn(&CorPoint) -> f64| {
         first
             .iter()
             .map(|p| format!("{:?}", f(p)))
@@ -180,9 +210,15 @@ pub fn run(a: CorArgs) -> Result<()> {
         list(&|p| p.velocity_m_s),
         list(&|p| p.restitution.clamp(1e-6, 1.0))
     );
-    pdamp_io::atomic::write_atomic(a.out.join("gonthier_table.toml"), toml.as_bytes())?;
+    pdamp_io::atomic::write_atomic(out.join("gonthier_table.toml"), toml.as_bytes())?;
+    Ok(())
+}
+
+/// `cor_all.csv` (every impact with the FE energy split) and the FE force histories
+/// `force_v<V>_i<K>.csv`.
+fn write_every_impact(out: &Path, pts: &[CorPoint]) -> Result<()> {
     pdamp_io::csv::write_csv_atomic(
-        a.out.join("cor_all.csv"),
+        out.join("cor_all.csv"),
         &[
             "velocity_m_s",
             "impact",
@@ -237,17 +273,21 @@ pub fn run(a: CorArgs) -> Result<()> {
             row
         }),
     )?;
-    for p in &pts {
+    for p in pts {
         if let Some(r) = &p.fe {
             pdamp_io::csv::write_csv_atomic(
-                a.out
-                    .join(format!("force_v{}_i{}.csv", p.velocity_m_s, p.impact)),
+                out.join(format!("force_v{}_i{}.csv", p.velocity_m_s, p.impact)),
                 &["time_s", "force_n"],
                 r.force_history.iter().map(|&(t, f)| [t, f]),
             )?;
         }
     }
-    // plot
+    Ok(())
+}
+
+/// `cor.png` / `cor.svg`: ε over v, one series per impact number (a log velocity axis where
+/// the velocities span more than a factor 20).
+fn plot_cor(a: &CorArgs, sphere_name: &str, vs: &[f64], pts: &[CorPoint]) -> Result<()> {
     let mut plot = LinePlot::new(
         if vs.len() > 1 && vs[vs.len() - 1] / vs[0] > 20.0 {
             Axis::log("impact velocity (m/s)")
@@ -258,7 +298,7 @@ pub fn run(a: CorArgs) -> Result<()> {
     );
     plot.title = format!(
         "{} sphere r = {} mm on {}",
-        sphere.name,
+        sphere_name,
         a.sphere_radius_m * 1e3,
         a.wall
     );
@@ -277,21 +317,5 @@ pub fn run(a: CorArgs) -> Result<()> {
             .push(Series::new(label, x, y).with_marker(Marker::Circle));
     }
     line_plot(a.out.join("cor"), &plot)?;
-    traced.write(&a.out)?;
-    dir.set_status(pdamp_io::output_dir::RunStatus::Finished);
-    dir.close()?;
-    let fe_times: Vec<f64> = pts
-        .iter()
-        .filter_map(|p| p.fe.as_ref().map(|r| r.wall_time_s))
-        .collect();
-    let summary = serde_json::json!({
-        "out": a.out.display().to_string(),
-        "points": pts.len(),
-        "wall_time_s": elapsed,
-        "mean_run_time_per_impact_s": if fe_times.is_empty() { f64::NAN } else { fe_times.iter().sum::<f64>() / fe_times.len() as f64 },
-        "velocity_m_s": first.iter().map(|p| p.velocity_m_s).collect::<Vec<_>>(),
-        "restitution": first.iter().map(|p| p.restitution).collect::<Vec<_>>(),
-    });
-    println!("{}", serde_json::to_string_pretty(&summary)?);
     Ok(())
 }

@@ -268,7 +268,7 @@ pub fn run(args: PowderArgs) -> Result<()> {
             let sc = load(&scenario)?;
             let traced = crate::Traced::start(Some(&scenario), study::seed_of(&sc));
             let options = ck.options()?;
-            let mut dir = crate::open_out(
+            let mut dir = crate::outputs::open_out(
                 &out,
                 ck.resume,
                 ck.overwrite,

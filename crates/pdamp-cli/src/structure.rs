@@ -102,7 +102,7 @@ pub struct CoupleArgs {
     overwrite: bool,
 }
 
-/// Runs `work` with `out` opened for it (see [`crate::open_out`]): the manifest records how it
+/// Runs `work` with `out` opened for it (see [`crate::outputs::open_out`]): the manifest records how it
 /// ended; a failure that wrote nothing leaves no directory.
 pub(crate) fn in_out_dir<T>(
     out: &std::path::Path,
@@ -112,7 +112,7 @@ pub(crate) fn in_out_dir<T>(
     input: &std::path::Path,
     work: impl FnOnce() -> Result<T>,
 ) -> Result<T> {
-    let mut dir = crate::open_out(
+    let mut dir = crate::outputs::open_out(
         out,
         resume,
         overwrite,

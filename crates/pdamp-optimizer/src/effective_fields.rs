@@ -24,6 +24,7 @@
 use crate::DesignError;
 use crate::fidelity::Evaluation;
 use crate::space::{Design, Space};
+use crate::spec::VerificationSpec;
 use crate::study::ObjectiveSpec;
 use pdamp_design::ensemble::EnsembleStat;
 use pdamp_structure::effective::FieldTable;
@@ -178,7 +179,7 @@ fn damper_range_m(
     if !(a.is_finite() && b.is_finite() && b > a) {
         return Err(DesignError::Solver(format!(
             "{}: no amplitude range for the field of mode {} ({a:e} … {b:e} m at the damper)",
-            crate::report::describe(space, d),
+            crate::design_scenario::describe(space, d),
             k + 1
         )));
     }
@@ -227,22 +228,8 @@ fn field_scenario(
         "check_impact_velocity_m_s",
         toml::Value::Float(velocity),
     );
-    if let Some(toml::Value::Table(dm)) = table.get_mut("damper") {
-        dm.insert("frequency_hz".into(), toml::Value::Float(frequency_hz));
-        dm.insert("amplitude_m".into(), toml::Value::Float(range.1));
-        dm.insert("cycles".into(), toml::Value::Integer(v.field_cycles.into()));
-        dm.insert(
-            "transient_cycles".into(),
-            toml::Value::Integer(v.field_transient_cycles.into()),
-        );
-        dm.insert("packings".into(), toml::Value::Integer(v.packings as i64));
-    }
-    let fields: toml::Table = toml::from_str(&format!(
-        "frequencies_hz = [{frequency_hz:e}]\namplitudes_m = {{ from = {:e}, to = {:e}, count = \
-         {}, spacing = \"log\" }}\n",
-        range.0, range.1, v.field_amplitudes
-    ))
-    .map_err(|e| DesignError::Solver(format!("field scenario: {e}")))?;
+    set_field_excitation(&mut table, v, frequency_hz, range.1);
+    let fields = fields_grid(frequency_hz, range, v.field_amplitudes)?;
     table.insert("fields".into(), toml::Value::Table(fields));
     let body =
         toml::to_string(&table).map_err(|e| DesignError::Solver(format!("field scenario: {e}")))?;
@@ -250,10 +237,46 @@ fn field_scenario(
         format!(
             "# Effective field (level 2) of a design of {} (pdamp design):\n# {}\n{body}",
             space.study.path.display(),
-            crate::report::describe(space, d)
+            crate::design_scenario::describe(space, d)
         ),
         dt,
     ))
+}
+
+/// The field's excitation in the damper scenario's `[damper]`: one frequency at the top
+/// amplitude `amplitude_m`, the field's cycles and the packings.
+fn set_field_excitation(
+    table: &mut toml::Table,
+    v: &VerificationSpec,
+    frequency_hz: f64,
+    amplitude_m: f64,
+) {
+    if let Some(toml::Value::Table(dm)) = table.get_mut("damper") {
+        dm.insert("frequency_hz".into(), toml::Value::Float(frequency_hz));
+        dm.insert("amplitude_m".into(), toml::Value::Float(amplitude_m));
+        dm.insert("cycles".into(), toml::Value::Integer(v.field_cycles.into()));
+        dm.insert(
+            "transient_cycles".into(),
+            toml::Value::Integer(v.field_transient_cycles.into()),
+        );
+        dm.insert("packings".into(), toml::Value::Integer(v.packings as i64));
+    }
+}
+
+/// The `[fields]` grid of a field scenario: one frequency and `count` log-spaced amplitudes over
+/// `range`.
+fn fields_grid(
+    frequency_hz: f64,
+    range: (f64, f64),
+    count: usize,
+) -> Result<toml::Table, DesignError> {
+    toml::from_str(&format!(
+        "frequencies_hz = [{frequency_hz:e}]\namplitudes_m = {{ from = {:e}, to = {:e}, count = \
+         {}, spacing = \"log\" \
+         }}\n",
+        range.0, range.1, count
+    ))
+    .map_err(|e| DesignError::Solver(format!("field scenario: {e}")))
 }
 
 /// Folder of a damper's fields in the store: the digest of its scenario without the grid, the
@@ -317,30 +340,11 @@ pub fn evaluate_design(
     let st = space.study;
     let v = &st.file.verification;
     let store = store_dir(space, out);
-    let structure = space.structure(d.choice);
     let particles: usize = d.particles.iter().sum();
     let bed_mass = space.bed_mass_kg(d) / space.location(d.choice).points.len() as f64;
     let modes = field_modes(space);
     // the scenarios first: the cost is announced before anything runs
-    let mut plans = Vec::new();
-    let mut steps = 0.0;
-    let mut dt_max = 0.0_f64;
-    for &k in &modes {
-        let f = structure.modes[k].frequency_hz;
-        let range = damper_range_m(space, d, level1, k)?;
-        let (scenario, dt) = field_scenario(space, d, f, range)?;
-        let dir = damper_dir(&store, &scenario)?.join(format!("field_{f:.4}Hz"));
-        let pending = (0..v.packings)
-            .map(|p| packing_dir(&dir, v.packings, p))
-            .flat_map(|pd| {
-                (0..v.field_amplitudes).map(move |j| pdamp_design::fields::point_path(&pd, 0, j))
-            })
-            .filter(|path| !path.exists())
-            .count() as f64;
-        steps += pending * f64::from(v.field_cycles) / (f * dt) * particles as f64;
-        dt_max = dt_max.max(dt);
-        plans.push((k, f, range, scenario, dir));
-    }
+    let (plans, steps, dt_max) = plan_fields(space, d, level1, &store, &modes)?;
     let coating = st.file.damper.coatings[d.choice.coating].clone();
     progress(&format!(
         "level 2, design {level1_rank} ({coating}): effective fields of {} mode(s), {} \
@@ -436,6 +440,65 @@ pub fn evaluate_design(
         tables.push((k, t));
     }
     // the objective with every packing's fields
+    let (values, per_mode) = objective_with_fields(space, d, &tables)?;
+    let n_modes = per_mode.first().map_or(0, |v| v.len());
+    result.stat = EnsembleStat::of(&values);
+    result.values = values;
+    result.per_mode = (0..n_modes)
+        .map(|k| EnsembleStat::of(&per_mode.iter().map(|v| v[k]).collect::<Vec<_>>()))
+        .collect();
+    result.wall_s = started.elapsed().as_secs_f64();
+    Ok(result)
+}
+
+/// A mode's field to compute: the 0-based mode, its frequency (Hz), the damper's amplitude
+/// range (m), the field scenario and its folder in the store.
+type FieldPlan = (usize, f64, (f64, f64), String, PathBuf);
+
+/// The field scenario of every mode of design `d` and the cost of the points not yet in the
+/// store: the plans, the particle-steps to run and the largest DEM time step.
+fn plan_fields(
+    space: &Space,
+    d: &Design,
+    level1: &Evaluation,
+    store: &Path,
+    modes: &[usize],
+) -> Result<(Vec<FieldPlan>, f64, f64), DesignError> {
+    let v = &space.study.file.verification;
+    let structure = space.structure(d.choice);
+    let particles: usize = d.particles.iter().sum();
+    let mut plans = Vec::new();
+    let mut steps = 0.0;
+    let mut dt_max = 0.0_f64;
+    for &k in modes {
+        let f = structure.modes[k].frequency_hz;
+        let range = damper_range_m(space, d, level1, k)?;
+        let (scenario, dt) = field_scenario(space, d, f, range)?;
+        let dir = damper_dir(store, &scenario)?.join(format!("field_{f:.4}Hz"));
+        let pending = (0..v.packings)
+            .map(|p| packing_dir(&dir, v.packings, p))
+            .flat_map(|pd| {
+                (0..v.field_amplitudes).map(move |j| pdamp_design::fields::point_path(&pd, 0, j))
+            })
+            .filter(|path| !path.exists())
+            .count() as f64;
+        steps += pending * f64::from(v.field_cycles) / (f * dt) * particles as f64;
+        dt_max = dt_max.max(dt);
+        plans.push((k, f, range, scenario, dir));
+    }
+    Ok((plans, steps, dt_max))
+}
+
+/// The objective with every packing's fields (each mode coupled to its own field at every
+/// container point): the shown value and the per-mode values of every packing.
+fn objective_with_fields(
+    space: &Space,
+    d: &Design,
+    tables: &[(usize, Vec<FieldTable>)],
+) -> Result<(Vec<f64>, Vec<Vec<f64>>), DesignError> {
+    let st = space.study;
+    let v = &st.file.verification;
+    let structure = space.structure(d.choice);
     let mut values = Vec::new();
     let mut per_mode: Vec<Vec<f64>> = Vec::new();
     for p in 0..v.packings {
@@ -468,14 +531,7 @@ pub fn evaluate_design(
         };
         per_mode.push(pm);
     }
-    let n_modes = per_mode.first().map_or(0, |v| v.len());
-    result.stat = EnsembleStat::of(&values);
-    result.values = values;
-    result.per_mode = (0..n_modes)
-        .map(|k| EnsembleStat::of(&per_mode.iter().map(|v| v[k]).collect::<Vec<_>>()))
-        .collect();
-    result.wall_s = started.elapsed().as_secs_f64();
-    Ok(result)
+    Ok((values, per_mode))
 }
 
 /// Largest 95 % half-width of η̄ over the grid points of the packings' tables.

@@ -24,6 +24,7 @@
 #![forbid(unsafe_code)]
 
 pub mod dem;
+mod design_scenario;
 pub mod effective_fields;
 mod error;
 pub mod fidelity;

@@ -129,8 +129,14 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<SweepManifest> {
             })
             .collect(),
     };
-    let inputs = crate::scenario_inputs(scenario, &sc);
-    install(scenario, out, manifest, &inputs, &crate::RUN_OUTPUTS)
+    let inputs = crate::outputs::scenario_inputs(scenario, &sc);
+    install(
+        scenario,
+        out,
+        manifest,
+        &inputs,
+        &crate::outputs::RUN_OUTPUTS,
+    )
 }
 
 /// What the store holds for a task of a field sweep.

@@ -302,7 +302,7 @@ fn install(
     )?;
     let text = std::fs::read_to_string(scenario)?;
     let m = SweepManifest::create_or_open(out, manifest, &text)?;
-    crate::copy_input(out, scenario)?;
+    crate::outputs::copy_input(out, scenario)?;
     dir.close()?;
     Ok(m)
 }
@@ -609,7 +609,7 @@ pub(crate) fn collect(dir: &Path) -> Result<()> {
     let mut out_dir = pdamp_io::output_dir::OutputDir::open(
         dir,
         pdamp_io::output_dir::OutputMode::Continue,
-        &crate::RUN_OUTPUTS,
+        &crate::outputs::RUN_OUTPUTS,
         &[],
     )?;
     let start = std::time::Instant::now();

@@ -13,17 +13,22 @@
 //! every output of a coupled DEM run (decay.csv, damping.csv, the energy exchange, ParaView
 //! frames) lies in `dem/design_N/packing_K/out/`.
 
+mod scenarios;
+
 use crate::DesignError;
-use crate::fidelity::DecayPlan;
 use crate::resonance_sweep::{SweepPlan, SweepTarget};
 use crate::space::{Design, Space};
-use crate::study::{Direction, ObjectiveSpec};
+use crate::study::ObjectiveSpec;
 use pdamp_dem::contact::hertz::hertz_contact_time;
 use pdamp_design::ensemble::EnsembleStat;
 use pdamp_structure::forced;
+use pdamp_structure::free::CoupledDamper;
+use pdamp_structure::modal::ModalStructure;
+use scenarios::{container_seed, damper_file};
 use serde::Serialize;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+pub use scenarios::{couple_scenario, damper_scenario, decay_scenario, sweep_scenario};
 
 /// One design's coupled-DEM result.
 #[derive(Debug, Clone, Serialize)]
@@ -169,366 +174,6 @@ pub fn time_step_at_s(space: &Space, d: &Design, velocity_m_s: f64) -> f64 {
     0.08 * pair.min(wall)
 }
 
-fn plane(
-    s: &mut String,
-    name: &str,
-    material: &str,
-    point: [f64; 3],
-    normal: [f64; 3],
-    two_sided: bool,
-) {
-    let _ = writeln!(
-        s,
-        "[[bodies.walls]]\nname = \"{name}\"\nmaterial = \"{material}\"\ngeometry = {{ type = \
-         \"plane\", point_m = [{:e}, {:e}, {:e}], normal = [{}, {}, {}], two_sided = {two_sided} \
-         }}\n",
-        point[0], point[1], point[2], normal[0], normal[1], normal[2]
-    );
-}
-
-/// The six walls of a box container, x ∈ [−a/2, a/2], y ∈ [−b/2, b/2], z ∈ [0, c], as one-sided
-/// planes facing inwards; the two walls normal to the excitation (x for a horizontal
-/// container, z for a vertical one) of material `impacted`, the others of the container's.
-fn box_walls(s: &mut String, a: f64, b: f64, c: f64, vertical: bool, impacted: &str) {
-    let (xm, zm) = if vertical {
-        ("container", impacted)
-    } else {
-        (impacted, "container")
-    };
-    plane(
-        s,
-        "wall_x-",
-        xm,
-        [-a / 2.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        false,
-    );
-    plane(
-        s,
-        "wall_x+",
-        xm,
-        [a / 2.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        false,
-    );
-    plane(
-        s,
-        "wall_y-",
-        "container",
-        [0.0, -b / 2.0, 0.0],
-        [0.0, 1.0, 0.0],
-        false,
-    );
-    plane(
-        s,
-        "wall_y+",
-        "container",
-        [0.0, b / 2.0, 0.0],
-        [0.0, -1.0, 0.0],
-        false,
-    );
-    plane(s, "floor", zm, [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false);
-    plane(s, "lid", zm, [0.0, 0.0, c], [0.0, 0.0, -1.0], false);
-}
-
-/// The damper scenario of a design (TOML), for packing seed `seed`.
-pub fn damper_scenario(space: &Space, d: &Design, seed: u64) -> String {
-    let st = space.study;
-    let f = &st.file;
-    let v = &f.verification;
-    let g = space.geometry(d.choice);
-    let m = &f.materials[d.choice.material];
-    let dt = time_step_s(space, d);
-    let vcheck = check_velocity_m_s(space, d);
-    let k = st.free.mode;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Coupled-DEM verification of a design of {} (pdamp design):\n# {}\n\
-         title = \"pdamp design verification\"\n\n[simulation]\nduration_s = 0.0\n\
-         time_step_s = {dt:e}\ngravity_m_s2 = [0.0, 0.0, -9.81]\nseed = {seed}\n\
-         check_impact_velocity_m_s = {vcheck}\n",
-        st.path.display(),
-        crate::report::describe(space, d)
-    );
-    let _ = writeln!(
-        s,
-        "[[materials]]\nname = \"particle\"\ndensity_kg_m3 = {}\nyoungs_modulus_pa = {:e}\n\
-         poisson_ratio = {}\n\n[[materials]]\nname = \"container\"\ndensity_kg_m3 = {}\n\
-         youngs_modulus_pa = {:e}\npoisson_ratio = {}\n",
-        m.density_kg_m3,
-        m.youngs_modulus_pa * v.youngs_modulus_scale,
-        m.poisson_ratio,
-        v.container.density_kg_m3,
-        v.container.youngs_modulus_pa,
-        v.container.poisson_ratio
-    );
-    let _ = writeln!(
-        s,
-        "[contact]\nnormal = {{ law = \"gonthier\", restitution = {}, min_impact_velocity_m_s = \
-         0.05 }}\nfriction = {{ law = \"regularized-sliding\", friction_coefficient = {}, \
-         regularization_s_m = 1000.0 }}\n\n[[contact.pairs]]\nmaterials = [\"particle\", \
-         \"container\"]\nnormal = {{ law = \"gonthier\", restitution = {}, \
-         min_impact_velocity_m_s = 0.05 }}\nfriction = {{ law = \"regularized-sliding\", \
-         friction_coefficient = {}, regularization_s_m = 1000.0 }}\n",
-        m.restitution, m.friction, m.wall_restitution, m.friction
-    );
-    let coating = st.coating(d.choice.coating);
-    let impacted = if let Some(c) = coating {
-        let _ = writeln!(
-            s,
-            "# end walls coated with {}: a half-space of its modulus (D Eq. 8.3–8.11)\n\
-             [[materials]]\nname = \"coating\"\ndensity_kg_m3 = {}\nyoungs_modulus_pa = {:e}\n\
-             poisson_ratio = {}\n\n[[contact.pairs]]\nmaterials = [\"particle\", \"coating\"]\n\
-             normal = {{ law = \"gonthier\", restitution = {}, min_impact_velocity_m_s = 0.05 }}\n\
-             friction = {{ law = \"regularized-sliding\", friction_coefficient = {}, \
-             regularization_s_m = 1000.0 }}\n",
-            c.name,
-            c.density_kg_m3,
-            c.youngs_modulus_pa,
-            c.poisson_ratio,
-            c.restitution,
-            m.friction
-        );
-        "coating"
-    } else {
-        "container"
-    };
-    let _ = writeln!(s, "[[bodies]]\nname = \"container\"\n");
-    let (l, w) = (g.length_m, f.damper.container_width_m);
-    let direction;
-    let mut groups: Vec<(usize, [f64; 3], [f64; 3])> = Vec::new();
-    let settle_gravity;
-    match space.location(d.choice).direction {
-        Direction::Horizontal => {
-            let h = match f.damper.container_height_m {
-                Some(height) => height / d.particles.len() as f64,
-                None => v.layer_height_m.unwrap_or(2.2 * g.radius_m),
-            };
-            let top = h * d.particles.len() as f64;
-            box_walls(&mut s, l, w, top, false, impacted);
-            for i in 1..d.particles.len() {
-                plane(
-                    &mut s,
-                    &format!("shelf_{i}"),
-                    "container",
-                    [0.0, 0.0, i as f64 * h],
-                    [0.0, 0.0, 1.0],
-                    true,
-                );
-            }
-            for (i, &n) in d.particles.iter().enumerate() {
-                if n > 0 {
-                    groups.push((
-                        n,
-                        [-l / 2.0, -w / 2.0, i as f64 * h],
-                        [l / 2.0, w / 2.0, (i + 1) as f64 * h],
-                    ));
-                }
-            }
-            direction = [1.0, 0.0, 0.0];
-            settle_gravity = Some([-9.81, 0.0, 0.0]);
-        }
-        Direction::Vertical => {
-            let depth = f.damper.container_depth_m.unwrap_or(w);
-            box_walls(&mut s, w, depth, l, true, impacted);
-            groups.push((
-                d.particles[0],
-                [-w / 2.0, -depth / 2.0, 0.0],
-                [w / 2.0, depth / 2.0, l],
-            ));
-            direction = [0.0, 0.0, 1.0];
-            settle_gravity = None;
-        }
-    }
-    for (n, lo, hi) in groups {
-        let _ = writeln!(
-            s,
-            "[[particles]]\nmaterial = \"particle\"\ncount = {n}\nsize = {{ type = \
-             \"monodisperse\", radius_m = {:e} }}\nplacement = {{ method = \"drop_down\", region \
-             = {{ type = \"box\", min_m = [{:e}, {:e}, {:e}], max_m = [{:e}, {:e}, {:e}] }} }}\n",
-            g.radius_m, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
-        );
-    }
-    let _ = writeln!(
-        s,
-        "[settle]\nmax_duration_s = 1.0\nkinetic_energy_per_particle_j = 1e-9{}\n",
-        settle_gravity.map_or(String::new(), |g| format!(
-            "\ngravity_m_s2 = [{}, {}, {}]\nturn_max_duration_s = 0.5",
-            g[0], g[1], g[2]
-        ))
-    );
-    let freq = space.structure(d.choice).modes[k].frequency_hz;
-    let _ = writeln!(
-        s,
-        "[damper]\ncontainer_body = \"container\"\ncontainer_mass_kg = 0.0\ndirection = [{}, {}, \
-         {}]\nfrequency_hz = {freq}\namplitude_m = {:e}\ncycles = 2\ntransient_cycles = 1",
-        direction[0],
-        direction[1],
-        direction[2],
-        st.free.initial_displacement_m.abs().max(1e-6)
-    );
-    s
-}
-
-/// The damper scenario file of container `j` (0-based) of a design's run: `damper.toml`, then
-/// `damper_2.toml`, … beside the coupling scenario.
-fn damper_file(j: usize) -> String {
-    if j == 0 {
-        "damper.toml".into()
-    } else {
-        format!("damper_{}.toml", j + 1)
-    }
-}
-
-/// The drop seed of container `j` of the packing with seed `seed`: the packing's own for the
-/// first container, independent ones for the others (never another packing's).
-fn container_seed(seed: u64, j: usize) -> u64 {
-    if j == 0 {
-        seed
-    } else {
-        seed ^ (j as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-    }
-}
-
-/// Replaces a coupling scenario's dampers by the design's DEM beds, one per container at its
-/// point ([`damper_file`] beside it).
-fn set_dem_damper(space: &Space, d: &Design, table: &mut toml::Table) {
-    let dampers = space
-        .location(d.choice)
-        .points
-        .iter()
-        .enumerate()
-        .map(|(j, point)| {
-            let mut damper = toml::Table::new();
-            damper.insert("model".into(), toml::Value::String("dem".into()));
-            damper.insert("point".into(), toml::Value::String(point.clone()));
-            damper.insert("scenario".into(), toml::Value::String(damper_file(j)));
-            toml::Value::Table(damper)
-        })
-        .collect();
-    table.insert("dampers".into(), toml::Value::Array(dampers));
-}
-
-/// Sampling interval (DEM steps) for about 4000 samples of a decay of `duration_s`.
-fn sample_every(space: &Space, d: &Design, duration_s: f64) -> i64 {
-    ((duration_s / time_step_s(space, d)) / 4000.0)
-        .floor()
-        .max(1.0) as i64
-}
-
-/// The coupling scenario of a design's DEM run (TOML): the study's structure and free analysis
-/// (duration = the evaluation time) with the DEM damper at the design's point.
-pub fn couple_scenario(
-    space: &Space,
-    d: &Design,
-    evaluate_at_s: f64,
-) -> Result<String, DesignError> {
-    let mut table = crate::report::scenario_table(space, d)?;
-    set_dem_damper(space, d, &mut table);
-    if let Some(toml::Value::Table(a)) = table.get_mut("analysis") {
-        a.insert("duration_s".into(), toml::Value::Float(evaluate_at_s));
-        a.insert(
-            "sample_every".into(),
-            toml::Value::Integer(sample_every(space, d, evaluate_at_s)),
-        );
-    }
-    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
-}
-
-/// The study's coupling scenario with the structure replaced by `s` written inline as
-/// `[structure.modal]` (a structure reduced to one mode) and the DEM damper at the design's
-/// point; the caller sets `[analysis]`.
-fn single_mode_table(
-    space: &Space,
-    d: &Design,
-    s: &pdamp_structure::modal::ModalStructure,
-) -> Result<toml::Table, DesignError> {
-    let mut table = crate::report::scenario_table(space, d)?;
-    table.remove("structure_file");
-    let points: Vec<toml::Value> = s
-        .points
-        .iter()
-        .map(|p| {
-            let mut t = toml::Table::new();
-            t.insert("name".into(), toml::Value::String(p.name.clone()));
-            t.insert(
-                "shape".into(),
-                toml::Value::Array(p.shape.iter().map(|&v| toml::Value::Float(v)).collect()),
-            );
-            toml::Value::Table(t)
-        })
-        .collect();
-    let floats = |v: Vec<f64>| toml::Value::Array(v.into_iter().map(toml::Value::Float).collect());
-    let mut modal = toml::Table::new();
-    modal.insert(
-        "frequencies_hz".into(),
-        floats(s.modes.iter().map(|m| m.frequency_hz).collect()),
-    );
-    modal.insert(
-        "damping_ratios".into(),
-        floats(s.modes.iter().map(|m| m.damping_ratio).collect()),
-    );
-    modal.insert("points".into(), toml::Value::Array(points));
-    let mut structure = toml::Table::new();
-    structure.insert("n_modes".into(), toml::Value::Integer(1));
-    structure.insert("modal".into(), toml::Value::Table(modal));
-    table.insert("structure".into(), toml::Value::Table(structure));
-    set_dem_damper(space, d, &mut table);
-    Ok(table)
-}
-
-/// The coupling scenario of a design's damping decay in one mode (max_damping, TOML): the
-/// [`DecayPlan`]'s single-mode structure written inline as `[structure.modal]`, its free
-/// analysis over `duration_s`, and the DEM damper at the design's point.
-pub fn decay_scenario(
-    space: &Space,
-    d: &Design,
-    plan: &DecayPlan,
-    duration_s: f64,
-) -> Result<String, DesignError> {
-    let mut table = single_mode_table(space, d, &plan.structure)?;
-    let f = &plan.spec;
-    let every = sample_every(space, d, duration_s);
-    let analysis: toml::Table = toml::from_str(&format!(
-        "kind = \"free\"\nduration_s = {duration_s:e}\ntime_step_s = {:e}\nmode = 1\n\
-         initial_point = \"{}\"\ninitial_displacement_m = {:e}\noutput_point = \"{}\"\n\
-         sample_every = {every}\n",
-        f.time_step_s, f.initial_point, f.initial_displacement_m, f.output_point
-    ))
-    .map_err(|e| DesignError::Solver(e.to_string()))?;
-    table.insert("analysis".into(), toml::Value::Table(analysis));
-    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
-}
-
-/// The coupling scenario of a design's resonance sweep in one mode (forced objectives, TOML):
-/// the [`SweepPlan`]'s single-mode structure inline, its sweep (`kind = "sweep"`, sampled
-/// [`crate::resonance_sweep::SAMPLES_PER_PERIOD`] times per period of the highest frequency
-/// at the DEM step) and the DEM damper at the design's point.
-pub fn sweep_scenario(space: &Space, d: &Design, plan: &SweepPlan) -> Result<String, DesignError> {
-    let mut table = single_mode_table(space, d, &plan.structure)?;
-    let s = &plan.spec;
-    let top = s.sweep.start_hz.max(s.sweep.end_hz);
-    let every = ((1.0 / (crate::resonance_sweep::SAMPLES_PER_PERIOD * top)) / time_step_s(space, d))
-        .floor()
-        .max(1.0) as i64;
-    let analysis: toml::Table = toml::from_str(&format!(
-        "kind = \"sweep\"\nstart_hz = {:e}\nend_hz = {:e}\nduration_s = {:e}\n\
-         law = \"linear\"\nforce_amplitude_n = {:e}\nexcitation_point = \"{}\"\n\
-         output_point = \"{}\"\ntime_step_s = {:e}\nsample_every = {every}\nmode = 1\n",
-        s.sweep.start_hz,
-        s.sweep.end_hz,
-        s.sweep.duration_s,
-        s.force_amplitude_n,
-        s.excitation_point,
-        s.output_point,
-        s.time_step_s
-    ))
-    .map_err(|e| DesignError::Solver(e.to_string()))?;
-    table.insert("analysis".into(), toml::Value::Table(analysis));
-    toml::to_string(&table).map_err(|e| DesignError::Solver(e.to_string()))
-}
-
 /// How much longer than the formulas' decay a DEM decay runs: a DEM bed that damps less than
 /// the formulas predict still reaches (most of) the bottom of the amplitude range.
 pub const DEM_DECAY_MARGIN: f64 = 1.25;
@@ -586,7 +231,7 @@ fn run_one(
 /// Runs the coupled DEM of `d` on `[verification] packings` beds in `out/dem/design_RANK` and
 /// returns the objective of each: the stroke at the evaluation time (min_stroke), or ζ(X) of
 /// every mode from a free decay over the amplitude range (max_damping, one run per mode and
-/// packing, [`DecayPlan`] × [`DEM_DECAY_MARGIN`]), or each mode's resonance from a sine sweep
+/// packing, [`DecayPlan`](crate::fidelity::DecayPlan) × [`DEM_DECAY_MARGIN`]), or each mode's resonance from a sine sweep
 /// (min_frf_peak, max_resonance_damping, [`crate::resonance_sweep`]). `level1` is the design's time-simulation
 /// evaluation (compared in the result). The cost (particles × steps) is reported through
 /// `progress` before the first run.
@@ -811,6 +456,10 @@ fn damping_decays(
     Ok(())
 }
 
+/// Level 1's resonance of a mode: the steady-state FRF's peak, ζ at it and the bare
+/// structure's peak (m).
+type Level1Resonance = (crate::fidelity::FrfResonance, f64, f64);
+
 /// min_frf_peak, max_resonance_damping: per mode a [`SweepPlan`] at level 1's resonance
 /// (frequency and ζ of the steady-state FRF); one coupled-DEM sweep per packing and mode. After
 /// the first packing a mode's sweep is planned again once, around the DEM's peak and for the
@@ -856,28 +505,8 @@ fn resonance_sweeps(
     };
     let dampers = space.coupled_dampers(d)?;
     let structure = space.structure(d.choice);
-    let mut plans = Vec::new();
-    let mut level1_modes = Vec::new();
-    for &m in modes {
-        let k = m - 1;
-        let steady =
-            crate::fidelity::frf_resonance(st, structure, &dampers, k, *frequencies, *band)?;
-        let zeta = crate::fidelity::resonance_damping_ratio(st, structure, k, steady.modal_peak)?;
-        let bare = crate::fidelity::bare_peak_m(st, k)?;
-        level1_modes.push((steady, zeta, bare));
-        plans.push(crate::resonance_sweep::sweep_plan(
-            st,
-            structure,
-            &dampers,
-            k,
-            &steady,
-            SweepTarget {
-                centre_hz: steady.frequency_hz,
-                band_damping_ratio: zeta,
-                rate_damping_ratio: zeta,
-            },
-        )?);
-    }
+    let (mut plans, level1_modes) =
+        plan_resonance_sweeps(space, structure, &dampers, modes, *frequencies, *band)?;
     let simulated: f64 = plans.iter().map(|p| p.summary.duration_s).sum();
     result.estimated_particle_steps = announce(
         progress,
@@ -942,22 +571,9 @@ fn resonance_sweeps(
             }
         }
     }
-    for (i, &m) in modes.iter().enumerate() {
-        let (steady, zeta, bare) = level1_modes[i];
-        let rel_peak: Vec<f64> = peaks[i].iter().map(|p| p.max_amplitude_m / bare).collect();
-        let zetas: Vec<f64> = peaks[i].iter().map(|p| p.damping_ratio).collect();
-        result.resonances.push(DemResonance {
-            mode: m,
-            relative_peak_stat: EnsembleStat::of(&rel_peak),
-            relative_peak: rel_peak,
-            damping_ratio_stat: EnsembleStat::of(&zetas),
-            damping_ratio: zetas,
-            resonance_frequency_hz: peaks[i].iter().map(|p| p.resonance_frequency_hz).collect(),
-            time_simulation: (steady.peak_m / bare, zeta, steady.frequency_hz),
-            sweep: plans[i].summary,
-            replanned: replanned[i].take(),
-        });
-    }
+    result.resonances = mode_resonances(modes, &level1_modes, &plans, &peaks, replanned);
+    // the objective of every packing: the mean over the modes of the relative peak
+    // (min_frf_peak) or of ζ (max_resonance_damping)
     let n = modes.len() as f64;
     result.values = (0..v.packings)
         .map(|p| {
@@ -976,6 +592,69 @@ fn resonance_sweeps(
         })
         .collect();
     Ok(())
+}
+
+/// Level 1's resonance of every objective mode (the steady-state FRF's peak, ζ at it by
+/// D Eq. 3.47 and the bare structure's peak) and the first [`SweepPlan`] around it.
+fn plan_resonance_sweeps(
+    space: &Space,
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    modes: &[usize],
+    frequencies: usize,
+    band: f64,
+) -> Result<(Vec<SweepPlan>, Vec<Level1Resonance>), DesignError> {
+    let st = space.study;
+    let mut plans = Vec::new();
+    let mut level1_modes = Vec::new();
+    for &m in modes {
+        let k = m - 1;
+        let steady = crate::fidelity::frf_resonance(st, structure, dampers, k, frequencies, band)?;
+        let zeta = crate::fidelity::resonance_damping_ratio(st, structure, k, steady.modal_peak)?;
+        let bare = crate::fidelity::bare_peak_m(st, k)?;
+        level1_modes.push((steady, zeta, bare));
+        plans.push(crate::resonance_sweep::sweep_plan(
+            st,
+            structure,
+            dampers,
+            k,
+            &steady,
+            SweepTarget {
+                centre_hz: steady.frequency_hz,
+                band_damping_ratio: zeta,
+                rate_damping_ratio: zeta,
+            },
+        )?);
+    }
+    Ok((plans, level1_modes))
+}
+
+/// Each mode's resonance over the packings (relative peak, ζ, frequency) beside level 1's.
+fn mode_resonances(
+    modes: &[usize],
+    level1_modes: &[Level1Resonance],
+    plans: &[SweepPlan],
+    peaks: &[Vec<forced::PeakDamping>],
+    mut replanned: Vec<Option<String>>,
+) -> Vec<DemResonance> {
+    let mut resonances = Vec::new();
+    for (i, &m) in modes.iter().enumerate() {
+        let (steady, zeta, bare) = level1_modes[i];
+        let rel_peak: Vec<f64> = peaks[i].iter().map(|p| p.max_amplitude_m / bare).collect();
+        let zetas: Vec<f64> = peaks[i].iter().map(|p| p.damping_ratio).collect();
+        resonances.push(DemResonance {
+            mode: m,
+            relative_peak_stat: EnsembleStat::of(&rel_peak),
+            relative_peak: rel_peak,
+            damping_ratio_stat: EnsembleStat::of(&zetas),
+            damping_ratio: zetas,
+            resonance_frequency_hz: peaks[i].iter().map(|p| p.resonance_frequency_hz).collect(),
+            time_simulation: (steady.peak_m / bare, zeta, steady.frequency_hz),
+            sweep: plans[i].summary,
+            replanned: replanned[i].take(),
+        });
+    }
+    resonances
 }
 
 /// Reads `decay.csv` or `response.csv` (time_s, displacement_m, …) of a coupled run.
