@@ -1,15 +1,23 @@
 //! Runs of `pdamp structure modes` and `pdamp couple`: CSV tables, `summary.json` and plots.
+//! The swept-sine analysis of `pdamp couple` is in `sweep`, the steady-state one in
+//! `steady_state`.
+
+mod steady_state;
+mod sweep;
+
+use steady_state::SteadyStateRequest;
 
 use crate::StructureError;
-use crate::dem::{CouplingCheckpoint, DemCoupling, run_dem_sweep_beds};
+use crate::dem::{CouplingCheckpoint, DemCoupling};
 use crate::design::damping_ratio_modal;
-use crate::forced::{self, ModeCoupling, Sweep, SweepSpec};
+use crate::forced::{self, Sweep, SweepSpec};
 use crate::free::{self, CoupledDamper, FreeVibrationSpec, TimeHistory};
 use crate::modal::ModalStructure;
 use crate::modal_fit;
 use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, ForceSpec, load_structure};
 use pdamp_io::csv::write_csv_atomic;
-use pdamp_plot::{Axis, FrfPlot, FrfSeries, LinePlot, Marker, Series, frf_plot_with, line_plot};
+use pdamp_io::scenario::VtkFormat;
+use pdamp_plot::{Axis, LinePlot, Marker, Series, line_plot};
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -100,55 +108,8 @@ pub fn run_couple(
         .build(base)
         .map_err(|m| crate::scenario::locate_error(&scn.structure_source(path), m))?
         .modal;
-    let dem_count = scn
-        .dampers
-        .iter()
-        .filter(|d| matches!(d, DamperSpec::Dem { .. }))
-        .count();
-    if dem_count > 0 && dem_count < scn.dampers.len() {
-        return Err(StructureError::inconsistent(
-            "DEM dampers (approach 1) cannot be mixed with other damper models in a scenario: \
-             make every damper `model = \"dem\"` or none",
-        ));
-    }
-    // The DEM beds (one per damper, each its own scenario and seed); the first bed's
-    // `[output]` interval and format give the ParaView output.
-    let mut bed_vtk = None;
-    let mut dem_beds: Vec<(String, pdamp_design::Damper, DemCoupling)> = Vec::new();
-    for (i, spec) in scn.dampers.iter().enumerate() {
-        let DamperSpec::Dem {
-            point,
-            scenario,
-            compensate_static_weight,
-            ..
-        } = spec
-        else {
-            continue;
-        };
-        let kinematics = spec.dem_kinematics(i)?;
-        let p = if scenario.is_absolute() {
-            scenario.clone()
-        } else {
-            base.join(scenario)
-        };
-        let in_damper = |e: StructureError| e.context(format!("dampers[{i}]: {}", p.display()));
-        let sc = pdamp_io::scenario::Scenario::load(&p).map_err(|e| in_damper(e.into()))?;
-        inputs.extend_from_slice(sc.to_toml().as_bytes());
-        if bed_vtk.is_none() {
-            bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
-        }
-        let d =
-            pdamp_design::Damper::from_scenario(&sc, p.parent().unwrap_or(Path::new(".")), |_| {})
-                .map_err(|e| in_damper(StructureError::Design(Box::new(e))))?;
-        dem_beds.push((
-            point.clone(),
-            d,
-            DemCoupling {
-                compensate_static_weight: *compensate_static_weight,
-                kinematics,
-            },
-        ));
-    }
+    check_dem_not_mixed(&scn)?;
+    let (dem_beds, bed_vtk) = load_dem_beds(&scn, base, &mut inputs)?;
     let beds: Vec<crate::dem::DemBed> = dem_beds
         .iter()
         .map(|(p, d, o)| crate::dem::DemBed {
@@ -158,73 +119,24 @@ pub fn run_couple(
         })
         .collect();
     let dem = (!beds.is_empty()).then_some(beds.as_slice());
-    let ck = CouplingCheckpoint {
-        path: out.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
-        inputs_digest: pdamp_io::checkpoint::digest(&inputs),
-        interval_s: options.checkpoint_interval_s,
-        resume: options.resume,
-        bed_vtk: bed_vtk.map(|(interval_s, format)| crate::dem::BedVtk {
-            dir: out.to_path_buf(),
-            pvd_name: "particles.pvd".into(),
-            subdir: "vtk".into(),
-            interval_s,
-            encoding: format.into(),
-        }),
-    };
-    let analysis_mode = match &scn.analysis {
-        AnalysisSpec::Free { mode, .. }
-        | AnalysisSpec::Sweep { mode, .. }
-        | AnalysisSpec::SteadyState { mode, .. } => mode.saturating_sub(1),
-    };
-    let mut dampers = Vec::new();
-    for (i, d) in scn.dampers.iter().enumerate() {
-        if let Some(m) = d
-            .effective_model(base, &structure, analysis_mode)
-            .map_err(|e| crate::scenario::locate_error(path, e.context(format!("dampers[{i}]"))))?
-        {
-            dampers.push(CoupledDamper {
-                point: d.point().to_string(),
-                model: m,
-            });
-        }
-    }
+    let ck = coupling_checkpoint(out, &inputs, &options, bed_vtk);
+    let dampers = equivalent_dampers(&scn, path, base, &structure)?;
     // Only now, with the dampers validated: bad input leaves no output directory behind.
     std::fs::create_dir_all(out).map_err(io)?;
-    let approach = if dem.is_some() {
-        "1 (full DEM)"
-    } else if scn
-        .dampers
-        .iter()
-        .any(|d| matches!(d, DamperSpec::Fields { .. }))
-    {
-        "2 (effective fields)"
-    } else if scn.dampers.is_empty() {
-        "none (bare structure)"
-    } else {
-        "2/3 (equivalent damper)"
-    };
+    let approach = approach_label(&scn, dem.is_some());
     let started = std::time::Instant::now();
+    let run = CoupledRun {
+        structure: &structure,
+        dampers: &dampers,
+        dem,
+        checkpoint: &ck,
+        resume: options.resume,
+        out,
+    };
     let mut summary = match &scn.analysis {
         AnalysisSpec::Free { .. } => {
             let spec = scn.analysis.free_vibration_spec().expect("a free analysis");
-            let (hist, energy) = match &dem {
-                Some(beds) => {
-                    let (h, e) = crate::dem::run_dem_free_beds(
-                        &structure,
-                        beds,
-                        &spec,
-                        progress,
-                        Some(&ck),
-                    )?;
-                    (h, Some(e))
-                }
-                None => (free::run_free_vibration(&structure, &dampers, &spec)?, None),
-            };
-            let mut v = free_outputs(&structure, &scn, &spec, &hist, out)?;
-            if let Some(e) = energy {
-                v["energy_exchange"] = energy_exchange_json(&e);
-            }
-            v
+            run.free_vibration(&scn, &spec, progress)?
         }
         AnalysisSpec::Sweep {
             start_hz,
@@ -262,118 +174,18 @@ pub fn run_couple(
                 sample_every: *sample_every,
             };
             if *segments <= 1 {
-                let (hist, energy) = match &dem {
-                    Some(beds) => {
-                        let (h, e) =
-                            run_dem_sweep_beds(&structure, beds, &spec, progress, Some(&ck))?;
-                        (h, Some(e))
-                    }
-                    None => (forced::run_sweep(&structure, &dampers, &spec)?, None),
-                };
-                let frf = forced::sweep_frf(&hist, &spec.sweep, *window_cycles);
-                let mut v = sweep_outputs(
-                    &structure,
-                    &spec,
-                    &[(hist, sweep)],
-                    frf,
-                    mode.saturating_sub(1),
-                    out,
-                )?;
-                if let Some(e) = energy {
-                    v["energy_exchange"] = energy_exchange_json(&e);
-                }
-                v
+                run.single_sweep(&spec, *window_cycles, mode.saturating_sub(1), progress)?
             } else {
                 // Frequency-domain approach [D Sect. 3.3.2]: overlapping segments from rest,
                 // start-up transients cut off, FRFs combined by peak hold.
                 let plan = forced::segment_sweep(&sweep, *segments, *segment_overlap);
-                let n = plan.len() as f64;
-                let mut runs = Vec::new();
-                let mut seg_frfs = Vec::new();
-                let mut seg_rows = Vec::new();
-                // DEM segments are checkpointed: the finished segments' histories in
-                // checkpoint.bin (kind "couple-dem-segments", rewritten atomically after every
-                // segment), the running segment in checkpoint_segment_<i>.bin (the coupled-run
-                // checkpoint, own digest per segment); --resume skips the finished ones and
-                // continues the running one, ending bit for bit as an uninterrupted run.
-                let mut done: Vec<SegmentHistory> = match (&dem, options.resume) {
-                    (Some(_), true) => {
-                        pdamp_io::checkpoint::load(&ck.path, SEGMENTS_KIND, &ck.inputs_digest)
-                            .map_err(StructureError::from)?
-                            .unwrap_or_default()
-                    }
-                    _ => Vec::new(),
-                };
-                for (i, sg) in plan.iter().enumerate() {
-                    let sspec = SweepSpec {
-                        sweep: sg.sweep,
-                        ..spec.clone()
-                    };
-                    let hist = match &dem {
-                        Some(_) if i < done.len() => done[i].clone().into_history(),
-                        Some(beds) => {
-                            let cki = CouplingCheckpoint {
-                                path: out.join(format!("checkpoint_segment_{i}.bin")),
-                                inputs_digest: pdamp_io::checkpoint::digest(
-                                    format!("{} segment {i}", ck.inputs_digest).as_bytes(),
-                                ),
-                                bed_vtk: ck.bed_vtk.clone().map(|b| crate::dem::BedVtk {
-                                    pvd_name: format!("particles_segment_{}.pvd", i + 1),
-                                    subdir: format!("vtk/segment_{}", i + 1),
-                                    ..b
-                                }),
-                                ..ck.clone()
-                            };
-                            let (h, _) = run_dem_sweep_beds(
-                                &structure,
-                                beds,
-                                &sspec,
-                                &mut |f| progress((i as f64 + f) / n),
-                                Some(&cki),
-                            )?;
-                            done.push(SegmentHistory::from_history(&h));
-                            pdamp_io::checkpoint::save(
-                                &ck.path,
-                                &pdamp_io::checkpoint::CheckpointHeader::new(
-                                    SEGMENTS_KIND,
-                                    &ck.inputs_digest,
-                                ),
-                                &done,
-                            )
-                            .map_err(StructureError::from)?;
-                            let _ = std::fs::remove_file(&cki.path);
-                            h
-                        }
-                        None => forced::run_sweep(&structure, &dampers, &sspec)?,
-                    };
-                    let frf: Vec<_> = forced::sweep_frf(&hist, &sg.sweep, *window_cycles)
-                        .into_iter()
-                        .filter(|p| {
-                            p.frequency_hz >= sg.keep_from_hz && p.frequency_hz <= sg.keep_to_hz
-                        })
-                        .collect();
-                    for p in &frf {
-                        seg_rows.push([
-                            (i + 1) as f64,
-                            p.frequency_hz,
-                            p.h_m_per_n.norm(),
-                            p.h_m_per_n.arg(),
-                        ]);
-                    }
-                    seg_frfs.push(frf);
-                    runs.push((hist, sg.sweep));
-                }
-                write_csv_atomic(
-                    out.join("frf_segments.csv"),
-                    &["segment", "frequency_hz", "magnitude_m_per_n", "phase_rad"],
-                    &seg_rows,
-                )
-                .map_err(io)?;
-                let frf = forced::peak_hold(&seg_frfs);
-                let mut v =
-                    sweep_outputs(&structure, &spec, &runs, frf, mode.saturating_sub(1), out)?;
-                v["segment_plan"] = json!(plan);
-                v
+                run.segmented_sweep(
+                    &spec,
+                    &plan,
+                    *window_cycles,
+                    mode.saturating_sub(1),
+                    progress,
+                )?
             }
         }
         AnalysisSpec::SteadyState {
@@ -397,117 +209,27 @@ pub fn run_couple(
                 base_amplitude_m: *base_amplitude_m,
             }
             .force_n(&structure_spec)?;
-            let k = mode.saturating_sub(1);
-            let m = structure
-                .modes
-                .get(k)
-                .ok_or_else(|| StructureError::rule("mode", "does not exist"))?;
-            let mc = ModeCoupling {
-                omega_rad_s: m.omega_rad_s(),
-                damping_ratio: m.damping_ratio,
-                phi_pd: structure.point(&dampers[0].point)?[k],
-                phi_ex: structure.point(excitation_point)?[k],
-                force_amplitude_n: f,
-            };
-            let phi_out = structure.point(output_point)?[k];
-            let n = (*points).max(3);
-            let freqs: Vec<f64> = (0..n)
-                .map(|i| start_hz + (end_hz - start_hz) * i as f64 / (n - 1) as f64)
-                .collect();
-            let pts = forced::steady_state_frf(&mc, dampers[0].model.as_ref(), &freqs);
-            let rows: Vec<Vec<f64>> = pts
-                .iter()
-                .map(|p| {
-                    vec![
-                        p.frequency_hz,
-                        p.modal_amplitude * phi_out.abs() / f,
-                        -p.phase_rad,
-                        p.amplitude_m,
-                        p.modal_mass,
-                        p.converged as u8 as f64,
-                    ]
-                })
-                .collect();
-            write_csv_atomic(
-                out.join("frf.csv"),
-                &[
-                    "frequency_hz",
-                    "magnitude_m_per_n",
-                    "phase_rad",
-                    "damper_amplitude_m",
-                    "modal_mass",
-                    "converged",
-                ],
-                &rows,
-            )
-            .map_err(io)?;
-            let (zeta, f_r, x_peak) = forced::steady_state_damping(&mc, &pts)
-                .ok_or_else(|| StructureError::numerical("empty FRF"))?;
-            let eq = forced::resonance_equilibrium(&mc, dampers[0].model.as_ref(), 200);
-            // Fig. 3.7 equilibrium of every mode (D Sect. 8.2.3 treats modes one at a time).
-            let mut per_mode = Vec::new();
-            for (j, mj) in structure.modes.iter().enumerate() {
-                let cj = ModeCoupling {
-                    omega_rad_s: mj.omega_rad_s(),
-                    damping_ratio: mj.damping_ratio,
-                    phi_pd: structure.point(&dampers[0].point)?[j],
-                    phi_ex: structure.point(excitation_point)?[j],
+            run.steady_state(
+                &SteadyStateRequest {
+                    start_hz: *start_hz,
+                    end_hz: *end_hz,
+                    points: *points,
                     force_amplitude_n: f,
-                };
-                let e = forced::resonance_equilibrium(&cj, dampers[0].model.as_ref(), 400);
-                per_mode.push(json!({
-                    "mode": j + 1,
-                    "undamped_frequency_hz": mj.frequency_hz,
-                    "frequency_reduction_percent": 100.0 * (1.0 - e.frequency_hz / mj.frequency_hz),
-                    "equilibrium": e,
-                }));
-            }
-            let mag: Vec<f64> = rows.iter().map(|r| r[1]).collect();
-            let ph: Vec<f64> = rows.iter().map(|r| r[2].to_degrees()).collect();
-            let mut plot = FrfPlot::new(
-                freqs.clone(),
-                vec![FrfSeries::new(
-                    "steady state (Fig. 3.7 / Eq. 3.44)",
-                    mag,
-                    ph,
-                )],
-            );
-            plot.magnitude_title = "|H| (m/N)".into();
-            frf_plot_with(out.join("frf"), &plot).map_err(io)?;
-            let hc: Vec<_> = rows
-                .iter()
-                .map(|r| pdamp_signal::Complex64::from_polar(r[1], r[2]))
-                .collect();
-            let modal_parameters = extract_modal_parameters(&structure, &freqs, &hc);
-            json!({
-                "damping_ratio_eq_3_47": zeta,
-                "modal_parameters": modal_parameters,
-                "resonance_frequency_hz": f_r,
-                "peak_damper_amplitude_m": x_peak,
-                "non_converged_points": pts.iter().filter(|p| !p.converged).count(),
-                "resonance_equilibrium_fig_3_7": eq,
-                "resonance_equilibrium_all_modes": per_mode,
-                "force_amplitude_n": f,
-                "undamped_frequency_hz": m.frequency_hz,
-            })
+                    excitation_point,
+                    output_point,
+                },
+                mode.saturating_sub(1),
+            )?
         }
     };
     let obj = summary.as_object_mut().expect("object");
     obj.insert("approach".into(), json!(approach));
     obj.insert("modes".into(), json!(structure.modes));
     obj.insert("wall_time_s".into(), json!(started.elapsed().as_secs_f64()));
-    // Efficiency ζ(η̄ = 1) of each damper per mode [D Eq. 3.51] with m̄ ≈ m_bed.
-    let mut eff = Vec::new();
-    for d in &dampers {
-        let phi = structure.point(&d.point)?;
-        let mb = d.model.bed_mass_kg();
-        let z: Vec<f64> = phi
-            .iter()
-            .map(|p| damping_ratio_modal(*p, mb, mb, 1.0))
-            .collect();
-        eff.push(json!({"point": d.point, "bed_mass_kg": mb, "damping_ratio_at_unit_loss_factor_per_mode": z}));
-    }
-    obj.insert("efficiency_eq_3_51".into(), json!(eff));
+    obj.insert(
+        "efficiency_eq_3_51".into(),
+        json!(damper_efficiency(&structure, &dampers)?),
+    );
     pdamp_io::atomic::write_atomic(
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)
@@ -518,35 +240,204 @@ pub fn run_couple(
     Ok(summary)
 }
 
-/// Checkpoint kind of the finished segments of a segmented DEM sweep.
-const SEGMENTS_KIND: &str = "couple-dem-segments";
-
-/// The response of one finished sweep segment (checkpointed).
-#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
-struct SegmentHistory {
-    time_s: Vec<f64>,
-    displacement_m: Vec<f64>,
-    velocity_m_s: Vec<f64>,
-    force_n: Vec<f64>,
+/// The structure, dampers and output settings one analysis of `pdamp couple` runs with.
+struct CoupledRun<'a> {
+    /// The reduced structure.
+    structure: &'a ModalStructure,
+    /// The equivalent dampers (approaches 2/3; empty with DEM beds).
+    dampers: &'a [CoupledDamper],
+    /// The DEM beds (approach 1), `None` without.
+    dem: Option<&'a [crate::dem::DemBed<'a>]>,
+    /// Checkpoint file, digest and ParaView output of the coupled DEM run.
+    checkpoint: &'a CouplingCheckpoint,
+    /// `--resume`: continue from the checkpoint.
+    resume: bool,
+    /// The output directory.
+    out: &'a Path,
 }
 
-impl SegmentHistory {
-    fn from_history(h: &TimeHistory) -> Self {
-        Self {
-            time_s: h.time_s.clone(),
-            displacement_m: h.displacement_m.clone(),
-            velocity_m_s: h.velocity_m_s.clone(),
-            force_n: h.force_n.clone(),
+/// DEM dampers (approach 1) cannot be mixed with the other damper models in one scenario.
+fn check_dem_not_mixed(scn: &CoupleScenario) -> Result<(), StructureError> {
+    let dem_count = scn
+        .dampers
+        .iter()
+        .filter(|d| matches!(d, DamperSpec::Dem { .. }))
+        .count();
+    if dem_count > 0 && dem_count < scn.dampers.len() {
+        return Err(StructureError::inconsistent(
+            "DEM dampers (approach 1) cannot be mixed with other damper models in a scenario: \
+             make every damper `model = \"dem\"` or none",
+        ));
+    }
+    Ok(())
+}
+
+/// A DEM bed of the scenario: its structure point, the settled damper and its coupling.
+type LoadedBed = (String, pdamp_design::Damper, DemCoupling);
+
+/// The DEM beds (one per damper, each its own scenario and seed; paths relative to `base`),
+/// every damper scenario appended to `inputs` (the checkpoint digest); the first bed's
+/// `[output]` interval and format give the ParaView output.
+fn load_dem_beds(
+    scn: &CoupleScenario,
+    base: &Path,
+    inputs: &mut Vec<u8>,
+) -> Result<(Vec<LoadedBed>, Option<(f64, VtkFormat)>), StructureError> {
+    let mut bed_vtk = None;
+    let mut dem_beds: Vec<LoadedBed> = Vec::new();
+    for (i, spec) in scn.dampers.iter().enumerate() {
+        let DamperSpec::Dem {
+            point,
+            scenario,
+            compensate_static_weight,
+            ..
+        } = spec
+        else {
+            continue;
+        };
+        let kinematics = spec.dem_kinematics(i)?;
+        let p = if scenario.is_absolute() {
+            scenario.clone()
+        } else {
+            base.join(scenario)
+        };
+        let in_damper = |e: StructureError| e.context(format!("dampers[{i}]: {}", p.display()));
+        let sc = pdamp_io::scenario::Scenario::load(&p).map_err(|e| in_damper(e.into()))?;
+        inputs.extend_from_slice(sc.to_toml().as_bytes());
+        if bed_vtk.is_none() {
+            bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
+        }
+        let d =
+            pdamp_design::Damper::from_scenario(&sc, p.parent().unwrap_or(Path::new(".")), |_| {})
+                .map_err(|e| in_damper(StructureError::Design(Box::new(e))))?;
+        dem_beds.push((
+            point.clone(),
+            d,
+            DemCoupling {
+                compensate_static_weight: *compensate_static_weight,
+                kinematics,
+            },
+        ));
+    }
+    Ok((dem_beds, bed_vtk))
+}
+
+/// The checkpoint of the coupled run in `out`: its digest over every input file (`inputs`), the
+/// interval and `--resume` of `options`, the first bed's ParaView output (`bed_vtk`: interval
+/// and format) in `particles.pvd` and `vtk/`.
+fn coupling_checkpoint(
+    out: &Path,
+    inputs: &[u8],
+    options: &pdamp_io::run::RunOptions,
+    bed_vtk: Option<(f64, VtkFormat)>,
+) -> CouplingCheckpoint {
+    CouplingCheckpoint {
+        path: out.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
+        inputs_digest: pdamp_io::checkpoint::digest(inputs),
+        interval_s: options.checkpoint_interval_s,
+        resume: options.resume,
+        bed_vtk: bed_vtk.map(|(interval_s, format)| crate::dem::BedVtk {
+            dir: out.to_path_buf(),
+            pvd_name: "particles.pvd".into(),
+            subdir: "vtk".into(),
+            interval_s,
+            encoding: format.into(),
+        }),
+    }
+}
+
+/// The equivalent model of every non-DEM damper for the analysed mode (paths relative to
+/// `base`; errors located in the scenario `path`).
+fn equivalent_dampers(
+    scn: &CoupleScenario,
+    path: &Path,
+    base: &Path,
+    structure: &ModalStructure,
+) -> Result<Vec<CoupledDamper>, StructureError> {
+    let analysis_mode = match &scn.analysis {
+        AnalysisSpec::Free { mode, .. }
+        | AnalysisSpec::Sweep { mode, .. }
+        | AnalysisSpec::SteadyState { mode, .. } => mode.saturating_sub(1),
+    };
+    let mut dampers = Vec::new();
+    for (i, d) in scn.dampers.iter().enumerate() {
+        if let Some(m) = d
+            .effective_model(base, structure, analysis_mode)
+            .map_err(|e| crate::scenario::locate_error(path, e.context(format!("dampers[{i}]"))))?
+        {
+            dampers.push(CoupledDamper {
+                point: d.point().to_string(),
+                model: m,
+            });
         }
     }
-    fn into_history(self) -> TimeHistory {
-        TimeHistory {
-            time_s: self.time_s,
-            displacement_m: self.displacement_m,
-            velocity_m_s: self.velocity_m_s,
-            force_n: self.force_n,
-            updates: Vec::new(),
+    Ok(dampers)
+}
+
+/// The damper approach of the scenario, for `summary.json`.
+fn approach_label(scn: &CoupleScenario, dem: bool) -> &'static str {
+    if dem {
+        "1 (full DEM)"
+    } else if scn
+        .dampers
+        .iter()
+        .any(|d| matches!(d, DamperSpec::Fields { .. }))
+    {
+        "2 (effective fields)"
+    } else if scn.dampers.is_empty() {
+        "none (bare structure)"
+    } else {
+        "2/3 (equivalent damper)"
+    }
+}
+
+/// Efficiency ζ(η̄ = 1) of each damper per mode [D Eq. 3.51] with m̄ ≈ m_bed.
+fn damper_efficiency(
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+) -> Result<Vec<serde_json::Value>, StructureError> {
+    let mut eff = Vec::new();
+    for d in dampers {
+        let phi = structure.point(&d.point)?;
+        let mb = d.model.bed_mass_kg();
+        let z: Vec<f64> = phi
+            .iter()
+            .map(|p| damping_ratio_modal(*p, mb, mb, 1.0))
+            .collect();
+        eff.push(json!({"point": d.point, "bed_mass_kg": mb, "damping_ratio_at_unit_loss_factor_per_mode": z}));
+    }
+    Ok(eff)
+}
+
+impl CoupledRun<'_> {
+    /// A free-vibration analysis: DEM beds or equivalent dampers, then its outputs.
+    fn free_vibration(
+        &self,
+        scn: &CoupleScenario,
+        spec: &FreeVibrationSpec,
+        progress: &mut dyn FnMut(f64),
+    ) -> Result<serde_json::Value, StructureError> {
+        let (hist, energy) = match &self.dem {
+            Some(beds) => {
+                let (h, e) = crate::dem::run_dem_free_beds(
+                    self.structure,
+                    beds,
+                    spec,
+                    progress,
+                    Some(self.checkpoint),
+                )?;
+                (h, Some(e))
+            }
+            None => (
+                free::run_free_vibration(self.structure, self.dampers, spec)?,
+                None,
+            ),
+        };
+        let mut v = free_outputs(self.structure, scn, spec, &hist, self.out)?;
+        if let Some(e) = energy {
+            v["energy_exchange"] = energy_exchange_json(&e);
         }
+        Ok(v)
     }
 }
 
@@ -775,105 +666,4 @@ fn extract_modal_parameters(
         "method": "rational fraction polynomial per mode band (Sanathanan–Koerner reweighted) + half-power bandwidth",
         "modes": modes,
     })
-}
-
-/// Outputs of a sweep: `runs` are the (history, sweep) of the whole sweep or of its segments,
-/// `frf` the (peak-held) FRF.
-fn sweep_outputs(
-    structure: &ModalStructure,
-    spec: &SweepSpec,
-    runs: &[(TimeHistory, Sweep)],
-    frf: Vec<forced::FrfPoint>,
-    mode: usize,
-    out: &Path,
-) -> Result<serde_json::Value, StructureError> {
-    let k = mode.min(structure.modes.len() - 1);
-    let phi_ex = structure.point(&spec.excitation_point)?[k];
-    let phi_out = structure.point(&spec.output_point)?[k];
-    // Eq. 3.47 from the run with the largest peak (the segment through the resonance)
-    let mut pk: Option<forced::PeakDamping> = None;
-    let mut peak_run = 0;
-    for (i, (h, sw)) in runs.iter().enumerate() {
-        let p = forced::peak_damping(
-            h,
-            sw,
-            spec.force_amplitude_n,
-            phi_ex,
-            phi_out,
-            structure.modes[k].omega_rad_s(),
-            None,
-        );
-        if let Some(p) = p
-            && pk.is_none_or(|q| p.max_amplitude_m > q.max_amplitude_m)
-        {
-            pk = Some(p);
-            peak_run = i;
-        }
-    }
-    let hist = &runs
-        .get(peak_run)
-        .ok_or_else(|| StructureError::numerical("no sweep run"))?
-        .0;
-    let rows: Vec<[f64; 3]> = (0..hist.time_s.len())
-        .map(|i| [hist.time_s[i], hist.displacement_m[i], hist.force_n[i]])
-        .collect();
-    write_csv_atomic(
-        out.join("response.csv"),
-        &["time_s", "displacement_m", "force_n"],
-        &rows,
-    )
-    .map_err(io)?;
-    let frows: Vec<[f64; 3]> = frf
-        .iter()
-        .map(|p| [p.frequency_hz, p.h_m_per_n.norm(), p.h_m_per_n.arg()])
-        .collect();
-    write_csv_atomic(
-        out.join("frf.csv"),
-        &["frequency_hz", "magnitude_m_per_n", "phase_rad"],
-        &frows,
-    )
-    .map_err(io)?;
-    let f: Vec<f64> = frf.iter().map(|p| p.frequency_hz).collect();
-    let mag: Vec<f64> = frf.iter().map(|p| p.h_m_per_n.norm()).collect();
-    let mut plot = FrfPlot::new(
-        f.clone(),
-        vec![FrfSeries::new(
-            "sweep FRF (Eq. 3.42)",
-            mag.clone(),
-            frows.iter().map(|r| r[2].to_degrees()).collect(),
-        )],
-    );
-    plot.magnitude_title = "|H| (m/N)".into();
-    if f.len() >= 2 {
-        frf_plot_with(out.join("frf"), &plot).map_err(io)?;
-    }
-    let hp = pdamp_signal::frf::half_power_damping(&f, &mag, None).ok();
-    let rfp = hp.and_then(|h| {
-        let band: Vec<_> = frf
-            .iter()
-            .copied()
-            .filter(|p| p.h_m_per_n.norm() > 0.5 * h.peak_magnitude)
-            .collect();
-        forced::rfp_single_mode(&band)
-    });
-    let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("displacement (m)"));
-    p.series.push(Series::new(
-        "output point",
-        hist.time_s.clone(),
-        hist.displacement_m.clone(),
-    ));
-    line_plot(out.join("response"), &p).map_err(io)?;
-    let hc: Vec<_> = frf.iter().map(|p| p.h_m_per_n).collect();
-    let modal_parameters = extract_modal_parameters(structure, &f, &hc);
-    Ok(json!({
-        "analysis": "sweep",
-        "force_amplitude_n": spec.force_amplitude_n,
-        "half_power": hp,
-        "rational_fraction_polynomial": rfp,
-        "modal_parameters": modal_parameters,
-        "peak_damping_eq_3_47": pk,
-        "frf_points": frf.len(),
-        "segments": runs.len(),
-        "response_csv_segment": peak_run + 1,
-    }))
 }
