@@ -275,6 +275,9 @@ fn check_dem_not_mixed(scn: &CoupleScenario) -> Result<(), StructureError> {
 /// A DEM bed of the scenario: its structure point, the settled damper and its coupling.
 type LoadedBed = (String, pdamp_design::Damper, DemCoupling);
 
+/// ParaView output of a bed scenario's `[output]`: the interval, s, and the format.
+type BedVtkOutput = (f64, VtkFormat);
+
 /// The DEM beds (one per damper, each its own scenario and seed; paths relative to `base`),
 /// every damper scenario appended to `inputs` (the checkpoint digest); the first bed's
 /// `[output]` interval and format give the ParaView output.
@@ -282,7 +285,7 @@ fn load_dem_beds(
     scn: &CoupleScenario,
     base: &Path,
     inputs: &mut Vec<u8>,
-) -> Result<(Vec<LoadedBed>, Option<(f64, VtkFormat)>), StructureError> {
+) -> Result<(Vec<LoadedBed>, Option<BedVtkOutput>), StructureError> {
     let mut bed_vtk = None;
     let mut dem_beds: Vec<LoadedBed> = Vec::new();
     for (i, spec) in scn.dampers.iter().enumerate() {
@@ -329,7 +332,7 @@ fn coupling_checkpoint(
     out: &Path,
     inputs: &[u8],
     options: &pdamp_io::run::RunOptions,
-    bed_vtk: Option<(f64, VtkFormat)>,
+    bed_vtk: Option<BedVtkOutput>,
 ) -> CouplingCheckpoint {
     CouplingCheckpoint {
         path: out.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
