@@ -344,29 +344,11 @@ impl Damper {
         let start = std::time::Instant::now();
         let omega = 2.0 * PI * frequency_hz;
         let period = 1.0 / frequency_hz;
-        let mut w = self.settled.clone();
+        let (mut w, steps_per_cycle) = self.driven_world(frequency_hz, amplitude_m, period);
         let e = self.direction;
-        w.bodies[self.container].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
-            direction: [e.x, e.y, e.z],
-            amplitude_m,
-            frequency_hz,
-            phase_rad: 0.0,
-        }));
-        let steps_per_cycle = (period / self.time_step_s).ceil().max(1.0);
-        w.dt_s = period / steps_per_cycle;
-        w.restart_clock();
         let t_eval = self.transient_cycles as f64 * period;
         let n_eval = self.cycles - self.transient_cycles;
-        let mut times = Vec::with_capacity((n_eval as f64 * steps_per_cycle) as usize + 2);
-        let mut force = Vec::with_capacity(times.capacity());
-        let mut velocity = Vec::with_capacity(times.capacity());
-        let mut ledger0 = None;
-        // Early stop: per evaluated cycle the sums of the single-bin DFT of the driving force and
-        // the velocity (additive over whole cycles), and the running estimates.
-        let mut cycle_start_sample = 0usize;
-        let (mut f_sum, mut v_sum) = ((0.0, 0.0), (0.0, 0.0));
-        let mut history: Vec<RunningEstimate> = Vec::new();
-        let mut per_cycle: Vec<RunningEstimate> = Vec::new();
+        let mut rec = PointRecord::with_capacity((n_eval as f64 * steps_per_cycle) as usize + 2);
         let mut converged = self.convergence.as_ref().map(|_| false);
         let mut n_eval = n_eval;
         let m_con = self.container_mass_kg;
@@ -374,40 +356,20 @@ impl Damper {
         // A point in progress to continue.
         let mut first_cycle = 0;
         let mut wall_before = 0.0;
-        let resumed = match checkpointing {
-            Some(c) if c.resume => {
-                match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)
-                    .map_err(DesignError::from)?
-                {
-                    Some(PointCheckpoint::Running(p)) => Some(p),
-                    Some(PointCheckpoint::Finished) => {
-                        return Err(DesignError::CheckpointFinished {
-                            path: c.path.clone(),
-                        });
-                    }
-                    None => None,
-                }
-            }
-            _ => None,
-        };
-        if let Some(p) = resumed {
-            if p.frequency_hz != frequency_hz || p.amplitude_m != amplitude_m {
-                return Err(DesignError::CheckpointOtherPoint {
-                    frequency_hz: p.frequency_hz,
-                    amplitude_m: p.amplitude_m,
-                });
-            }
+        if let Some(p) = load_running_point(checkpointing, frequency_hz, amplitude_m)? {
             let p = *p;
             w.restore_state(p.world).map_err(DesignError::from)?;
-            times = p.times;
-            force = p.force;
-            velocity = p.velocity;
-            ledger0 = p.ledger0;
-            cycle_start_sample = p.cycle_start_sample;
-            f_sum = p.f_sum;
-            v_sum = p.v_sum;
-            history = p.history;
-            per_cycle = p.per_cycle;
+            rec = PointRecord {
+                times: p.times,
+                force: p.force,
+                velocity: p.velocity,
+                ledger0: p.ledger0,
+                cycle_start_sample: p.cycle_start_sample,
+                f_sum: p.f_sum,
+                v_sum: p.v_sum,
+                history: p.history,
+                per_cycle: p.per_cycle,
+            };
             observer.restore_state(&p.observer)?;
             first_cycle = p.cycle;
             wall_before = p.wall_time_s;
@@ -430,9 +392,9 @@ impl Damper {
             let t_end = (cycle + 1) as f64 * period;
             // (A point resumed inside this cycle has done its start already.)
             if cycle == self.transient_cycles && resumed_in != Some(cycle) {
-                ledger0 = Some(w.ledger);
-                cycle_start_sample = times.len();
-                sample(&w, &mut times, &mut force, &mut velocity);
+                rec.ledger0 = Some(w.ledger);
+                rec.cycle_start_sample = rec.times.len();
+                sample(&w, &mut rec.times, &mut rec.force, &mut rec.velocity);
             }
             let evaluating = cycle >= self.transient_cycles;
             let mut health = None;
@@ -444,7 +406,7 @@ impl Damper {
                     w.complete_step();
                 }
                 if evaluating {
-                    sample(w, &mut times, &mut force, &mut velocity);
+                    sample(w, &mut rec.times, &mut rec.force, &mut rec.velocity);
                 }
                 let phase = (omega * w.time_s).rem_euclid(2.0 * PI);
                 observer.on_step(w, cycle, phase, self);
@@ -464,23 +426,13 @@ impl Damper {
                 {
                     w.complete_step();
                     let r = observer.save_state().and_then(|obs| {
-                        let p = PointProgress {
-                            frequency_hz,
-                            amplitude_m,
+                        let p = rec.progress(
+                            (frequency_hz, amplitude_m),
                             cycle,
-                            world: w.save_state(),
-                            times: times.clone(),
-                            force: force.clone(),
-                            velocity: velocity.clone(),
-                            ledger0,
-                            cycle_start_sample,
-                            f_sum,
-                            v_sum,
-                            history: history.clone(),
-                            per_cycle: per_cycle.clone(),
-                            observer: obs,
-                            wall_time_s: wall_before + start.elapsed().as_secs_f64(),
-                        };
+                            w.save_state(),
+                            obs,
+                            wall_before + start.elapsed().as_secs_f64(),
+                        );
                         ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
                             .map_err(DesignError::from)
                     });
@@ -497,83 +449,21 @@ impl Damper {
             if let Some(e) = save_error.take() {
                 return Err(e);
             }
-            if let Some(source) = health {
-                return Err(DesignError::Health {
-                    frequency_hz,
-                    amplitude_m,
-                    cycle: cycle + 1,
-                    source,
-                });
-            }
-            if pdamp_io::checkpoint::stop_requested() {
-                return Err(DesignError::PointInterrupted {
-                    frequency_hz,
-                    amplitude_m,
-                    cycle: cycle + 1,
-                });
-            }
-            if !w.ledger.kinetic_j.is_finite() {
-                return Err(DesignError::Unstable {
-                    frequency_hz,
-                    amplitude_m,
-                    cycle: cycle + 1,
-                });
-            }
+            check_cycle_end(health, &w, (frequency_hz, amplitude_m), cycle)?;
             if let Some(c) = &self.convergence
                 && evaluating
             {
-                let k0 = cycle_start_sample;
-                let fc = harmonic_amplitude(&times[k0..], &force[k0..], frequency_hz);
-                let vc = harmonic_amplitude(&times[k0..], &velocity[k0..], frequency_hz);
-                cycle_start_sample = times.len() - 1;
-                f_sum = (f_sum.0 + fc.0, f_sum.1 + fc.1);
-                v_sum = (v_sum.0 + vc.0, v_sum.1 + vc.1);
-                let n = history.len() as f64 + 1.0;
-                let estimate = |f: (f64, f64), v: (f64, f64)| {
-                    complex_power(
-                        Complex64::new(f.0, f.1),
-                        Complex64::new(v.0, v.1),
-                        frequency_hz,
-                        self.bed_mass_kg,
-                        self.container_mass_kg,
-                    )
-                    .map(|cp| RunningEstimate {
-                        effective_loss_factor: cp.effective_loss_factor,
-                        effective_mass_ratio: cp.effective_mass_ratio,
-                    })
-                    .unwrap_or(RunningEstimate {
-                        effective_loss_factor: f64::NAN,
-                        effective_mass_ratio: f64::NAN,
-                    })
-                };
-                history.push(estimate(
-                    (f_sum.0 / n, f_sum.1 / n),
-                    (v_sum.0 / n, v_sum.1 / n),
-                ));
-                per_cycle.push(estimate(fc, vc));
-                if has_converged(&history, &per_cycle, c) {
+                rec.add_cycle(self, frequency_hz);
+                if has_converged(&rec.history, &rec.per_cycle, c) {
                     converged = Some(true);
-                    n_eval = history.len() as u32;
+                    n_eval = rec.history.len() as u32;
                     break;
                 }
             }
         }
-        debug_assert!((times[0] - t_eval).abs() < 1e-9 * period.max(1.0));
-        let f_hat = harmonic_amplitude(&times, &force, frequency_hz);
-        let v_hat = harmonic_amplitude(&times, &velocity, frequency_hz);
-        let cp = complex_power(
-            Complex64::new(f_hat.0, f_hat.1),
-            Complex64::new(v_hat.0, v_hat.1),
-            frequency_hz,
-            self.bed_mass_kg,
-            self.container_mass_kg,
-        )
-        .map_err(|source| DesignError::ComplexPower {
-            frequency_hz,
-            amplitude_m,
-            source,
-        })?;
-        let l0 = ledger0.expect("evaluated cycles");
+        debug_assert!((rec.times[0] - t_eval).abs() < 1e-9 * period.max(1.0));
+        let cp = rec.complex_power(self, frequency_hz, amplitude_m)?;
+        let l0 = rec.ledger0.expect("evaluated cycles");
         Ok(PointResult::evaluate(
             (frequency_hz, amplitude_m),
             &cp,
@@ -583,6 +473,215 @@ impl Damper {
             (w.dt_s, w.counters.steps),
             wall_before + start.elapsed().as_secs_f64(),
         ))
+    }
+
+    /// The settled bed with its container driven harmonically at f and X (whole steps per
+    /// period, at most the damper's time step); returns it with the steps per cycle.
+    fn driven_world(&self, frequency_hz: f64, amplitude_m: f64, period: f64) -> (World, f64) {
+        let mut w = self.settled.clone();
+        let e = self.direction;
+        w.bodies[self.container].motion = Motion::Prescribed(Arc::new(HarmonicTranslation {
+            direction: [e.x, e.y, e.z],
+            amplitude_m,
+            frequency_hz,
+            phase_rad: 0.0,
+        }));
+        let steps_per_cycle = (period / self.time_step_s).ceil().max(1.0);
+        w.dt_s = period / steps_per_cycle;
+        w.restart_clock();
+        (w, steps_per_cycle)
+    }
+}
+
+/// The end of cycle `cycle` (0-based) at (f, X): a failed health check, a requested stop or a
+/// bed whose kinetic energy diverged ends the point with its error.
+fn check_cycle_end(
+    health: Option<pdamp_dem::health::HealthError>,
+    w: &World,
+    (frequency_hz, amplitude_m): (f64, f64),
+    cycle: u32,
+) -> Result<(), DesignError> {
+    if let Some(source) = health {
+        return Err(DesignError::Health {
+            frequency_hz,
+            amplitude_m,
+            cycle: cycle + 1,
+            source,
+        });
+    }
+    if pdamp_io::checkpoint::stop_requested() {
+        return Err(DesignError::PointInterrupted {
+            frequency_hz,
+            amplitude_m,
+            cycle: cycle + 1,
+        });
+    }
+    if !w.ledger.kinetic_j.is_finite() {
+        return Err(DesignError::Unstable {
+            frequency_hz,
+            amplitude_m,
+            cycle: cycle + 1,
+        });
+    }
+    Ok(())
+}
+
+/// The point in progress of a resumed run (`None` without one or without `resume`): a finished
+/// point or one at another (f, X) is an error.
+fn load_running_point(
+    checkpointing: Option<&PointCheckpointing>,
+    frequency_hz: f64,
+    amplitude_m: f64,
+) -> Result<Option<Box<PointProgress>>, DesignError> {
+    use pdamp_io::checkpoint as ck;
+    let resumed = match checkpointing {
+        Some(c) if c.resume => {
+            match ck::load::<PointCheckpoint>(&c.path, POINT_KIND, &c.scenario_digest)
+                .map_err(DesignError::from)?
+            {
+                Some(PointCheckpoint::Running(p)) => Some(p),
+                Some(PointCheckpoint::Finished) => {
+                    return Err(DesignError::CheckpointFinished {
+                        path: c.path.clone(),
+                    });
+                }
+                None => None,
+            }
+        }
+        _ => None,
+    };
+    if let Some(p) = &resumed
+        && (p.frequency_hz != frequency_hz || p.amplitude_m != amplitude_m)
+    {
+        return Err(DesignError::CheckpointOtherPoint {
+            frequency_hz: p.frequency_hz,
+            amplitude_m: p.amplitude_m,
+        });
+    }
+    Ok(resumed)
+}
+
+/// What a point records over its evaluated cycles: the sampled driving force and container
+/// velocity, the energy ledger at their start and, for the early stop, per evaluated cycle the
+/// sums of the single-bin DFT of force and velocity (additive over whole cycles) and the
+/// running estimates.
+struct PointRecord {
+    times: Vec<f64>,
+    force: Vec<f64>,
+    velocity: Vec<f64>,
+    ledger0: Option<pdamp_dem::EnergyLedger>,
+    cycle_start_sample: usize,
+    f_sum: (f64, f64),
+    v_sum: (f64, f64),
+    history: Vec<RunningEstimate>,
+    per_cycle: Vec<RunningEstimate>,
+}
+
+impl PointRecord {
+    /// An empty record with room for `samples` samples.
+    fn with_capacity(samples: usize) -> Self {
+        let times = Vec::with_capacity(samples);
+        let force = Vec::with_capacity(times.capacity());
+        let velocity = Vec::with_capacity(times.capacity());
+        Self {
+            times,
+            force,
+            velocity,
+            ledger0: None,
+            cycle_start_sample: 0,
+            f_sum: (0.0, 0.0),
+            v_sum: (0.0, 0.0),
+            history: Vec::new(),
+            per_cycle: Vec::new(),
+        }
+    }
+
+    /// The point's checkpoint in cycle `cycle` at (f, X), with the world's and the observer's
+    /// state and the wall time so far.
+    fn progress(
+        &self,
+        (frequency_hz, amplitude_m): (f64, f64),
+        cycle: u32,
+        world: pdamp_dem::state::WorldState,
+        observer: Vec<u8>,
+        wall_time_s: f64,
+    ) -> PointProgress {
+        PointProgress {
+            frequency_hz,
+            amplitude_m,
+            cycle,
+            world,
+            times: self.times.clone(),
+            force: self.force.clone(),
+            velocity: self.velocity.clone(),
+            ledger0: self.ledger0,
+            cycle_start_sample: self.cycle_start_sample,
+            f_sum: self.f_sum,
+            v_sum: self.v_sum,
+            history: self.history.clone(),
+            per_cycle: self.per_cycle.clone(),
+            observer,
+            wall_time_s,
+        }
+    }
+
+    /// The cycle just evaluated added to the early-stop estimates: its harmonic amplitudes of
+    /// force and velocity, the running estimate of their mean over the evaluated cycles and
+    /// the cycle's own estimate (complex power, D Eq. 3.13–3.17; NaN where undefined).
+    fn add_cycle(&mut self, damper: &Damper, frequency_hz: f64) {
+        let k0 = self.cycle_start_sample;
+        let fc = harmonic_amplitude(&self.times[k0..], &self.force[k0..], frequency_hz);
+        let vc = harmonic_amplitude(&self.times[k0..], &self.velocity[k0..], frequency_hz);
+        self.cycle_start_sample = self.times.len() - 1;
+        self.f_sum = (self.f_sum.0 + fc.0, self.f_sum.1 + fc.1);
+        self.v_sum = (self.v_sum.0 + vc.0, self.v_sum.1 + vc.1);
+        let n = self.history.len() as f64 + 1.0;
+        let estimate = |f: (f64, f64), v: (f64, f64)| {
+            complex_power(
+                Complex64::new(f.0, f.1),
+                Complex64::new(v.0, v.1),
+                frequency_hz,
+                damper.bed_mass_kg,
+                damper.container_mass_kg,
+            )
+            .map(|cp| RunningEstimate {
+                effective_loss_factor: cp.effective_loss_factor,
+                effective_mass_ratio: cp.effective_mass_ratio,
+            })
+            .unwrap_or(RunningEstimate {
+                effective_loss_factor: f64::NAN,
+                effective_mass_ratio: f64::NAN,
+            })
+        };
+        let (f_sum, v_sum) = (self.f_sum, self.v_sum);
+        self.history.push(estimate(
+            (f_sum.0 / n, f_sum.1 / n),
+            (v_sum.0 / n, v_sum.1 / n),
+        ));
+        self.per_cycle.push(estimate(fc, vc));
+    }
+
+    /// Complex power of the whole evaluated record at (f, X) [D Eq. 3.13–3.17].
+    fn complex_power(
+        &self,
+        damper: &Damper,
+        frequency_hz: f64,
+        amplitude_m: f64,
+    ) -> Result<pdamp_signal::complex_power::ComplexPowerResult, DesignError> {
+        let f_hat = harmonic_amplitude(&self.times, &self.force, frequency_hz);
+        let v_hat = harmonic_amplitude(&self.times, &self.velocity, frequency_hz);
+        complex_power(
+            Complex64::new(f_hat.0, f_hat.1),
+            Complex64::new(v_hat.0, v_hat.1),
+            frequency_hz,
+            damper.bed_mass_kg,
+            damper.container_mass_kg,
+        )
+        .map_err(|source| DesignError::ComplexPower {
+            frequency_hz,
+            amplitude_m,
+            source,
+        })
     }
 }
 

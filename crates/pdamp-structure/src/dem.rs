@@ -506,18 +506,7 @@ fn coupled_run(
         .ok_or_else(|| StructureError::inconsistent("a coupled DEM run needs a DEM bed"))?;
     let out = structure.point(output_point)?.to_vec();
     let dt = first_bed.damper.time_step_s;
-    for (i, b) in beds.iter().enumerate() {
-        if b.damper.time_step_s != dt {
-            return Err(StructureError::invalid(
-                format!("DEM bed {} at '{}'", i + 1, b.point),
-                format!(
-                    "time step {:e} s, but bed 1's is {dt:e} s; the beds of one coupled run step \
-                     together: give their damper scenarios the same time_step_s",
-                    b.damper.time_step_s
-                ),
-            ));
-        }
-    }
+    check_same_time_step(beds, dt)?;
     crate::integrate::validate_settings(structure, dt, duration_s, sample_every, true)
         .map_err(|e| StructureError::DemTimeStep { error: e })?;
     let mut it = ModalIntegrator::new(structure, dt);
@@ -569,43 +558,14 @@ fn coupled_run(
         && let Some(st) = cp::load::<CoupledState>(&c.path, COUPLE_KIND, &c.inputs_digest)
             .map_err(StructureError::from)?
     {
-        if st.more_worlds.len() + 1 != runs.len() {
-            return Err(StructureError::invalid(
-                c.path.display().to_string(),
-                format!(
-                    "a checkpoint of {} DEM bed(s), the scenario has {}",
-                    st.more_worlds.len() + 1,
-                    runs.len()
-                ),
-            ));
-        }
-        let worlds = std::iter::once(st.world).chain(st.more_worlds);
-        for (r, ws) in runs.iter_mut().zip(worlds) {
-            r.w.restore_state(ws).map_err(StructureError::State)?;
-        }
-        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
-        hist.time_s = st.time;
-        hist.displacement_m = st.displacement;
-        hist.velocity_m_s = st.velocity;
-        hist.force_n = st.force;
-        energy = st.energy;
-        let loads = st.q_load.into_iter().chain(st.more_q_load);
-        for (r, ql) in runs.iter_mut().zip(loads) {
-            r.q_raw = ql;
-        }
-        first = st.step + 1;
+        first = st.restore(&c.path, &mut runs, &mut it, &mut hist, &mut energy)?;
     }
     let _stoppable = ck.map(|_| cp::StoppableSection::enter());
     let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
     let n_steps = (duration_s / dt).round() as usize;
     // The first bed in ParaView: a frame every `interval_s` (frames of a resumed run's earlier
     // steps are the interrupted run's).
-    let mut snapshots = match ck.and_then(|c| c.bed_vtk.as_ref()) {
-        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
-            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
-        }),
-        None => None,
-    };
+    let mut snapshots = bed_snapshots(ck, dt);
     if let Some(s) = snapshots.as_mut() {
         if first > 1 {
             s.resume_after((first - 1) as u64, dt, &runs[0].w)
@@ -655,22 +615,7 @@ fn coupled_run(
         if let (Some(c), Some(h)) = (ck, &header) {
             let stop = cp::stop_requested();
             if stop || timer.due() {
-                let st = CoupledState {
-                    step,
-                    time_s: it.time_s,
-                    q: it.q.clone(),
-                    v: it.v.clone(),
-                    a: it.a.clone(),
-                    world: runs[0].w.save_state(),
-                    time: hist.time_s.clone(),
-                    displacement: hist.displacement_m.clone(),
-                    velocity: hist.velocity_m_s.clone(),
-                    force: hist.force_n.clone(),
-                    energy,
-                    q_load: Some(runs[0].q_raw.clone()),
-                    more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
-                    more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
-                };
+                let st = CoupledState::capture(step, &it, &runs, &hist, energy);
                 cp::save(&c.path, h, &st).map_err(StructureError::from)?;
                 if stop {
                     return Err(StructureError::Interrupted(cp::Interrupted {
@@ -681,18 +626,122 @@ fn coupled_run(
             }
         }
     }
-    for r in &runs {
+    add_bed_ledgers(&mut energy, &runs);
+    energy.structure_energy_change_j = it.energy_j() - e_structure0;
+    Ok(CoupledResult {
+        history: hist,
+        energy,
+    })
+}
+
+/// The beds of one coupled run step together: every bed's time step must be `dt` (bed 1's).
+fn check_same_time_step(beds: &[DemBed], dt: f64) -> Result<(), StructureError> {
+    for (i, b) in beds.iter().enumerate() {
+        if b.damper.time_step_s != dt {
+            return Err(StructureError::invalid(
+                format!("DEM bed {} at '{}'", i + 1, b.point),
+                format!(
+                    "time step {:e} s, but bed 1's is {dt:e} s; the beds of one coupled run step \
+                     together: give their damper scenarios the same time_step_s",
+                    b.damper.time_step_s
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first bed's ParaView series of a checkpointed run: a frame every `interval_s` of its
+/// `bed_vtk` settings (`None` without them).
+fn bed_snapshots(
+    ck: Option<&CouplingCheckpoint>,
+    dt: f64,
+) -> Option<pdamp_io::run::SnapshotSeries> {
+    match ck.and_then(|c| c.bed_vtk.as_ref()) {
+        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
+            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
+        }),
+        None => None,
+    }
+}
+
+/// Every bed's energy ledger added to the run's energy exchange: wall work, change of the
+/// bed's mechanical energy and dissipation.
+fn add_bed_ledgers(energy: &mut DemEnergy, runs: &[BedRun]) {
+    for r in runs {
         let l = &r.w.ledger;
         energy.wall_work_j += l.wall_work_j;
         energy.bed_energy_change_j += l.total_mechanical_j()
             - (l.initial_kinetic_j + l.initial_potential_j + l.initial_elastic_j);
         energy.dissipated_j += l.dissipated_j();
     }
-    energy.structure_energy_change_j = it.energy_j() - e_structure0;
-    Ok(CoupledResult {
-        history: hist,
-        energy,
-    })
+}
+
+impl CoupledState {
+    /// The state after `step`: the integrator, every bed's world and last raw load, the
+    /// history so far and the energy exchange.
+    fn capture(
+        step: usize,
+        it: &ModalIntegrator,
+        runs: &[BedRun],
+        hist: &TimeHistory,
+        energy: DemEnergy,
+    ) -> Self {
+        CoupledState {
+            step,
+            time_s: it.time_s,
+            q: it.q.clone(),
+            v: it.v.clone(),
+            a: it.a.clone(),
+            world: runs[0].w.save_state(),
+            time: hist.time_s.clone(),
+            displacement: hist.displacement_m.clone(),
+            velocity: hist.velocity_m_s.clone(),
+            force: hist.force_n.clone(),
+            energy,
+            q_load: Some(runs[0].q_raw.clone()),
+            more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
+            more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
+        }
+    }
+
+    /// Restores a checkpoint (read from `path`) into the beds, the integrator, the history and
+    /// the energy exchange; returns the first step still to run.
+    fn restore(
+        self,
+        path: &std::path::Path,
+        runs: &mut [BedRun],
+        it: &mut ModalIntegrator,
+        hist: &mut TimeHistory,
+        energy: &mut DemEnergy,
+    ) -> Result<usize, StructureError> {
+        let st = self;
+        if st.more_worlds.len() + 1 != runs.len() {
+            return Err(StructureError::invalid(
+                path.display().to_string(),
+                format!(
+                    "a checkpoint of {} DEM bed(s), the scenario has {}",
+                    st.more_worlds.len() + 1,
+                    runs.len()
+                ),
+            ));
+        }
+        let worlds = std::iter::once(st.world).chain(st.more_worlds);
+        for (r, ws) in runs.iter_mut().zip(worlds) {
+            r.w.restore_state(ws).map_err(StructureError::State)?;
+        }
+        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
+        hist.time_s = st.time;
+        hist.displacement_m = st.displacement;
+        hist.velocity_m_s = st.velocity;
+        hist.force_n = st.force;
+        *energy = st.energy;
+        let loads = st.q_load.into_iter().chain(st.more_q_load);
+        for (r, ql) in runs.iter_mut().zip(loads) {
+            r.q_raw = ql;
+        }
+        Ok(st.step + 1)
+    }
 }
 
 /// Free vibration with a full DEM damper at `damper_point` (approach 1).

@@ -165,15 +165,12 @@ pub fn fixed_point_update(
     )
 }
 
-/// Runs a free vibration of `structure` with the equivalent `dampers` [D Sect. 3.3.1].
-///
-/// # Errors
-/// Unknown points, invalid spec.
-pub fn run_free_vibration(
+/// The structure, the analysed mode, the integration settings and the initial condition of a
+/// free vibration checked before it runs.
+fn check_free_vibration(
     structure: &ModalStructure,
-    dampers: &[CoupledDamper],
     spec: &FreeVibrationSpec,
-) -> Result<TimeHistory, StructureError> {
+) -> Result<(), StructureError> {
     structure.validate()?;
     if spec.mode >= structure.modes.len() {
         return Err(StructureError::rule(
@@ -194,6 +191,42 @@ pub fn run_free_vibration(
             spec.initial_displacement_m, spec.initial_velocity_m_s
         )));
     }
+    Ok(())
+}
+
+/// Whether the damper's parameters are updated over a step from (x0, v0) to (x1, v1) under
+/// `rule`, and with which measure: the velocity interpolated at a zero crossing, or the
+/// larger amplitude at a peak.
+fn update_event(rule: UpdateRule, (x0, v0): (f64, f64), (x1, v1): (f64, f64)) -> Option<Measure> {
+    match rule {
+        UpdateRule::Never => None,
+        UpdateRule::ZeroCrossing => (x0 != 0.0 && x0.signum() != x1.signum()).then(|| {
+            let t = x0 / (x0 - x1);
+            Measure::Velocity(v0 + (v1 - v0) * t)
+        }),
+        rule => {
+            let pos = v0 > 0.0 && v1 <= 0.0;
+            let neg = v0 < 0.0 && v1 >= 0.0;
+            let hit = match rule {
+                UpdateRule::PositivePeak => pos,
+                UpdateRule::NegativePeak => neg,
+                _ => pos || neg,
+            };
+            hit.then(|| Measure::Peak(x1.abs().max(x0.abs())))
+        }
+    }
+}
+
+/// Runs a free vibration of `structure` with the equivalent `dampers` [D Sect. 3.3.1].
+///
+/// # Errors
+/// Unknown points, invalid spec.
+pub fn run_free_vibration(
+    structure: &ModalStructure,
+    dampers: &[CoupledDamper],
+    spec: &FreeVibrationSpec,
+) -> Result<TimeHistory, StructureError> {
+    check_free_vibration(structure, spec)?;
     let init = structure.point(&spec.initial_point)?.to_vec();
     let out = structure.point(&spec.output_point)?.to_vec();
     let shapes: Vec<Vec<f64>> = dampers
@@ -276,23 +309,7 @@ pub fn run_free_vibration(
             let (x1, v1) = (it.displacement(&shapes[i]), it.velocity(&shapes[i]));
             let (x0, v0) = prev[i];
             prev[i] = (x1, v1);
-            let event = match spec.update {
-                UpdateRule::Never => None,
-                UpdateRule::ZeroCrossing => (x0 != 0.0 && x0.signum() != x1.signum()).then(|| {
-                    let t = x0 / (x0 - x1);
-                    Measure::Velocity(v0 + (v1 - v0) * t)
-                }),
-                rule => {
-                    let pos = v0 > 0.0 && v1 <= 0.0;
-                    let neg = v0 < 0.0 && v1 >= 0.0;
-                    let hit = match rule {
-                        UpdateRule::PositivePeak => pos,
-                        UpdateRule::NegativePeak => neg,
-                        _ => pos || neg,
-                    };
-                    hit.then(|| Measure::Peak(x1.abs().max(x0.abs())))
-                }
-            };
+            let event = update_event(spec.update, (x0, v0), (x1, v1));
             if let Some(measure) = event {
                 let (x, w, m, d) =
                     fixed_point_update(structure, k, dampers, &shapes, &atts, i, measure);

@@ -182,12 +182,9 @@ const MIN_ENTRY_BYTES: usize = 6;
 /// Relative tolerance of the symmetry check of `general` files: |a_ij − a_ji| ≤ 1e-9·max|a|.
 pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 
-/// Parses Matrix Market coordinate text.
-///
-/// # Errors
-/// Every malformed banner, size line or entry, out-of-range indices, wrong entry counts,
-/// non-finite values.
-pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
+/// The banner line `%%MatrixMarket matrix coordinate real|integer|double general|symmetric`;
+/// returns whether the file is symmetric.
+fn parse_banner(text: &str) -> Result<bool, MatrixMarketError> {
     let banner = text.lines().next().ok_or(MatrixMarketError::Header {
         line: 1,
         reason: "empty file".into(),
@@ -216,94 +213,67 @@ pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
     if tok[3] != "real" && tok[3] != "integer" && tok[3] != "double" {
         return Err(head("only real or integer fields are supported"));
     }
-    let symmetric = match tok[4].as_str() {
+    Ok(match tok[4].as_str() {
         "general" => false,
         "symmetric" => true,
         _ => return Err(head("symmetry must be 'general' or 'symmetric'")),
-    };
-    let mut size: Option<(usize, usize, usize)> = None;
-    let mut entries = Vec::new();
-    let mut lines = Vec::new();
-    for (i, raw) in text.lines().enumerate().skip(1) {
-        let line = i + 1;
-        let l = raw.trim();
-        if l.is_empty() || l.starts_with('%') {
-            continue;
-        }
-        let f: Vec<&str> = l.split_whitespace().collect();
-        let bad = |reason: String| MatrixMarketError::Entry { line, reason };
-        match size {
-            None => {
-                if f.len() != 3 {
-                    return Err(bad(format!(
-                        "size line needs 'rows cols entries', got '{l}'"
-                    )));
-                }
-                let p = |s: &str| {
-                    s.parse::<usize>()
-                        .map_err(|_| bad(format!("'{s}' is not a non-negative integer")))
-                };
-                let (r, c, n) = (p(f[0])?, p(f[1])?, p(f[2])?);
-                if r > MAX_DIMENSION || c > MAX_DIMENSION {
-                    return Err(bad(format!("dimension {r}×{c} exceeds {MAX_DIMENSION}")));
-                }
-                if symmetric && r != c {
-                    return Err(bad(format!("symmetric matrix must be square, got {r}×{c}")));
-                }
-                if n > r.saturating_mul(c) {
-                    return Err(bad(format!("{n} entries cannot fit a {r}×{c} matrix")));
-                }
-                if n > MAX_ENTRIES {
-                    return Err(bad(format!(
-                        "{n} entries announced, more than the {MAX_ENTRIES} accepted"
-                    )));
-                }
-                if n > text.len() / MIN_ENTRY_BYTES + 1 {
-                    return Err(bad(format!(
-                        "{n} entries announced, but the file ({} bytes) can hold at most {} \
-                         (truncated file or wrong size line)",
-                        text.len(),
-                        text.len() / MIN_ENTRY_BYTES + 1
-                    )));
-                }
-                size = Some((r, c, n));
-                entries.reserve(n * if symmetric { 2 } else { 1 });
-                lines.reserve(n * if symmetric { 2 } else { 1 });
-            }
-            Some((r, c, _)) => {
-                if f.len() != 3 {
-                    return Err(bad(format!("entry needs 'row col value', got '{l}'")));
-                }
-                let idx = |s: &str, max: usize, what: &str| -> Result<usize, MatrixMarketError> {
-                    let v = s
-                        .parse::<usize>()
-                        .map_err(|_| bad(format!("{what} index '{s}' is not an integer")))?;
-                    if v == 0 || v > max {
-                        return Err(bad(format!("{what} index {v} outside 1..={max}")));
-                    }
-                    Ok(v - 1)
-                };
-                let (ri, ci) = (idx(f[0], r, "row")?, idx(f[1], c, "column")?);
-                let v: f64 = f[2]
-                    .parse()
-                    .map_err(|_| bad(format!("value '{}' is not a number", f[2])))?;
-                if !v.is_finite() {
-                    return Err(bad(format!("value '{}' is not finite", f[2])));
-                }
-                if entries.len() >= 2 * MAX_ENTRIES {
-                    return Err(bad(format!("more than {MAX_ENTRIES} entries")));
-                }
-                entries.push((ri, ci, v));
-                lines.push(line);
-                if symmetric && ri != ci {
-                    entries.push((ci, ri, v));
-                    lines.push(line);
-                }
-            }
-        }
+    })
+}
+
+/// The size line `rows cols entries` (`l`, split into `f`, on line `line`): dimensions and
+/// entry count within the limits and what a file of `text_len` bytes can hold.
+fn parse_size_line(
+    line: usize,
+    l: &str,
+    f: &[&str],
+    symmetric: bool,
+    text_len: usize,
+) -> Result<(usize, usize, usize), MatrixMarketError> {
+    let bad = |reason: String| MatrixMarketError::Entry { line, reason };
+    if f.len() != 3 {
+        return Err(bad(format!(
+            "size line needs 'rows cols entries', got '{l}'"
+        )));
     }
-    let (nrows, ncols, n) =
-        size.ok_or(MatrixMarketError::Structure("no size line found".into()))?;
+    let p = |s: &str| {
+        s.parse::<usize>()
+            .map_err(|_| bad(format!("'{s}' is not a non-negative integer")))
+    };
+    let (r, c, n) = (p(f[0])?, p(f[1])?, p(f[2])?);
+    if r > MAX_DIMENSION || c > MAX_DIMENSION {
+        return Err(bad(format!("dimension {r}×{c} exceeds {MAX_DIMENSION}")));
+    }
+    if symmetric && r != c {
+        return Err(bad(format!("symmetric matrix must be square, got {r}×{c}")));
+    }
+    if n > r.saturating_mul(c) {
+        return Err(bad(format!("{n} entries cannot fit a {r}×{c} matrix")));
+    }
+    if n > MAX_ENTRIES {
+        return Err(bad(format!(
+            "{n} entries announced, more than the {MAX_ENTRIES} accepted"
+        )));
+    }
+    if n > text_len / MIN_ENTRY_BYTES + 1 {
+        return Err(bad(format!(
+            "{n} entries announced, but the file ({} bytes) can hold at most {} \
+             (truncated file or wrong size line)",
+            text_len,
+            text_len / MIN_ENTRY_BYTES + 1
+        )));
+    }
+    Ok((r, c, n))
+}
+
+/// The stored entries checked against the size line's count `n` (the mirrored copies of a
+/// symmetric file left out) and for positions given twice: duplicates, or both triangles of
+/// a symmetric file.
+fn check_stored_entries(
+    entries: &[(usize, usize, f64)],
+    lines: &[usize],
+    symmetric: bool,
+    n: usize,
+) -> Result<(), MatrixMarketError> {
     // Stored entries (the mirrored copies of a symmetric file left out), keyed by position
     // (a symmetric file's by its lower-triangle position): equal keys are duplicates or both
     // triangles of a symmetric file.
@@ -357,6 +327,69 @@ pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
             reason,
         });
     }
+    Ok(())
+}
+
+/// Parses Matrix Market coordinate text.
+///
+/// # Errors
+/// Every malformed banner, size line or entry, out-of-range indices, wrong entry counts,
+/// non-finite values.
+pub fn parse_matrix_market(text: &str) -> Result<CooMatrix, MatrixMarketError> {
+    let symmetric = parse_banner(text)?;
+    let mut size: Option<(usize, usize, usize)> = None;
+    let mut entries = Vec::new();
+    let mut lines = Vec::new();
+    for (i, raw) in text.lines().enumerate().skip(1) {
+        let line = i + 1;
+        let l = raw.trim();
+        if l.is_empty() || l.starts_with('%') {
+            continue;
+        }
+        let f: Vec<&str> = l.split_whitespace().collect();
+        let bad = |reason: String| MatrixMarketError::Entry { line, reason };
+        match size {
+            None => {
+                let (r, c, n) = parse_size_line(line, l, &f, symmetric, text.len())?;
+                size = Some((r, c, n));
+                entries.reserve(n * if symmetric { 2 } else { 1 });
+                lines.reserve(n * if symmetric { 2 } else { 1 });
+            }
+            Some((r, c, _)) => {
+                if f.len() != 3 {
+                    return Err(bad(format!("entry needs 'row col value', got '{l}'")));
+                }
+                let idx = |s: &str, max: usize, what: &str| -> Result<usize, MatrixMarketError> {
+                    let v = s
+                        .parse::<usize>()
+                        .map_err(|_| bad(format!("{what} index '{s}' is not an integer")))?;
+                    if v == 0 || v > max {
+                        return Err(bad(format!("{what} index {v} outside 1..={max}")));
+                    }
+                    Ok(v - 1)
+                };
+                let (ri, ci) = (idx(f[0], r, "row")?, idx(f[1], c, "column")?);
+                let v: f64 = f[2]
+                    .parse()
+                    .map_err(|_| bad(format!("value '{}' is not a number", f[2])))?;
+                if !v.is_finite() {
+                    return Err(bad(format!("value '{}' is not finite", f[2])));
+                }
+                if entries.len() >= 2 * MAX_ENTRIES {
+                    return Err(bad(format!("more than {MAX_ENTRIES} entries")));
+                }
+                entries.push((ri, ci, v));
+                lines.push(line);
+                if symmetric && ri != ci {
+                    entries.push((ci, ri, v));
+                    lines.push(line);
+                }
+            }
+        }
+    }
+    let (nrows, ncols, n) =
+        size.ok_or(MatrixMarketError::Structure("no size line found".into()))?;
+    check_stored_entries(&entries, &lines, symmetric, n)?;
     Ok(CooMatrix {
         nrows,
         ncols,

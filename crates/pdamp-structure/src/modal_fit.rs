@@ -59,39 +59,10 @@ pub fn rfp_fit(
     h: &[Complex64],
     n_modes: usize,
 ) -> Result<RfpFit, StructureError> {
+    check_rfp_input(frequencies_hz, h, n_modes)?;
     let n = frequencies_hz.len();
-    if n != h.len() {
-        return Err(StructureError::invalid(
-            "rfp_fit",
-            "frequency and FRF lengths differ",
-        ));
-    }
-    if n_modes == 0 {
-        return Err(StructureError::invalid(
-            "rfp_fit",
-            "ask for at least one mode",
-        ));
-    }
     let na = 2 * n_modes; // denominator degree (monic)
     let nb = 2 * n_modes + 1; // numerator degree
-    let unknowns = na + nb + 1;
-    if 2 * n < unknowns + 2 {
-        return Err(StructureError::invalid(
-            "rfp_fit",
-            format!(
-                "{n} points are too few for {n_modes} modes (need ≥ {})",
-                unknowns.div_ceil(2) + 1
-            ),
-        ));
-    }
-    if frequencies_hz.iter().any(|f| !(f.is_finite() && *f > 0.0))
-        || h.iter().any(|c| !(c.re.is_finite() && c.im.is_finite()))
-    {
-        return Err(StructureError::invalid(
-            "rfp_fit",
-            "non-finite FRF or non-positive frequency",
-        ));
-    }
     let w_max = frequencies_hz.iter().fold(0.0f64, |a, &f| a.max(TAU * f));
     let w_min = frequencies_hz
         .iter()
@@ -104,76 +75,8 @@ pub fn rfp_fit(
     // H scaled to O(1).
     let h_scale = h.iter().fold(0.0f64, |a, c| a.max(c.norm())).max(1e-300);
     let hs: Vec<Complex64> = h.iter().map(|c| c / h_scale).collect();
-    let mut weights = vec![1.0f64; n];
-    let mut a_coef = DVector::<f64>::zeros(na);
-    for _ in 0..5 {
-        let mut m = DMatrix::<f64>::zeros(2 * n, unknowns);
-        let mut rhs = DVector::<f64>::zeros(2 * n);
-        for i in 0..n {
-            let wgt = weights[i];
-            let mut sp = Complex64::new(1.0, 0.0);
-            for j in 0..=nb.max(na) {
-                if j <= nb {
-                    m[(2 * i, j)] = sp.re * wgt;
-                    m[(2 * i + 1, j)] = sp.im * wgt;
-                }
-                if j < na {
-                    let c = -hs[i] * sp;
-                    m[(2 * i, nb + 1 + j)] = c.re * wgt;
-                    m[(2 * i + 1, nb + 1 + j)] = c.im * wgt;
-                }
-                if j == na {
-                    let c = hs[i] * sp;
-                    rhs[2 * i] = c.re * wgt;
-                    rhs[2 * i + 1] = c.im * wgt;
-                }
-                sp *= s[i];
-            }
-        }
-        // Column scaling.
-        let norms: Vec<f64> = (0..unknowns)
-            .map(|j| m.column(j).norm().max(1e-300))
-            .collect();
-        for (j, nj) in norms.iter().enumerate() {
-            m.column_mut(j).scale_mut(1.0 / nj);
-        }
-        let sol = m.svd(true, true).solve(&rhs, 1e-13).map_err(|e| {
-            StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
-        })?;
-        for j in 0..na {
-            a_coef[j] = sol[nb + 1 + j] / norms[nb + 1 + j];
-        }
-        // Sanathanan–Koerner weights 1/|A(s)|.
-        for i in 0..n {
-            let mut a = Complex64::new(0.0, 0.0);
-            let mut sp = Complex64::new(1.0, 0.0);
-            for j in 0..na {
-                a += sp * a_coef[j];
-                sp *= s[i];
-            }
-            a += sp; // monic
-            weights[i] = 1.0 / a.norm().max(1e-300);
-        }
-    }
-    // Roots of the monic denominator: companion matrix.
-    let mut comp = DMatrix::<f64>::zeros(na, na);
-    for j in 0..na {
-        comp[(0, j)] = -a_coef[na - 1 - j];
-    }
-    for j in 1..na {
-        comp[(j, j - 1)] = 1.0;
-    }
-    let roots = comp.complex_eigenvalues();
-    let mut poles: Vec<Complex64> = roots
-        .iter()
-        .map(|r| Complex64::new(r.re, r.im) * w_max)
-        .filter(|p| p.im > 0.0 && p.re < 0.0)
-        .filter(|p| {
-            let w = p.norm();
-            w >= 0.98 * w_min && w <= 1.02 * w_max
-        })
-        .collect();
-    poles.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
+    let a_coef = fit_denominator(&s, &hs, na, nb)?;
+    let poles = stable_poles(&a_coef, w_min, w_max);
     // Residues with fixed poles (+ constant and 1/ω² residual terms), complex least squares
     // written in real form.
     let np = poles.len();
@@ -235,6 +138,141 @@ pub fn rfp_fit(
         relative_error,
         model_modes: n_modes,
     })
+}
+
+/// The FRF points and mode count of [`rfp_fit`] checked: equal lengths, at least one mode,
+/// enough points (≥ 4N + 3), positive finite frequencies and a finite FRF.
+fn check_rfp_input(
+    frequencies_hz: &[f64],
+    h: &[Complex64],
+    n_modes: usize,
+) -> Result<(), StructureError> {
+    let n = frequencies_hz.len();
+    if n != h.len() {
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "frequency and FRF lengths differ",
+        ));
+    }
+    if n_modes == 0 {
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "ask for at least one mode",
+        ));
+    }
+    let na = 2 * n_modes; // denominator degree (monic)
+    let nb = 2 * n_modes + 1; // numerator degree
+    let unknowns = na + nb + 1;
+    if 2 * n < unknowns + 2 {
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            format!(
+                "{n} points are too few for {n_modes} modes (need ≥ {})",
+                unknowns.div_ceil(2) + 1
+            ),
+        ));
+    }
+    if frequencies_hz.iter().any(|f| !(f.is_finite() && *f > 0.0))
+        || h.iter().any(|c| !(c.re.is_finite() && c.im.is_finite()))
+    {
+        return Err(StructureError::invalid(
+            "rfp_fit",
+            "non-finite FRF or non-positive frequency",
+        ));
+    }
+    Ok(())
+}
+
+/// Coefficients of the monic denominator A(s) (degree `na`, numerator degree `nb`) of the
+/// linearised fit B − HA = 0 at the normalised points `s` of the scaled FRF `hs`: five
+/// Sanathanan–Koerner iterations, each row weighted by 1/|A(s)| of the previous iterate.
+fn fit_denominator(
+    s: &[Complex64],
+    hs: &[Complex64],
+    na: usize,
+    nb: usize,
+) -> Result<DVector<f64>, StructureError> {
+    let n = s.len();
+    let unknowns = na + nb + 1;
+    let mut weights = vec![1.0f64; n];
+    let mut a_coef = DVector::<f64>::zeros(na);
+    for _ in 0..5 {
+        let mut m = DMatrix::<f64>::zeros(2 * n, unknowns);
+        let mut rhs = DVector::<f64>::zeros(2 * n);
+        for i in 0..n {
+            let wgt = weights[i];
+            let mut sp = Complex64::new(1.0, 0.0);
+            for j in 0..=nb.max(na) {
+                if j <= nb {
+                    m[(2 * i, j)] = sp.re * wgt;
+                    m[(2 * i + 1, j)] = sp.im * wgt;
+                }
+                if j < na {
+                    let c = -hs[i] * sp;
+                    m[(2 * i, nb + 1 + j)] = c.re * wgt;
+                    m[(2 * i + 1, nb + 1 + j)] = c.im * wgt;
+                }
+                if j == na {
+                    let c = hs[i] * sp;
+                    rhs[2 * i] = c.re * wgt;
+                    rhs[2 * i + 1] = c.im * wgt;
+                }
+                sp *= s[i];
+            }
+        }
+        // Column scaling.
+        let norms: Vec<f64> = (0..unknowns)
+            .map(|j| m.column(j).norm().max(1e-300))
+            .collect();
+        for (j, nj) in norms.iter().enumerate() {
+            m.column_mut(j).scale_mut(1.0 / nj);
+        }
+        let sol = m.svd(true, true).solve(&rhs, 1e-13).map_err(|e| {
+            StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
+        })?;
+        for j in 0..na {
+            a_coef[j] = sol[nb + 1 + j] / norms[nb + 1 + j];
+        }
+        // Sanathanan–Koerner weights 1/|A(s)|.
+        for i in 0..n {
+            let mut a = Complex64::new(0.0, 0.0);
+            let mut sp = Complex64::new(1.0, 0.0);
+            for j in 0..na {
+                a += sp * a_coef[j];
+                sp *= s[i];
+            }
+            a += sp; // monic
+            weights[i] = 1.0 / a.norm().max(1e-300);
+        }
+    }
+    Ok(a_coef)
+}
+
+/// The physical poles of the fit: roots of the monic denominator `a_coef` (companion matrix,
+/// de-normalised by `w_max`), stable complex pairs (upper half) inside the band
+/// [0.98 ω_min, 1.02 ω_max], ascending in |p|.
+fn stable_poles(a_coef: &DVector<f64>, w_min: f64, w_max: f64) -> Vec<Complex64> {
+    let na = a_coef.len();
+    // Roots of the monic denominator: companion matrix.
+    let mut comp = DMatrix::<f64>::zeros(na, na);
+    for j in 0..na {
+        comp[(0, j)] = -a_coef[na - 1 - j];
+    }
+    for j in 1..na {
+        comp[(j, j - 1)] = 1.0;
+    }
+    let roots = comp.complex_eigenvalues();
+    let mut poles: Vec<Complex64> = roots
+        .iter()
+        .map(|r| Complex64::new(r.re, r.im) * w_max)
+        .filter(|p| p.im > 0.0 && p.re < 0.0)
+        .filter(|p| {
+            let w = p.norm();
+            w >= 0.98 * w_min && w <= 1.02 * w_max
+        })
+        .collect();
+    poles.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
+    poles
 }
 
 /// Half-power bandwidth damping around each of the given resonance frequencies
