@@ -225,7 +225,17 @@ impl HexMesh {
 
     /// Total volume from the 2 × 2 × 2 Gauss rule \[m³\].
     pub fn volume(&self) -> f64 {
-        super::svk::element_volumes(self).iter().sum()
+        let volumes: Vec<f64> = self
+            .elements
+            .iter()
+            .map(|el| {
+                super::hex8::element_gauss_points(&self.nodes, el)
+                    .iter()
+                    .map(|p| p.wdet)
+                    .sum()
+            })
+            .collect();
+        volumes.iter().sum()
     }
 
     /// The node nearest to `p`.
@@ -444,7 +454,7 @@ const CORNERS: [[f64; 3]; 8] = [
 
 /// Jacobian determinant of a hex8 with corners `x` at the parametric point `xi`.
 pub fn jacobian_det(x: &[[f64; 3]; 8], xi: [f64; 3]) -> f64 {
-    let (_, dxi) = super::svk::shape(xi);
+    let (_, dxi) = super::hex8::shape(xi);
     let mut j = [[0.0; 3]; 3];
     for a in 0..8 {
         for r in 0..3 {
