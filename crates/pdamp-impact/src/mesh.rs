@@ -147,6 +147,23 @@ impl Builder {
     }
 }
 
+/// Element sizes of a mesh: $h_c$ in the contact zone, growing by `growth` beyond `zone` up to
+/// `hmax` (all in m but `growth`).
+#[derive(Debug, Clone, Copy)]
+struct Sizing {
+    hc: f64,
+    zone: f64,
+    hmax: f64,
+    growth: f64,
+}
+
+/// The wall's top-face nodes and its clamped contour (outer mantle and bottom).
+struct WallNodes {
+    surface: Vec<u32>,
+    fix_r: Vec<u32>,
+    fix_z: Vec<u32>,
+}
+
 /// Builds the mesh: sphere of `radius` (m) with its pole at the origin; wall cylinder of
 /// `wall_radius` × `wall_height` (m) below z = 0 if `with_wall`. `a_ref` is the expected
 /// contact radius (m).
@@ -161,6 +178,12 @@ pub fn build(
     let hc = a_ref / p.elems_per_contact_radius;
     let hmax = p.max_size_over_radius * radius;
     let zone = p.zone_factor * a_ref;
+    let sz = Sizing {
+        hc,
+        zone,
+        hmax,
+        growth: p.growth,
+    };
     let mut b = Builder {
         r: Vec::new(),
         z: Vec::new(),
@@ -168,12 +191,66 @@ pub fn build(
     };
     // ---------------- sphere ----------------
     let rr = radius;
+    let inner = sphere_core(&mut b, rr, sz);
+    let surface = sphere_shell(&mut b, rr, &inner, sz);
+    let n_sphere = b.r.len();
+    let e_sphere = b.elems.len();
+    // ---------------- wall ----------------
+    let wall = if with_wall {
+        wall_cylinder(&mut b, wall_radius, wall_height, sz)
+    } else {
+        WallNodes {
+            surface: Vec::new(),
+            fix_r: Vec::new(),
+            fix_z: Vec::new(),
+        }
+    };
+    let n = b.r.len();
+    let mut fix_r = vec![false; n];
+    let mut fix_z = vec![false; n];
+    for (f, r) in fix_r.iter_mut().zip(&b.r) {
+        if r.abs() < 1e-12 * rr {
+            *f = true;
+        }
+    }
+    for &i in &wall.fix_r {
+        fix_r[i as usize] = true;
+    }
+    for &i in &wall.fix_z {
+        fix_z[i as usize] = true;
+    }
+    Mesh {
+        r: b.r,
+        z: b.z,
+        elems: b.elems.clone(),
+        sphere_nodes: 0..n_sphere,
+        wall_nodes: n_sphere..n,
+        sphere_elems: 0..e_sphere,
+        wall_elems: e_sphere..b.elems.len(),
+        sphere_surface: surface,
+        wall_surface: wall.surface,
+        fix_r,
+        fix_z,
+        h_contact: hc,
+    }
+}
+
+/// The sphere's inner rectangle (half width and half height R/2 about the centre, columns
+/// graded fine at the axis); returns its boundary points (bottom → right → top) with their
+/// surface angles θ (0 = south pole).
+fn sphere_core(b: &mut Builder, rr: f64, sz: Sizing) -> Vec<(u32, f64)> {
+    let Sizing {
+        hc,
+        zone,
+        hmax,
+        growth,
+    } = sz;
     let a = 0.5 * rr; // inner rectangle half width / half height
     let zc = rr; // centre
     // The bottom edge maps linearly onto the arc θ ∈ [0, π/4] (arc length (π/4)R over the
     // edge length a), so its spacing is the surface spacing scaled by `sc`.
     let sc = a / (std::f64::consts::FRAC_PI_4 * rr);
-    let rs = graded(a, hc * sc, zone * sc, hmax * sc, p.growth); // rectangle columns (fine at the axis)
+    let rs = graded(a, hc * sc, zone * sc, hmax * sc, growth); // rectangle columns (fine at the axis)
     let nz_rect = ((std::f64::consts::FRAC_PI_2 * rr / hmax).ceil() as usize).max(2);
     let zs: Vec<f64> = (0..=nz_rect)
         .map(|j| zc - a + 2.0 * a * j as f64 / nz_rect as f64)
@@ -211,8 +288,17 @@ pub fn build(
     for i in (0..nr).rev() {
         inner.push((rect[i][nz_rect], std::f64::consts::PI - theta_bottom(rs[i])));
     }
+    inner
+}
+
+/// The sphere's shell between the inner rectangle's boundary `inner` and the surface: rays
+/// from each boundary point to the surface point at its angle θ, depth graded from the
+/// surface (fine) to the rectangle; returns the surface nodes from the south pole upwards.
+fn sphere_shell(b: &mut Builder, rr: f64, inner: &[(u32, f64)], sz: Sizing) -> Vec<u32> {
+    let a = 0.5 * rr; // inner rectangle half width / half height
+    let zc = rr; // centre
     // depth fractions, graded from the surface (fine) to the rectangle (f = 1)
-    let depth = graded(a, hc, zone, hmax, p.growth);
+    let depth = graded(a, sz.hc, sz.zone, sz.hmax, sz.growth);
     let fr: Vec<f64> = depth.iter().map(|d| d / a).collect();
     let nk = fr.len() - 1;
     let mut ring = vec![vec![0u32; nk + 1]; inner.len()];
@@ -253,71 +339,49 @@ pub fn build(
             ]);
         }
     }
-    let n_sphere = b.r.len();
-    let e_sphere = b.elems.len();
-    // ---------------- wall ----------------
+    surface
+}
+
+/// The wall cylinder `wall_radius` × `wall_height` below z = 0, graded fine at the axis and
+/// at the top face; returns its top-face nodes and clamped contour.
+fn wall_cylinder(b: &mut Builder, wall_radius: f64, wall_height: f64, sz: Sizing) -> WallNodes {
     let mut wall_surface = Vec::new();
     let mut fix_r_nodes = Vec::new();
     let mut fix_z_nodes = Vec::new();
-    if with_wall {
-        let wr = graded(wall_radius, hc, zone, hmax, p.growth);
-        let wd = graded(wall_height, hc, zone, hmax, p.growth);
-        let mut grid = vec![vec![0u32; wd.len()]; wr.len()];
-        for (i, &r) in wr.iter().enumerate() {
-            for (j, &d) in wd.iter().enumerate() {
-                grid[i][j] = b.node(r, -d);
-            }
-        }
-        for i in 0..wr.len() - 1 {
-            for j in 0..wd.len() - 1 {
-                b.quad([
-                    grid[i][j + 1],
-                    grid[i + 1][j + 1],
-                    grid[i + 1][j],
-                    grid[i][j],
-                ]);
-            }
-        }
-        for col in &grid {
-            wall_surface.push(col[0]);
-        }
-        // clamped contour: outer mantle and bottom
-        for col in &grid {
-            fix_r_nodes.push(*col.last().unwrap());
-            fix_z_nodes.push(*col.last().unwrap());
-        }
-        for &n in grid.last().unwrap() {
-            fix_r_nodes.push(n);
-            fix_z_nodes.push(n);
+    let wr = graded(wall_radius, sz.hc, sz.zone, sz.hmax, sz.growth);
+    let wd = graded(wall_height, sz.hc, sz.zone, sz.hmax, sz.growth);
+    let mut grid = vec![vec![0u32; wd.len()]; wr.len()];
+    for (i, &r) in wr.iter().enumerate() {
+        for (j, &d) in wd.iter().enumerate() {
+            grid[i][j] = b.node(r, -d);
         }
     }
-    let n = b.r.len();
-    let mut fix_r = vec![false; n];
-    let mut fix_z = vec![false; n];
-    for (f, r) in fix_r.iter_mut().zip(&b.r) {
-        if r.abs() < 1e-12 * rr {
-            *f = true;
+    for i in 0..wr.len() - 1 {
+        for j in 0..wd.len() - 1 {
+            b.quad([
+                grid[i][j + 1],
+                grid[i + 1][j + 1],
+                grid[i + 1][j],
+                grid[i][j],
+            ]);
         }
     }
-    for &i in &fix_r_nodes {
-        fix_r[i as usize] = true;
+    for col in &grid {
+        wall_surface.push(col[0]);
     }
-    for &i in &fix_z_nodes {
-        fix_z[i as usize] = true;
+    // clamped contour: outer mantle and bottom
+    for col in &grid {
+        fix_r_nodes.push(*col.last().unwrap());
+        fix_z_nodes.push(*col.last().unwrap());
     }
-    Mesh {
-        r: b.r,
-        z: b.z,
-        elems: b.elems.clone(),
-        sphere_nodes: 0..n_sphere,
-        wall_nodes: n_sphere..n,
-        sphere_elems: 0..e_sphere,
-        wall_elems: e_sphere..b.elems.len(),
-        sphere_surface: surface,
-        wall_surface,
-        fix_r,
-        fix_z,
-        h_contact: hc,
+    for &n in grid.last().unwrap() {
+        fix_r_nodes.push(n);
+        fix_z_nodes.push(n);
+    }
+    WallNodes {
+        surface: wall_surface,
+        fix_r: fix_r_nodes,
+        fix_z: fix_z_nodes,
     }
 }
 

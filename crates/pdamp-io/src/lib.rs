@@ -11,7 +11,6 @@ pub mod bench;
 pub mod checkpoint;
 pub mod csv;
 pub mod error;
-pub mod estimate;
 pub mod examples;
 pub mod fuzz;
 pub mod output_dir;
@@ -24,3 +23,5 @@ pub mod stl;
 pub mod vtk;
 
 pub use error::InputError;
+// The estimate of a scenario lives at `scenario::estimate`; `pdamp_io::estimate` stays its path.
+pub use scenario::estimate;

@@ -8,6 +8,7 @@ use crate::InputError;
 use crate::bed::{BedFile, save_bed};
 use crate::checkpoint::CheckpointError;
 use crate::error::Source;
+pub use crate::scenario::excitation_direction;
 use crate::scenario::{Preparation, Scenario};
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::drop_down::DropDownReport;
@@ -146,7 +147,7 @@ struct PreparedFile {
 }
 
 /// Saves a prepared bed to `path` (atomic; the checkpoint framing of [`crate::checkpoint`],
-/// kind [`PREPARED_KIND`], keyed by [`crate::run::scenario_content_digest`] of `scenario`),
+/// kind [`PREPARED_KIND`], keyed by [`crate::provenance::scenario_content_digest`] of `scenario`),
 /// so that another process — a task of a sweep on another node — continues from the same bits
 /// with [`load_prepared`] instead of preparing the bed again.
 pub fn save_prepared(
@@ -155,7 +156,7 @@ pub fn save_prepared(
     scenario: &Scenario,
     base_dir: &Path,
 ) -> Result<(), CheckpointError> {
-    let digest = crate::run::scenario_content_digest(scenario, base_dir);
+    let digest = crate::provenance::scenario_content_digest(scenario, base_dir);
     crate::checkpoint::save(
         path,
         &crate::checkpoint::CheckpointHeader::new(PREPARED_KIND, &digest),
@@ -178,7 +179,7 @@ pub fn load_prepared(
     scenario: &Scenario,
     base_dir: &Path,
 ) -> Result<Option<PreparedBed>, PrepareError> {
-    let digest = crate::run::scenario_content_digest(scenario, base_dir);
+    let digest = crate::provenance::scenario_content_digest(scenario, base_dir);
     let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest).map_err(
         |e| match e {
             CheckpointError::Io { path, cause } => PrepareError::prepared(path, cause),
@@ -208,11 +209,6 @@ pub fn load_prepared(
         drop_down: f.drop_down,
         fill_statistics: f.fill_statistics,
     }))
-}
-
-/// The excitation direction of a damper scenario (for the clearance), if it has one.
-pub fn excitation_direction(scenario: &Scenario) -> Option<Vec3> {
-    scenario.damper.as_ref().map(|d| Vec3::from(d.direction))
 }
 
 /// `summary.json` of `pdamp settle`.
@@ -258,7 +254,7 @@ pub fn settle_scenario(
         .write(scenario, out)
         .map_err(io)?;
     let stats = bed_statistics(world, excitation_direction(scenario));
-    let digest = crate::run::scenario_digest(scenario);
+    let digest = crate::provenance::scenario_digest(scenario);
     let bed = Bed::from_world(world);
     save_bed(
         &out.join("bed.pdbed"),

@@ -1,7 +1,10 @@
 //! Where an output comes from: `provenance.json` in every output directory (next to the
 //! `scenario.toml` copy) names the pdamp version, the command line, the scenario digest, the
-//! seed and the thread count, so every figure can be traced and reproduced.
+//! seed and the thread count, so every figure can be traced and reproduced. The scenario
+//! digests that key checkpoints and stored results live here too ([`scenario_digest`],
+//! [`scenario_content_digest`]).
 
+use crate::scenario::Scenario;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -31,7 +34,7 @@ impl Provenance {
             pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
             command: std::env::args().collect(),
             scenario_title: scenario.title.clone(),
-            scenario_digest: crate::run::scenario_digest(scenario),
+            scenario_digest: scenario_digest(scenario),
             seed: scenario.simulation.seed,
             threads: rayon::current_num_threads(),
             started_unix_s: std::time::SystemTime::now()
@@ -85,4 +88,35 @@ impl Provenance {
         let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
         crate::atomic::write_atomic(dir.join("provenance.json"), json.as_bytes())
     }
+}
+
+/// Digest identifying a scenario in checkpoints and outputs (of its canonical TOML).
+pub fn scenario_digest(scenario: &Scenario) -> String {
+    crate::checkpoint::digest(scenario.to_toml().as_bytes())
+}
+
+/// The content of every file the scenario reads ([`Scenario::referenced_files`], relative to
+/// `base_dir`) as TOML comment lines `# file <path>: <digest of its bytes>` (`unreadable`
+/// where it cannot be read), so that a checkpoint or a stored result is never continued with
+/// a changed mesh or bed behind an unchanged path.
+pub fn referenced_files_digest(scenario: &Scenario, base_dir: &Path) -> String {
+    let mut s = String::new();
+    for f in scenario.referenced_files() {
+        let d = std::fs::read(base_dir.join(&f)).map_or_else(
+            |_| "unreadable".to_string(),
+            |b| crate::checkpoint::digest(&b),
+        );
+        s.push_str(&format!("# file {}: {d}\n", f.display()));
+    }
+    s
+}
+
+/// Digest of a scenario together with the content of the files it reads (checkpoints and
+/// stored results of runs are keyed by it).
+pub fn scenario_content_digest(scenario: &Scenario, base_dir: &Path) -> String {
+    let files = referenced_files_digest(scenario, base_dir);
+    if files.is_empty() {
+        return scenario_digest(scenario);
+    }
+    crate::checkpoint::digest((scenario.to_toml() + &files).as_bytes())
 }

@@ -9,12 +9,12 @@ use plotters::prelude::*;
 use crate::axis::{Axis, cell_edges};
 use crate::color::{ColorScale, Rgb};
 use crate::legend::{
-    LegendEntry, Occupancy, Placement, PxRect, Swatch, draw_legend_box, legend_size, place_legend,
+    LegendEntry, Occupancy, Placement, Swatch, draw_legend_box, legend_size, place_legend,
 };
 use crate::render::{
-    AxisLayout, COLORBAR_WIDTH, ColorBar, Figure, Frame, TICK_PT, chart_rect, clip_polyline, de,
-    draw_axes, draw_colorbar, draw_frame, draw_polyline, font, rgb, segments, titled, write_figure,
-    y_label_width,
+    AxisLayout, COLORBAR_WIDTH, ColorBar, Figure, Frame, PxRect, TICK_PT, chart_rect,
+    clip_polyline, de, draw_axes, draw_colorbar, draw_frame, draw_polyline, font, rgb, segments,
+    titled, write_figure, y_label_width,
 };
 use crate::{LegendPosition, PlotError, PlotFiles};
 

@@ -13,8 +13,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::color::Rgb;
-use crate::line::Marker;
-use crate::render::{LEGEND_PT, clip_polyline, de, font, rgb};
+use crate::marker::{Marker, marker_element};
+use crate::render::{LEGEND_PT, PxRect, clip_polyline, de, font, rgb};
 use crate::{LegendPosition, PlotError};
 
 /// The symbol of a legend entry.
@@ -42,53 +42,6 @@ pub(crate) enum Swatch {
 pub(crate) struct LegendEntry {
     pub label: String,
     pub swatch: Swatch,
-}
-
-/// A pixel rectangle `[x0, x1] × [y0, y1]` (y down) relative to the drawing area.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PxRect {
-    pub x0: f64,
-    pub y0: f64,
-    pub x1: f64,
-    pub y1: f64,
-}
-
-impl PxRect {
-    pub fn w(&self) -> f64 {
-        self.x1 - self.x0
-    }
-
-    pub fn h(&self) -> f64 {
-        self.y1 - self.y0
-    }
-
-    pub fn contains(&self, p: (f64, f64)) -> bool {
-        p.0 >= self.x0 && p.0 <= self.x1 && p.1 >= self.y0 && p.1 <= self.y1
-    }
-
-    pub fn grown(&self, d: f64) -> Self {
-        Self {
-            x0: self.x0 - d,
-            y0: self.y0 - d,
-            x1: self.x1 + d,
-            y1: self.y1 + d,
-        }
-    }
-
-    /// Maps display-space `(tx, ty)` of axes spanning `x`/`y` onto this rectangle.
-    pub fn map(&self, x: (f64, f64), y: (f64, f64), t: (f64, f64)) -> (f64, f64) {
-        let fx = if x.1 > x.0 {
-            (t.0 - x.0) / (x.1 - x.0)
-        } else {
-            0.5
-        };
-        let fy = if y.1 > y.0 {
-            (t.1 - y.0) / (y.1 - y.0)
-        } else {
-            0.5
-        };
-        (self.x0 + fx * self.w(), self.y1 - fy * self.h())
-    }
 }
 
 /// What is drawn in the plotting area, in pixels (see [`PxRect`]): polylines and markers.
@@ -285,7 +238,7 @@ fn draw_swatch<DB: DrawingBackend>(
                 ))
                 .map_err(de)?;
             }
-            area.draw(&crate::line::marker_element::<DB>(
+            area.draw(&marker_element::<DB>(
                 marker,
                 (x + w / 2, y),
                 size.max(1),

@@ -26,6 +26,7 @@ mod color;
 mod heatmap;
 mod legend;
 mod line;
+mod marker;
 mod raster;
 mod render;
 mod scatter;
@@ -38,9 +39,8 @@ pub use axis::{
 };
 pub use color::{ColorMap, ColorScale, MISSING_COLOR, PALETTE, Rgb, palette_color};
 pub use heatmap::{HeatMap, Polyline, heat_map};
-pub use line::{
-    FrfPlot, FrfSeries, LinePlot, Marker, Series, XSpan, frf_plot, frf_plot_with, line_plot,
-};
+pub use line::{FrfPlot, FrfSeries, LinePlot, Series, XSpan, frf_plot, frf_plot_with, line_plot};
+pub use marker::Marker;
 pub use scatter::{Quiver, QuiverKey, ScatterField, scatter_field, typical_spacing};
 
 /// Where the legend is placed.

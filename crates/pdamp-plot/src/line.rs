@@ -3,34 +3,21 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
-use plotters::element::DynElement;
 use plotters::prelude::*;
 
 use crate::axis::{Axis, Scale};
 use crate::color::{Rgb, palette_color};
 use crate::legend::{
-    LegendEntry, Occupancy, Placement, PxRect, Swatch, draw_legend_box, legend_size, outside_rect,
+    LegendEntry, Occupancy, Placement, Swatch, draw_legend_box, legend_size, outside_rect,
     outside_width, place_legend,
 };
+use crate::marker::{Marker, marker_element};
 use crate::render::{
-    AUTO_MARGIN, AxisLayout, Coord2, Figure, Frame, auto_range, build_chart, chart_rect, de,
-    draw_axes, draw_frame, draw_polyline, draw_right_axis, plot_rect, rgb, right_axis_width,
+    AUTO_MARGIN, AxisLayout, Coord2, Figure, Frame, PxRect, auto_range, build_chart, chart_rect,
+    de, draw_axes, draw_frame, draw_polyline, draw_right_axis, plot_rect, rgb, right_axis_width,
     segments, titled, write_figure, y_label_width,
 };
 use crate::{LegendPosition, PlotError, PlotFiles};
-
-/// Marker symbol drawn at each data point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Marker {
-    /// Filled circle.
-    Circle,
-    /// Filled square.
-    Square,
-    /// Filled triangle.
-    Triangle,
-    /// Diagonal cross.
-    Cross,
-}
 
 /// One named `(x, y)` data series of a [`LinePlot`]. Points that cannot be
 /// drawn (NaN, or ≤ 0 on a log axis) are skipped and break the line.
@@ -220,23 +207,6 @@ impl LinePlot {
 /// Writes the line plot to `<stem>.png` and `<stem>.svg`.
 pub fn line_plot(stem: impl AsRef<Path>, plot: &LinePlot) -> Result<PlotFiles, PlotError> {
     write_figure(stem.as_ref(), plot)
-}
-
-pub(crate) fn marker_element<DB: DrawingBackend>(
-    marker: Marker,
-    at: (i32, i32),
-    size: u32,
-    color: RGBColor,
-) -> DynElement<'static, DB, (i32, i32)> {
-    let s = size as i32;
-    match marker {
-        Marker::Circle => Circle::new(at, size, color.filled()).into_dyn(),
-        Marker::Square => {
-            Rectangle::new([(at.0 - s, at.1 - s), (at.0 + s, at.1 + s)], color.filled()).into_dyn()
-        }
-        Marker::Triangle => TriangleMarker::new(at, size + 1, color.filled()).into_dyn(),
-        Marker::Cross => Cross::new(at, size, color.stroke_width(2)).into_dyn(),
-    }
 }
 
 /// Maps a secondary-axis display value onto the primary axis' display range.

@@ -14,9 +14,55 @@ use plotters::style::{FontTransform, register_font};
 
 use crate::axis::{Scale, Ticks, ticks};
 use crate::color::{ColorScale, MISSING_COLOR, Rgb};
-use crate::legend::PxRect;
 use crate::raster::RasterBackend;
 use crate::{PlotError, PlotFiles};
+
+/// A pixel rectangle `[x0, x1] × [y0, y1]` (y down) relative to the drawing area.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PxRect {
+    pub x0: f64,
+    pub y0: f64,
+    pub x1: f64,
+    pub y1: f64,
+}
+
+impl PxRect {
+    pub fn w(&self) -> f64 {
+        self.x1 - self.x0
+    }
+
+    pub fn h(&self) -> f64 {
+        self.y1 - self.y0
+    }
+
+    pub fn contains(&self, p: (f64, f64)) -> bool {
+        p.0 >= self.x0 && p.0 <= self.x1 && p.1 >= self.y0 && p.1 <= self.y1
+    }
+
+    pub fn grown(&self, d: f64) -> Self {
+        Self {
+            x0: self.x0 - d,
+            y0: self.y0 - d,
+            x1: self.x1 + d,
+            y1: self.y1 + d,
+        }
+    }
+
+    /// Maps display-space `(tx, ty)` of axes spanning `x`/`y` onto this rectangle.
+    pub fn map(&self, x: (f64, f64), y: (f64, f64), t: (f64, f64)) -> (f64, f64) {
+        let fx = if x.1 > x.0 {
+            (t.0 - x.0) / (x.1 - x.0)
+        } else {
+            0.5
+        };
+        let fy = if y.1 > y.0 {
+            (t.1 - y.0) / (y.1 - y.0)
+        } else {
+            0.5
+        };
+        (self.x0 + fx * self.w(), self.y1 - fy * self.h())
+    }
+}
 
 /// Font family name under which the embedded font is registered.
 pub(crate) const FONT: &str = "sans-serif";

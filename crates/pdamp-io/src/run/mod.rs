@@ -4,6 +4,7 @@
 use crate::checkpoint::CheckpointError;
 use crate::csv::CsvWriter;
 pub use crate::error::RunError;
+pub use crate::provenance::{referenced_files_digest, scenario_content_digest, scenario_digest};
 use crate::scenario::Scenario;
 use crate::vtk::{PvdSeries, VtkEncoding};
 use pdamp_dem::WorldState;
@@ -226,37 +227,6 @@ fn report_failure(
 
 /// Kind tag of `run` checkpoints.
 const RUN_KIND: &str = "run";
-
-/// Digest identifying a scenario in checkpoints and outputs (of its canonical TOML).
-pub fn scenario_digest(scenario: &Scenario) -> String {
-    crate::checkpoint::digest(scenario.to_toml().as_bytes())
-}
-
-/// The content of every file the scenario reads ([`Scenario::referenced_files`], relative to
-/// `base_dir`) as TOML comment lines `# file <path>: <digest of its bytes>` (`unreadable`
-/// where it cannot be read), so that a checkpoint or a stored result is never continued with
-/// a changed mesh or bed behind an unchanged path.
-pub fn referenced_files_digest(scenario: &Scenario, base_dir: &Path) -> String {
-    let mut s = String::new();
-    for f in scenario.referenced_files() {
-        let d = std::fs::read(base_dir.join(&f)).map_or_else(
-            |_| "unreadable".to_string(),
-            |b| crate::checkpoint::digest(&b),
-        );
-        s.push_str(&format!("# file {}: {d}\n", f.display()));
-    }
-    s
-}
-
-/// Digest of a scenario together with the content of the files it reads (checkpoints and
-/// stored results of runs are keyed by it).
-pub fn scenario_content_digest(scenario: &Scenario, base_dir: &Path) -> String {
-    let files = referenced_files_digest(scenario, base_dir);
-    if files.is_empty() {
-        return scenario_digest(scenario);
-    }
-    crate::checkpoint::digest((scenario.to_toml() + &files).as_bytes())
-}
 
 /// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
 /// `progress(phase, fraction)` is called regularly. Checkpoints every
@@ -661,7 +631,7 @@ fn open_fresh_outputs(
     let vtk_dir = out_dir.join("vtk");
     let vtk_every = scenario.output.vtk_interval_s;
     // The bed the main run starts from (measured once; a resumed run reads it back).
-    let stats = bed_statistics(world, crate::prepare::excitation_direction(scenario));
+    let stats = bed_statistics(world, crate::scenario::excitation_direction(scenario));
     let json = serde_json::to_string_pretty(&stats)?;
     crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes()).map_err(io)?;
     let mut series = if vtk_every > 0.0 {

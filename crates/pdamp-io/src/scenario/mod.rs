@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod build;
+pub mod estimate;
 mod particles;
 mod validate;
 pub use build::Preparation;
@@ -768,7 +769,7 @@ impl Scenario {
     pub fn load_and_build(path: &Path) -> Result<(Self, World), ScenarioError> {
         let s = Self::load(path)?;
         // Work and memory before anything is allocated (one run or one damper point).
-        crate::estimate::Estimate::of(&s, 1, rayon::current_num_threads())
+        estimate::Estimate::of(&s, 1, rayon::current_num_threads())
             .check()
             .map_err(|e| {
                 let text = std::fs::read_to_string(path).ok();
@@ -847,4 +848,9 @@ impl Scenario {
             .map(|(i, _)| i)
             .collect()
     }
+}
+
+/// The excitation direction of a damper scenario (for the clearance), if it has one.
+pub fn excitation_direction(scenario: &Scenario) -> Option<Vec3> {
+    scenario.damper.as_ref().map(|d| Vec3::from(d.direction))
 }

@@ -225,7 +225,17 @@ impl HexMesh {
 
     /// Total volume from the 2 × 2 × 2 Gauss rule \[m³\].
     pub fn volume(&self) -> f64 {
-        super::svk::element_volumes(self).iter().sum()
+        let volumes: Vec<f64> = self
+            .elements
+            .iter()
+            .map(|el| {
+                super::hex8::element_gauss_points(&self.nodes, el)
+                    .iter()
+                    .map(|p| p.wdet)
+                    .sum()
+            })
+            .collect();
+        volumes.iter().sum()
     }
 
     /// The node nearest to `p`.
@@ -444,7 +454,7 @@ const CORNERS: [[f64; 3]; 8] = [
 
 /// Jacobian determinant of a hex8 with corners `x` at the parametric point `xi`.
 pub fn jacobian_det(x: &[[f64; 3]; 8], xi: [f64; 3]) -> f64 {
-    let (_, dxi) = super::svk::shape(xi);
+    let (_, dxi) = super::hex8::shape(xi);
     let mut j = [[0.0; 3]; 3];
     for a in 0..8 {
         for r in 0..3 {
@@ -616,13 +626,12 @@ pub fn read_gmsh(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
         return Err(MeshError::BadScale(scale));
     }
     let lines: Vec<&str> = text.lines().collect();
-    let line = |l: usize| lines.get(l).copied().unwrap_or("");
+    let line = |l: usize| line_at(&lines, l);
     let mut version = 2.2;
     let mut nodes = NodeTable::default();
     let mut elems = Vec::new();
     let mut i = 0;
     while i < lines.len() {
-        let left = |l: usize| lines.len().saturating_sub(l + 1);
         match lines[i].trim() {
             "$MeshFormat" => {
                 version = nums::<f64>(line(i + 1), i + 1)?
@@ -639,130 +648,153 @@ pub fn read_gmsh(text: &str, scale: f64) -> Result<HexMesh, MeshError> {
                 }
                 i += 2;
             }
-            "$Nodes" if version < 4.0 => {
-                let h = nums::<i64>(line(i + 1), i + 1)?;
-                let n = announced(
-                    h.first().copied().unwrap_or(0),
-                    i + 1,
-                    "nodes",
-                    left(i + 1),
-                    1,
-                )?;
-                for k in 0..n {
-                    let l = i + 2 + k;
-                    let (id, x) = node_line(line(l), l)?;
-                    nodes.insert(id, x, l)?;
-                }
-                i += 2 + n;
-            }
-            "$Nodes" => {
-                let h = nums::<i64>(line(i + 1), i + 1)?;
-                let blocks = announced(
-                    h.first().copied().unwrap_or(0),
-                    i + 1,
-                    "node blocks",
-                    left(i + 1),
-                    1,
-                )?;
-                let mut l = i + 2;
-                for _ in 0..blocks {
-                    let b = nums::<i64>(line(l), l)?;
-                    if b.len() < 4 {
-                        return Err(perr(
-                            l,
-                            "node block header needs entityDim entityTag parametric numNodes",
-                        ));
-                    }
-                    let n = announced(b[3], l, "nodes in the block", left(l), 2)?;
-                    let mut tags = Vec::new();
-                    for k in 0..n {
-                        let v = nums::<i64>(line(l + 1 + k), l + 1 + k)?;
-                        tags.push(
-                            *v.first()
-                                .ok_or_else(|| perr(l + 1 + k, "missing node tag"))?,
-                        );
-                    }
-                    for (k, t) in tags.iter().enumerate() {
-                        let ll = l + 1 + n + k;
-                        let (_, x) = node_line(&format!("{t} {}", line(ll)), ll)?;
-                        nodes.insert(*t, x, ll)?;
-                    }
-                    l += 1 + 2 * n;
-                }
-                i = l;
-            }
-            "$Elements" if version < 4.0 => {
-                let h = nums::<i64>(line(i + 1), i + 1)?;
-                let n = announced(
-                    h.first().copied().unwrap_or(0),
-                    i + 1,
-                    "elements",
-                    left(i + 1),
-                    1,
-                )?;
-                for k in 0..n {
-                    let l = i + 2 + k;
-                    let v = nums::<i64>(line(l), l)?;
-                    if v.len() >= 3 && v[1] == 5 {
-                        let nt = usize::try_from(v[2])
-                            .map_err(|_| perr(l, "negative number of tags"))?;
-                        let c = nt
-                            .checked_add(3)
-                            .and_then(|s| v.get(s..s.checked_add(8)?))
-                            .ok_or_else(|| {
-                                perr(l, format!("element {}: hex8 needs 8 nodes", v[0]))
-                            })?;
-                        elems.push(RawHex {
-                            id: v[0],
-                            nodes: c.try_into().map_err(|_| perr(l, "hex8 needs 8 nodes"))?,
-                            line: l,
-                        });
-                    }
-                }
-                i += 2 + n;
-            }
-            "$Elements" => {
-                let h = nums::<i64>(line(i + 1), i + 1)?;
-                let blocks = announced(
-                    h.first().copied().unwrap_or(0),
-                    i + 1,
-                    "element blocks",
-                    left(i + 1),
-                    1,
-                )?;
-                let mut l = i + 2;
-                for _ in 0..blocks {
-                    let b = nums::<i64>(line(l), l)?;
-                    if b.len() < 4 {
-                        return Err(perr(
-                            l,
-                            "element block header needs entityDim entityTag elementType numElements",
-                        ));
-                    }
-                    let ty = b[2];
-                    let n = announced(b[3], l, "elements in the block", left(l), 1)?;
-                    for k in 0..n {
-                        let ll = l + 1 + k;
-                        if ty == 5 {
-                            let v = nums::<i64>(line(ll), ll)?;
-                            let c = v
-                                .get(1..9)
-                                .ok_or_else(|| perr(ll, "hex8 needs a tag and 8 nodes"))?;
-                            elems.push(RawHex {
-                                id: v[0],
-                                nodes: c.try_into().map_err(|_| perr(ll, "hex8 needs 8 nodes"))?,
-                                line: ll,
-                            });
-                        }
-                    }
-                    l += 1 + n;
-                }
-                i = l;
-            }
+            "$Nodes" if version < 4.0 => i = gmsh_nodes_v2(&lines, i, &mut nodes)?,
+            "$Nodes" => i = gmsh_nodes_v4(&lines, i, &mut nodes)?,
+            "$Elements" if version < 4.0 => i = gmsh_elements_v2(&lines, i, &mut elems)?,
+            "$Elements" => i = gmsh_elements_v4(&lines, i, &mut elems)?,
             _ => i += 1,
         }
     }
     compact(&nodes, &elems, scale)
+}
+
+/// Line `l` of the file, empty past its end.
+fn line_at<'a>(lines: &[&'a str], l: usize) -> &'a str {
+    lines.get(l).copied().unwrap_or("")
+}
+
+/// Lines of the file after line `l`.
+fn lines_left(lines: &[&str], l: usize) -> usize {
+    lines.len().saturating_sub(l + 1)
+}
+
+/// The `$Nodes` section of format 2.2 starting at line `i` (a count, then `id x y z` lines);
+/// returns the line after it.
+fn gmsh_nodes_v2(lines: &[&str], i: usize, nodes: &mut NodeTable) -> Result<usize, MeshError> {
+    let h = nums::<i64>(line_at(lines, i + 1), i + 1)?;
+    let n = announced(
+        h.first().copied().unwrap_or(0),
+        i + 1,
+        "nodes",
+        lines_left(lines, i + 1),
+        1,
+    )?;
+    for k in 0..n {
+        let l = i + 2 + k;
+        let (id, x) = node_line(line_at(lines, l), l)?;
+        nodes.insert(id, x, l)?;
+    }
+    Ok(i + 2 + n)
+}
+
+/// The `$Nodes` section of format 4.1 starting at line `i` (node blocks: a header, the tags,
+/// then the coordinates); returns the line after it.
+fn gmsh_nodes_v4(lines: &[&str], i: usize, nodes: &mut NodeTable) -> Result<usize, MeshError> {
+    let h = nums::<i64>(line_at(lines, i + 1), i + 1)?;
+    let blocks = announced(
+        h.first().copied().unwrap_or(0),
+        i + 1,
+        "node blocks",
+        lines_left(lines, i + 1),
+        1,
+    )?;
+    let mut l = i + 2;
+    for _ in 0..blocks {
+        let b = nums::<i64>(line_at(lines, l), l)?;
+        if b.len() < 4 {
+            return Err(perr(
+                l,
+                "node block header needs entityDim entityTag parametric numNodes",
+            ));
+        }
+        let n = announced(b[3], l, "nodes in the block", lines_left(lines, l), 2)?;
+        let mut tags = Vec::new();
+        for k in 0..n {
+            let v = nums::<i64>(line_at(lines, l + 1 + k), l + 1 + k)?;
+            tags.push(
+                *v.first()
+                    .ok_or_else(|| perr(l + 1 + k, "missing node tag"))?,
+            );
+        }
+        for (k, t) in tags.iter().enumerate() {
+            let ll = l + 1 + n + k;
+            let (_, x) = node_line(&format!("{t} {}", line_at(lines, ll)), ll)?;
+            nodes.insert(*t, x, ll)?;
+        }
+        l += 1 + 2 * n;
+    }
+    Ok(l)
+}
+
+/// The `$Elements` section of format 2.2 starting at line `i`, keeping the hex8 elements (type
+/// 5, after their tags); returns the line after it.
+fn gmsh_elements_v2(lines: &[&str], i: usize, elems: &mut Vec<RawHex>) -> Result<usize, MeshError> {
+    let h = nums::<i64>(line_at(lines, i + 1), i + 1)?;
+    let n = announced(
+        h.first().copied().unwrap_or(0),
+        i + 1,
+        "elements",
+        lines_left(lines, i + 1),
+        1,
+    )?;
+    for k in 0..n {
+        let l = i + 2 + k;
+        let v = nums::<i64>(line_at(lines, l), l)?;
+        if v.len() >= 3 && v[1] == 5 {
+            let nt = usize::try_from(v[2]).map_err(|_| perr(l, "negative number of tags"))?;
+            let c = nt
+                .checked_add(3)
+                .and_then(|s| v.get(s..s.checked_add(8)?))
+                .ok_or_else(|| perr(l, format!("element {}: hex8 needs 8 nodes", v[0])))?;
+            elems.push(RawHex {
+                id: v[0],
+                nodes: c.try_into().map_err(|_| perr(l, "hex8 needs 8 nodes"))?,
+                line: l,
+            });
+        }
+    }
+    Ok(i + 2 + n)
+}
+
+/// The `$Elements` section of format 4.1 starting at line `i` (element blocks; hex8 blocks are
+/// kept); returns the line after it.
+fn gmsh_elements_v4(lines: &[&str], i: usize, elems: &mut Vec<RawHex>) -> Result<usize, MeshError> {
+    let h = nums::<i64>(line_at(lines, i + 1), i + 1)?;
+    let blocks = announced(
+        h.first().copied().unwrap_or(0),
+        i + 1,
+        "element blocks",
+        lines_left(lines, i + 1),
+        1,
+    )?;
+    let mut l = i + 2;
+    for _ in 0..blocks {
+        let b = nums::<i64>(line_at(lines, l), l)?;
+        if b.len() < 4 {
+            return Err(perr(
+                l,
+                "element block header needs entityDim entityTag elementType numElements",
+            ));
+        }
+        let ty = b[2];
+        let n = announced(b[3], l, "elements in the block", lines_left(lines, l), 1)?;
+        for k in 0..n {
+            let ll = l + 1 + k;
+            if ty == 5 {
+                let v = nums::<i64>(line_at(lines, ll), ll)?;
+                let c = v
+                    .get(1..9)
+                    .ok_or_else(|| perr(ll, "hex8 needs a tag and 8 nodes"))?;
+                elems.push(RawHex {
+                    id: v[0],
+                    nodes: c.try_into().map_err(|_| perr(ll, "hex8 needs 8 nodes"))?,
+                    line: ll,
+                });
+            }
+        }
+        l += 1 + n;
+    }
+    Ok(l)
 }
 
 /// Reads the `*NODE` and `*ELEMENT, TYPE=C3D8`/`C3D8R`/`C3D8I` blocks of an Abaqus input file

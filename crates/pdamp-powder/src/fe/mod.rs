@@ -4,6 +4,7 @@
 
 pub mod beam_theory;
 pub mod gen_alpha;
+pub mod hex8;
 pub mod mesh;
 pub mod modes;
 pub mod quad;

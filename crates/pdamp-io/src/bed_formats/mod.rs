@@ -58,8 +58,11 @@
 //! lines whose first non-blank character is `#` are skipped (also before the header).
 
 use pdamp_dem::{Bed, Vec3};
-use std::collections::HashMap;
 use std::fmt::Write as _;
+
+mod bed_csv;
+
+pub use self::bed_csv::{BED_CSV_COLUMNS, read_bed_csv, write_bed_csv};
 
 /// Errors of the bed readers. Line numbers are 1-based and count every line of the input.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -467,31 +470,7 @@ pub fn read_lammps_data(text: &str, type_materials: &[String]) -> Result<Bed, Be
             if counts.is_none() {
                 counts = Some(header.finish(n_lines, type_materials.len())?);
             }
-            let (next, key) = match name.as_str() {
-                "Atoms" => (Section::Atoms, "Atoms"),
-                "Velocities" => (Section::Velocities, "Velocities"),
-                "Masses" => (Section::Masses, "Masses"),
-                _ => (Section::Skip, ""),
-            };
-            if !key.is_empty() {
-                if seen.contains(&key) {
-                    return Err(line_err(line, format!("second {key} section")));
-                }
-                seen.push(key);
-            }
-            if next == Section::Atoms {
-                let style = comment.and_then(|c| c.split_whitespace().next());
-                if let Some(style) = style.filter(|s| !matches!(*s, "sphere" | "granular")) {
-                    return Err(line_err(
-                        line,
-                        format!(
-                            "the Atoms section is for atom_style '{}'; only atom_style sphere \
-                             (LAMMPS) or granular (LIGGGHTS) is read",
-                            shown(style)
-                        ),
-                    ));
-                }
-            }
+            let next = open_section(&name, comment, line, &mut seen)?;
             if next == Section::Velocities {
                 velocities = Some(Vec::new());
             }
@@ -534,19 +513,7 @@ pub fn read_lammps_data(text: &str, type_materials: &[String]) -> Result<Bed, Be
         )));
     }
 
-    atoms.sort_unstable_by_key(|a| a.id);
-    for w in atoms.windows(2) {
-        if w[0].id == w[1].id {
-            return Err(line_err(
-                w[0].line.max(w[1].line),
-                format!(
-                    "duplicate atom ID {} (also on line {})",
-                    w[0].id,
-                    w[0].line.min(w[1].line)
-                ),
-            ));
-        }
-    }
+    sort_atoms(&mut atoms)?;
     if atoms.len() as u64 != n_atoms {
         return Err(file_err(format!(
             "the header says {n_atoms} atoms, the Atoms section has {}",
@@ -555,42 +522,10 @@ pub fn read_lammps_data(text: &str, type_materials: &[String]) -> Result<Bed, Be
     }
 
     let n = atoms.len();
-    let mut velocity_m_s = vec![Vec3::zeros(); n];
-    let mut angular_velocity_rad_s = vec![Vec3::zeros(); n];
-    if let Some(mut vels) = velocities {
-        vels.sort_unstable_by_key(|v| v.id);
-        for w in vels.windows(2) {
-            if w[0].id == w[1].id {
-                return Err(line_err(
-                    w[0].line.max(w[1].line),
-                    format!(
-                        "second velocity for atom ID {} (also on line {})",
-                        w[0].id,
-                        w[0].line.min(w[1].line)
-                    ),
-                ));
-            }
-        }
-        for v in &vels {
-            let Ok(k) = atoms.binary_search_by_key(&v.id, |a| a.id) else {
-                return Err(line_err(
-                    v.line,
-                    format!(
-                        "velocity for atom ID {}, which is not in the Atoms section",
-                        v.id
-                    ),
-                ));
-            };
-            velocity_m_s[k] = v.velocity_m_s;
-            angular_velocity_rad_s[k] = v.angular_velocity_rad_s;
-        }
-        if vels.len() != n {
-            return Err(file_err(format!(
-                "the Velocities section has {} entries for {n} atoms",
-                vels.len()
-            )));
-        }
-    }
+    let (velocity_m_s, angular_velocity_rad_s) = match velocities {
+        Some(vels) => atom_velocities(vels, &atoms)?,
+        None => (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]),
+    };
 
     let materials = if type_materials.is_empty() {
         (1..=n_types).map(|t| format!("type{t}")).collect()
@@ -607,6 +542,106 @@ pub fn read_lammps_data(text: &str, type_materials: &[String]) -> Result<Bed, Be
     };
     bed.validate()?;
     Ok(bed)
+}
+
+/// Checks a new section's name line: Atoms, Velocities and Masses at most once each, the
+/// Atoms section of atom_style sphere or granular (its `# style` comment); returns the
+/// section (unknown sections are skipped).
+fn open_section(
+    name: &str,
+    comment: Option<&str>,
+    line: usize,
+    seen: &mut Vec<&'static str>,
+) -> Result<Section, BedFormatError> {
+    let (next, key) = match name {
+        "Atoms" => (Section::Atoms, "Atoms"),
+        "Velocities" => (Section::Velocities, "Velocities"),
+        "Masses" => (Section::Masses, "Masses"),
+        _ => (Section::Skip, ""),
+    };
+    if !key.is_empty() {
+        if seen.contains(&key) {
+            return Err(line_err(line, format!("second {key} section")));
+        }
+        seen.push(key);
+    }
+    if next == Section::Atoms {
+        let style = comment.and_then(|c| c.split_whitespace().next());
+        if let Some(style) = style.filter(|s| !matches!(*s, "sphere" | "granular")) {
+            return Err(line_err(
+                line,
+                format!(
+                    "the Atoms section is for atom_style '{}'; only atom_style sphere \
+                     (LAMMPS) or granular (LIGGGHTS) is read",
+                    shown(style)
+                ),
+            ));
+        }
+    }
+    Ok(next)
+}
+
+/// Sorts the atoms by ID and refuses a duplicate ID (naming both lines).
+fn sort_atoms(atoms: &mut [AtomRow]) -> Result<(), BedFormatError> {
+    atoms.sort_unstable_by_key(|a| a.id);
+    for w in atoms.windows(2) {
+        if w[0].id == w[1].id {
+            return Err(line_err(
+                w[0].line.max(w[1].line),
+                format!(
+                    "duplicate atom ID {} (also on line {})",
+                    w[0].id,
+                    w[0].line.min(w[1].line)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Velocities and angular velocities of the Velocities section in atom order; refuses a
+/// second entry for an atom, an entry for an unknown atom ID and an entry count other than
+/// the atoms'.
+fn atom_velocities(
+    mut vels: Vec<VelocityRow>,
+    atoms: &[AtomRow],
+) -> Result<(Vec<Vec3>, Vec<Vec3>), BedFormatError> {
+    let n = atoms.len();
+    let mut velocity_m_s = vec![Vec3::zeros(); n];
+    let mut angular_velocity_rad_s = vec![Vec3::zeros(); n];
+    vels.sort_unstable_by_key(|v| v.id);
+    for w in vels.windows(2) {
+        if w[0].id == w[1].id {
+            return Err(line_err(
+                w[0].line.max(w[1].line),
+                format!(
+                    "second velocity for atom ID {} (also on line {})",
+                    w[0].id,
+                    w[0].line.min(w[1].line)
+                ),
+            ));
+        }
+    }
+    for v in &vels {
+        let Ok(k) = atoms.binary_search_by_key(&v.id, |a| a.id) else {
+            return Err(line_err(
+                v.line,
+                format!(
+                    "velocity for atom ID {}, which is not in the Atoms section",
+                    v.id
+                ),
+            ));
+        };
+        velocity_m_s[k] = v.velocity_m_s;
+        angular_velocity_rad_s[k] = v.angular_velocity_rad_s;
+    }
+    if vels.len() != n {
+        return Err(file_err(format!(
+            "the Velocities section has {} entries for {n} atoms",
+            vels.len()
+        )));
+    }
+    Ok((velocity_m_s, angular_velocity_rad_s))
 }
 
 /// Writes `bed` as a LAMMPS data file for `atom_style sphere` in SI units (`units si`), which
@@ -680,196 +715,6 @@ pub fn write_lammps_data(
             w.y,
             w.z
         );
-    }
-    s
-}
-
-// ---------------------------------------------------------------------------------------------
-// CSV
-// ---------------------------------------------------------------------------------------------
-
-/// The CSV columns, in the order [`write_bed_csv`] writes them.
-pub const BED_CSV_COLUMNS: [&str; 11] = [
-    "x_m", "y_m", "z_m", "radius_m", "vx_m_s", "vy_m_s", "vz_m_s", "wx_rad_s", "wy_rad_s",
-    "wz_rad_s", "material",
-];
-
-const MATERIAL_COLUMN: usize = 10;
-
-/// Reads a bed from CSV (see the [module documentation](self)): required columns
-/// `x_m,y_m,z_m,radius_m`, optional `vx_m_s,vy_m_s,vz_m_s` and `wx_rad_s,wy_rad_s,wz_rad_s` (all
-/// three or none; absent: zero) and `material` (absent: every particle is `default_material`).
-/// The materials table lists the names in order of first appearance. Errors name the line and
-/// the column. Never panics.
-pub fn read_bed_csv(text: &str, default_material: &str) -> Result<Bed, BedFormatError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l))
-        .filter(|(_, l)| {
-            let t = l.trim_start();
-            !t.trim_end().is_empty() && !t.starts_with('#')
-        });
-    let Some((header_line, header)) = lines.next() else {
-        return Err(file_err(format!(
-            "no header row (expected columns such as {})",
-            BED_CSV_COLUMNS.join(",")
-        )));
-    };
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let mut col: [Option<usize>; 11] = [None; 11];
-    for (j, name) in names.iter().enumerate() {
-        match BED_CSV_COLUMNS.iter().position(|c| c == name) {
-            Some(k) if col[k].is_some() => {
-                return Err(line_err(
-                    header_line,
-                    format!("column {name} appears twice in the header"),
-                ));
-            }
-            Some(k) => col[k] = Some(j),
-            None => {
-                return Err(line_err(
-                    header_line,
-                    format!(
-                        "unknown column '{}' (field {}); known columns: {}",
-                        shown(name),
-                        j + 1,
-                        BED_CSV_COLUMNS.join(",")
-                    ),
-                ));
-            }
-        }
-    }
-    let missing: Vec<&str> = (0..4)
-        .filter(|&k| col[k].is_none())
-        .map(|k| BED_CSV_COLUMNS[k])
-        .collect();
-    if !missing.is_empty() {
-        return Err(line_err(
-            header_line,
-            format!("missing required column(s) {}", missing.join(",")),
-        ));
-    }
-    for (first, what) in [(4, "velocity"), (7, "angular velocity")] {
-        let have: Vec<&str> = (first..first + 3)
-            .filter(|&k| col[k].is_some())
-            .map(|k| BED_CSV_COLUMNS[k])
-            .collect();
-        if !have.is_empty() && have.len() < 3 {
-            let lacking: Vec<&str> = (first..first + 3)
-                .filter(|&k| col[k].is_none())
-                .map(|k| BED_CSV_COLUMNS[k])
-                .collect();
-            return Err(line_err(
-                header_line,
-                format!(
-                    "{what} columns come all three or none: the header has {} but not {}",
-                    have.join(","),
-                    lacking.join(",")
-                ),
-            ));
-        }
-    }
-
-    let mut bed = Bed::default();
-    let mut index: HashMap<String, u16> = HashMap::new();
-    for (line, row) in lines {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
-        if fields.len() != names.len() {
-            return Err(line_err(
-                line,
-                format!(
-                    "expected {} fields (as in the header), found {}",
-                    names.len(),
-                    fields.len()
-                ),
-            ));
-        }
-        let value = |k: usize| -> Result<f64, BedFormatError> {
-            let Some(j) = col[k] else { return Ok(0.0) };
-            let text = fields[j];
-            text.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    line_err(
-                        line,
-                        format!(
-                            "column {}: '{}' is not a finite number",
-                            BED_CSV_COLUMNS[k],
-                            shown(text)
-                        ),
-                    )
-                })
-        };
-        let v3 = |k: usize| -> Result<Vec3, BedFormatError> {
-            Ok(Vec3::new(value(k)?, value(k + 1)?, value(k + 2)?))
-        };
-        let position_m = v3(0)?;
-        let radius_m = value(3)?;
-        if radius_m <= 0.0 {
-            return Err(line_err(
-                line,
-                format!("column radius_m: radius {radius_m} must be > 0"),
-            ));
-        }
-        let velocity_m_s = v3(4)?;
-        let angular_velocity_rad_s = v3(7)?;
-        let name = match col[MATERIAL_COLUMN] {
-            Some(j) if fields[j].is_empty() => {
-                return Err(line_err(line, "column material: empty material name"));
-            }
-            Some(j) => fields[j],
-            None => default_material,
-        };
-        let m = match index.get(name) {
-            Some(&m) => m,
-            None => {
-                let m = u16::try_from(bed.materials.len()).map_err(|_| {
-                    line_err(
-                        line,
-                        format!("column material: more than {MAX_TYPES} distinct materials"),
-                    )
-                })?;
-                index.insert(name.to_string(), m);
-                bed.materials.push(name.to_string());
-                m
-            }
-        };
-        bed.position_m.push(position_m);
-        bed.radius_m.push(radius_m);
-        bed.material.push(m);
-        bed.velocity_m_s.push(velocity_m_s);
-        bed.angular_velocity_rad_s.push(angular_velocity_rad_s);
-    }
-    bed.validate()?;
-    Ok(bed)
-}
-
-/// Writes `bed` as CSV with all columns ([`BED_CSV_COLUMNS`]: positions, radius, velocities,
-/// spins, material name), one row per particle in bed order, every f64 in shortest round-trip
-/// form ([`crate::csv::format_f64`]). [`read_bed_csv`] reads it back to the identical bed when
-/// the bed's materials table lists exactly the used names in order of first appearance (as in
-/// any bed read from CSV) and the names are non-empty, without commas or line breaks, and
-/// without surrounding whitespace (names are written unquoted).
-///
-/// # Panics
-///
-/// If the bed's columns are inconsistent (a bed that passes [`Bed::validate`] never makes it
-/// panic).
-pub fn write_bed_csv(bed: &Bed) -> String {
-    let mut s = BED_CSV_COLUMNS.join(",");
-    s.push('\n');
-    for i in 0..bed.len() {
-        let p = &bed.position_m[i];
-        let v = &bed.velocity_m_s[i];
-        let w = &bed.angular_velocity_rad_s[i];
-        for x in [p.x, p.y, p.z, bed.radius_m[i], v.x, v.y, v.z, w.x, w.y, w.z] {
-            crate::csv::format_f64(x, &mut s);
-            s.push(',');
-        }
-        s.push_str(&bed.materials[bed.material[i] as usize]);
-        s.push('\n');
     }
     s
 }

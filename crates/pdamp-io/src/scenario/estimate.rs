@@ -7,7 +7,7 @@
 //! time ≈ particle-steps / ([`PARTICLE_STEPS_PER_S_PER_THREAD`] × threads), outputs ≈ rows
 //! and frames times their size.
 
-use crate::scenario::{PlacementMethod, Scenario};
+use super::{PlacementMethod, Scenario};
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -230,7 +230,7 @@ impl Estimate {
 
 /// Lowest frequency of the scenario's field grid (infinite without a grid).
 fn lowest_field_frequency(sc: &Scenario) -> f64 {
-    use crate::scenario::AxisSpec;
+    use super::AxisSpec;
     match sc.fields.as_ref().map(|f| &f.frequencies_hz) {
         Some(AxisSpec::List(v)) => v.iter().copied().fold(f64::INFINITY, f64::min),
         Some(AxisSpec::Range { from, to, .. }) => from.min(*to),

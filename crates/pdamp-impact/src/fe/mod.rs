@@ -26,6 +26,12 @@ use crate::material::{Material, MaterialModel};
 use crate::mesh::{self, Mesh, MeshDensity, MeshParams};
 use crate::viscoelastic::prony_complex_modulus;
 
+mod setup;
+
+use self::setup::{
+    build_bodies, contact_slaves, element_geometry, element_time_step, penalty_time_step,
+};
+
 /// Impact partner.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Partner {
@@ -255,134 +261,25 @@ impl FeImpact {
             &opts.mesh,
         );
         let n = mesh.r.len();
-        // ---- geometry at the Gauss points, lumped mass ----
-        let g = 1.0 / 3f64.sqrt();
-        let pts = [(-g, -g), (g, -g), (g, g), (-g, g)];
-        let mut gps = Vec::with_capacity(4 * mesh.elems.len());
-        let mut bvbar = Vec::with_capacity(mesh.elems.len());
-        let mut mass = vec![0.0; n];
-        let mut lmin_sphere = f64::INFINITY;
-        let mut lmin_wall = f64::INFINITY;
         let wall_mat = match partner {
             Partner::Wall(w) => w.clone(),
             Partner::Sphere => sphere.clone(),
         };
-        for (e, q) in mesh.elems.iter().enumerate() {
-            let in_sphere = mesh.sphere_elems.contains(&e);
-            let rho = if in_sphere {
-                sphere.density_kg_m3
-            } else {
-                wall_mat.density_kg_m3
-            };
-            let xr: [f64; 4] = std::array::from_fn(|a| mesh.r[q[a] as usize]);
-            let xz: [f64; 4] = std::array::from_fn(|a| mesh.z[q[a] as usize]);
-            let mut bv = [0.0; 8];
-            let mut vol = 0.0;
-            for &(xi, eta) in &pts {
-                let nn = [
-                    0.25 * (1.0 - xi) * (1.0 - eta),
-                    0.25 * (1.0 + xi) * (1.0 - eta),
-                    0.25 * (1.0 + xi) * (1.0 + eta),
-                    0.25 * (1.0 - xi) * (1.0 + eta),
-                ];
-                let dxi = [
-                    -0.25 * (1.0 - eta),
-                    0.25 * (1.0 - eta),
-                    0.25 * (1.0 + eta),
-                    -0.25 * (1.0 + eta),
-                ];
-                let deta = [
-                    -0.25 * (1.0 - xi),
-                    -0.25 * (1.0 + xi),
-                    0.25 * (1.0 + xi),
-                    0.25 * (1.0 - xi),
-                ];
-                let (mut j11, mut j12, mut j21, mut j22, mut r) = (0.0, 0.0, 0.0, 0.0, 0.0);
-                for a in 0..4 {
-                    j11 += dxi[a] * xr[a];
-                    j12 += dxi[a] * xz[a];
-                    j21 += deta[a] * xr[a];
-                    j22 += deta[a] * xz[a];
-                    r += nn[a] * xr[a];
-                }
-                let det = j11 * j22 - j12 * j21;
-                assert!(det > 0.0, "element {e} is inverted");
-                let mut gp = Gp {
-                    dndr: [0.0; 4],
-                    dndz: [0.0; 4],
-                    nr: [0.0; 4],
-                    w: 2.0 * std::f64::consts::PI * r * det,
-                };
-                for a in 0..4 {
-                    gp.dndr[a] = (j22 * dxi[a] - j12 * deta[a]) / det;
-                    gp.dndz[a] = (-j21 * dxi[a] + j11 * deta[a]) / det;
-                    gp.nr[a] = nn[a] / r;
-                    mass[q[a] as usize] += rho * gp.w * nn[a];
-                    bv[2 * a] += gp.w * (gp.dndr[a] + gp.nr[a]);
-                    bv[2 * a + 1] += gp.w * gp.dndz[a];
-                }
-                vol += gp.w;
-                gps.push(gp);
-            }
-            for b in &mut bv {
-                *b /= vol;
-            }
-            bvbar.push(bv);
-            // characteristic length: area / longest diagonal
-            let area =
-                0.5 * ((xr[2] - xr[0]) * (xz[3] - xz[1]) - (xr[3] - xr[1]) * (xz[2] - xz[0]));
-            let d1 = ((xr[2] - xr[0]).powi(2) + (xz[2] - xz[0]).powi(2)).sqrt();
-            let d2 = ((xr[3] - xr[1]).powi(2) + (xz[3] - xz[1]).powi(2)).sqrt();
-            let le = area / d1.max(d2);
-            if in_sphere {
-                lmin_sphere = lmin_sphere.min(le);
-            } else {
-                lmin_wall = lmin_wall.min(le);
-            }
-        }
+        // ---- geometry at the Gauss points, lumped mass ----
+        let geo = element_geometry(&mesh, sphere, &wall_mat);
+        let mass = geo.mass;
         let inv_m: Vec<f64> = (0..n).map(|i| 1.0 / mass[i]).collect();
         let sphere_mass: f64 = mesh.sphere_nodes.clone().map(|i| mass[i]).sum();
         // ---- contact slaves: sphere surface nodes in the lower third ----
-        let surf = &mesh.sphere_surface;
-        let mut slaves = Vec::new();
-        let mut slave_area = Vec::new();
-        for (k, &s) in surf.iter().enumerate() {
-            if mesh.z[s as usize] > 0.3 * radius {
-                break;
-            }
-            let r = mesh.r[s as usize];
-            let rl = if k == 0 {
-                0.0
-            } else {
-                0.5 * (r + mesh.r[surf[k - 1] as usize])
-            };
-            let rh = 0.5 * (r + mesh.r[surf[k + 1] as usize]);
-            slaves.push(s);
-            slave_area.push(std::f64::consts::PI * (rh * rh - rl * rl));
-        }
+        let (slaves, slave_area) = contact_slaves(&mesh, radius);
         let penalty = opts.penalty_factor * hertz.e_eff / mesh.h_contact;
         // ---- stable time step (elements, Prony algorithmic moduli, penalty) ----
-        let cp = |mat: &Material, dt: f64| {
-            let (k, g) = Kernel::critical_moduli(mat, dt);
-            ((k + 4.0 / 3.0 * g) / mat.density_kg_m3).sqrt()
-        };
+        let wall = (!rigid_plane).then_some(&wall_mat);
+        let wall_surface = (!rigid_plane).then_some(&mesh.wall_surface[..]);
         let mut dt = 1e-3;
         for _ in 0..30 {
-            let mut dte = lmin_sphere / cp(sphere, dt);
-            if !rigid_plane {
-                dte = dte.min(lmin_wall / cp(&wall_mat, dt));
-            }
-            let mut w2 = 0.0f64;
-            for (k, &s) in slaves.iter().enumerate() {
-                let kk = penalty * slave_area[k];
-                let mw = if rigid_plane {
-                    0.0
-                } else {
-                    inv_m[mesh.wall_surface[k.min(mesh.wall_surface.len() - 1)] as usize]
-                };
-                w2 = w2.max(kk * (inv_m[s as usize] + mw));
-            }
-            let dtp = 2.0 / w2.sqrt();
+            let dte = element_time_step(sphere, wall, geo.lmin_sphere, geo.lmin_wall, dt);
+            let dtp = penalty_time_step(&slaves, &slave_area, penalty, &inv_m, wall_surface);
             let new = opts.dt_safety / (1.0 / (dte * dte) + 1.0 / (dtp * dtp)).sqrt();
             if (new - dt).abs() < 1e-6 * dt {
                 dt = new;
@@ -391,29 +288,12 @@ impl FeImpact {
             dt = new;
         }
         // ---- bodies ----
-        let mut bodies = Vec::new();
-        let mut add_body = |mat: &Material, elems: std::ops::Range<usize>| {
-            let kernel = Kernel::new(mat, dt);
-            let n_state = kernel.n_state();
-            let ngp = 4 * elems.len();
-            bodies.push(Body {
-                elems,
-                n_state,
-                state: vec![0.0; n_state * ngp],
-                kernel,
-                plastic: matches!(mat.model, MaterialModel::ViscoplasticJ2 { .. }),
-                dissipated: 0.0,
-            });
-        };
-        add_body(sphere, mesh.sphere_elems.clone());
-        if !rigid_plane {
-            add_body(&wall_mat, mesh.wall_elems.clone());
-        }
+        let bodies = build_bodies(&mesh, sphere, wall, dt);
         let nslaves = slaves.len();
-        let ngp = gps.len();
+        let ngp = geo.gps.len();
         Self {
-            gps,
-            bvbar,
+            gps: geo.gps,
+            bvbar: geo.bvbar,
             inv_m,
             mass,
             ur: vec![0.0; n],
@@ -603,6 +483,43 @@ impl FeImpact {
         let start = Instant::now();
         let n = self.mesh.r.len();
         let v_s = if self.rigid_plane { 0.5 * v } else { v };
+        let (mut ar, mut az, e0) = self.launch(v_s);
+        let tr = self.integrate(v_s, &mut ar, &mut az);
+        let mut failure = tr.failure;
+        let dt = self.dt;
+        // ---- results ----
+        let (en, v_cm) = self.energy_split(e0, &ar, &az);
+        if failure.is_none() && en.balance_error_j.abs() > MAX_BALANCE_ERROR * e0.abs() {
+            failure = Some(balance_failure(&en, e0, dt));
+        }
+        ImpactResult {
+            failure,
+            velocity_m_s: v,
+            restitution: v_cm / v_s,
+            contact_time_s: if tr.t_first.is_nan() {
+                0.0
+            } else {
+                tr.t_last - tr.t_first + dt
+            },
+            max_force_n: tr.fmax,
+            max_overlap_m: tr.dmax,
+            force_history: tr.history,
+            energy: en,
+            completed: tr.completed,
+            elements: self.mesh.elems.len(),
+            nodes: n,
+            h_contact_m: self.mesh.h_contact,
+            dt_s: dt,
+            steps: tr.step,
+            wall_time_s: start.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Places the sphere just touching (rigid shift so that the lowest gap is zero), gives it
+    /// the axial velocity `-v_s` and the accelerations of the current (possibly residually
+    /// stressed) state; returns the accelerations (a_r, a_z) and the initial energy.
+    fn launch(&mut self, v_s: f64) -> (Vec<f64>, Vec<f64>, f64) {
+        let n = self.mesh.r.len();
         // place the sphere just touching: rigid shift so the lowest gap is zero
         let mut gmin = f64::INFINITY;
         for &s in &self.slaves {
@@ -634,7 +551,7 @@ impl FeImpact {
         self.internal_forces();
         self.vz = vz_save;
         let (_, epen0) = self.contact_forces();
-        let mut ar: Vec<f64> = (0..n)
+        let ar: Vec<f64> = (0..n)
             .map(|i| {
                 if self.mesh.fix_r[i] {
                     0.0
@@ -643,7 +560,7 @@ impl FeImpact {
                 }
             })
             .collect();
-        let mut az: Vec<f64> = (0..n)
+        let az: Vec<f64> = (0..n)
             .map(|i| {
                 if self.mesh.fix_z[i] {
                     0.0
@@ -662,13 +579,25 @@ impl FeImpact {
             let st: f64 = (0..self.bodies.len()).map(|b| self.stored(b)).sum();
             ke + st + epen0
         };
-        let uz_cm0: f64 = self
-            .mesh
+        (ar, az, e0)
+    }
+
+    /// Axial displacement of the sphere's centre of mass (mass-weighted mean of its nodes), m.
+    fn sphere_cm_uz(&self) -> f64 {
+        self.mesh
             .sphere_nodes
             .clone()
             .map(|i| self.mass[i] * self.uz[i])
             .sum::<f64>()
-            / self.sphere_mass;
+            / self.sphere_mass
+    }
+
+    /// Central-difference steps until the sphere has separated (contact force zero for 10 %
+    /// of the contact duration and moving away [D L1777]), the time limit or a non-finite
+    /// displacement; records the force history, contact times, peak force and approach.
+    fn integrate(&mut self, v_s: f64, ar: &mut [f64], az: &mut [f64]) -> Trajectory {
+        let n = self.mesh.r.len();
+        let uz_cm0: f64 = self.sphere_cm_uz();
         let tc_est = self.hertz.contact_time(v_s.max(1e-9));
         let t_max = self.opts.max_time_over_contact_time * tc_est;
         let sample_every =
@@ -729,19 +658,13 @@ impl FeImpact {
                 history.push((t, fc));
             }
             if step % 16 == 0 || fc > 0.0 {
-                let uz_cm: f64 = self
-                    .mesh
-                    .sphere_nodes
-                    .clone()
-                    .map(|i| self.mass[i] * self.uz[i])
-                    .sum::<f64>()
-                    / self.sphere_mass;
+                let uz_cm: f64 = self.sphere_cm_uz();
                 dmax = dmax.max(uz_cm0 - uz_cm);
             }
             if !t_first.is_nan() && fc == 0.0 && step % 8 == 0 {
                 let open = t - t_last;
                 if open >= (0.1 * (t_last - t_first)).max(20.0 * dt) {
-                    let (_, pz) = self.kinetic(&ar, &az, self.mesh.sphere_nodes.clone());
+                    let (_, pz) = self.kinetic(ar, az, self.mesh.sphere_nodes.clone());
                     if pz > 0.0 {
                         completed = true;
                         break;
@@ -749,9 +672,24 @@ impl FeImpact {
                 }
             }
         }
-        // ---- results ----
-        let (ke_s, pz) = self.kinetic(&ar, &az, self.mesh.sphere_nodes.clone());
-        let (ke_w, _) = self.kinetic(&ar, &az, self.mesh.wall_nodes.clone());
+        Trajectory {
+            history,
+            t_first,
+            t_last,
+            fmax,
+            dmax,
+            completed,
+            step,
+            failure,
+        }
+    }
+
+    /// Where the initial energy `e0` went at the end (kinetic, stored, penalty, plastic and
+    /// viscous dissipation by body) and the sphere's centre-of-mass velocity (its momentum /
+    /// mass, [D Eq. 3.5]).
+    fn energy_split(&mut self, e0: f64, ar: &[f64], az: &[f64]) -> (EnergySplit, f64) {
+        let (ke_s, pz) = self.kinetic(ar, az, self.mesh.sphere_nodes.clone());
+        let (ke_w, _) = self.kinetic(ar, az, self.mesh.wall_nodes.clone());
         let v_cm = pz / self.sphere_mass;
         let rigid = 0.5 * self.sphere_mass * v_cm * v_cm;
         let stored_s = self.stored(0);
@@ -796,43 +734,44 @@ impl FeImpact {
                 + en.plastic_wall_j
                 + en.viscous_sphere_j
                 + en.viscous_wall_j);
-        if failure.is_none() && en.balance_error_j.abs() > MAX_BALANCE_ERROR * e0.abs() {
-            failure = Some(format!(
-                "energy balance broken: {:.3e} J of {:.3e} J ({:.1} %){}; likely cause: the \
-                 explicit step {dt:.3e} s too close to the critical step, or a penalty stiffness \
-                 out of range",
-                en.balance_error_j,
-                e0,
-                100.0 * en.balance_error_j / e0,
-                if en.balance_error_j < 0.0 {
-                    ", energy created"
-                } else {
-                    ""
-                }
-            ));
-        }
-        ImpactResult {
-            failure,
-            velocity_m_s: v,
-            restitution: v_cm / v_s,
-            contact_time_s: if t_first.is_nan() {
-                0.0
-            } else {
-                t_last - t_first + dt
-            },
-            max_force_n: fmax,
-            max_overlap_m: dmax,
-            force_history: history,
-            energy: en,
-            completed,
-            elements: self.mesh.elems.len(),
-            nodes: n,
-            h_contact_m: self.mesh.h_contact,
-            dt_s: dt,
-            steps: step,
-            wall_time_s: start.elapsed().as_secs_f64(),
-        }
+        (en, v_cm)
     }
+}
+
+/// What the time loop of [`FeImpact::run`] recorded.
+struct Trajectory {
+    /// Force history `(t_s, force_n)`.
+    history: Vec<(f64, f64)>,
+    /// First and last instant with contact force (NaN without contact), s.
+    t_first: f64,
+    t_last: f64,
+    /// Largest contact force, N.
+    fmax: f64,
+    /// Largest approach of the sphere's centre of mass, m.
+    dmax: f64,
+    /// Whether the sphere separated before the time limit.
+    completed: bool,
+    /// Steps taken.
+    step: usize,
+    /// A non-finite displacement, described.
+    failure: Option<String>,
+}
+
+/// The failure message of a broken energy balance (error beyond [`MAX_BALANCE_ERROR`]).
+fn balance_failure(en: &EnergySplit, e0: f64, dt: f64) -> String {
+    format!(
+        "energy balance broken: {:.3e} J of {:.3e} J ({:.1} %){}; likely cause: the \
+         explicit step {dt:.3e} s too close to the critical step, or a penalty stiffness \
+         out of range",
+        en.balance_error_j,
+        e0,
+        100.0 * en.balance_error_j / e0,
+        if en.balance_error_j < 0.0 {
+            ", energy created"
+        } else {
+            ""
+        }
+    )
 }
 
 /// One FE impact of a sphere (`radius` m, material `sphere`) on `partner` at relative velocity
