@@ -84,6 +84,9 @@ else
 fi
 # Lints are part of the tests: formatting, and clippy with every warning an error (issue 30).
 cargo fmt --all --check || status=$?
+# Architecture limits (issue 30): no library function over 150 lines, no source file over 900
+# lines of code, no module cycle.
+for check in fnlen sizes modcycles; do python3 "tools/$check.py" || status=$?; done
 cargo clippy --release --workspace --all-targets -- -D warnings || status=$?
 # … and the API documentation builds without a warning (broken links, unclosed tags).
 RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --workspace || status=$?
