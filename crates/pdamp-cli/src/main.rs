@@ -58,7 +58,7 @@ fn main() -> std::process::ExitCode {
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             if format!("{e}").starts_with(pdamp_io::checkpoint::INTERRUPTED) {
                 std::process::ExitCode::from(130)
             } else {
@@ -66,6 +66,24 @@ fn main() -> std::process::ExitCode {
             }
         }
     }
+}
+
+/// The error and its causes, joined by ": " like `{:#}`, each cause only where its text is not
+/// printed already: library errors carry their cause in their message (`"output: {source}"`)
+/// and some also expose it as `source()`; it is printed once.
+fn error_text(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }
 
 fn run_cli() -> Result<()> {
@@ -190,5 +208,45 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Design(args) => design::run(args),
         Command::Powder(args) => powder::run(args),
         Command::Bench(args) => bench::run(args),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_text;
+
+    /// An error that prints its cause and also returns it as `source()`.
+    #[derive(Debug)]
+    struct Wrapping {
+        source: std::io::Error,
+    }
+
+    impl std::fmt::Display for Wrapping {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "output: {}", self.source)
+        }
+    }
+
+    impl std::error::Error for Wrapping {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.source)
+        }
+    }
+
+    #[test]
+    fn a_cause_in_the_message_is_printed_once() {
+        let e = anyhow::Error::new(Wrapping {
+            source: std::io::Error::other("disk full"),
+        })
+        .context("writing fields.csv");
+        assert_eq!(error_text(&e), "writing fields.csv: output: disk full");
+        // `{:#}` would have printed it twice.
+        assert_eq!(
+            format!("{e:#}"),
+            "writing fields.csv: output: disk full: disk full"
+        );
+        // A cause not in the message is kept.
+        let e = anyhow::Error::new(std::io::Error::other("no space")).context("saving");
+        assert_eq!(error_text(&e), "saving: no space");
     }
 }
