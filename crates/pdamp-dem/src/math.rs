@@ -7,8 +7,9 @@ pub type Mat3 = nalgebra::Matrix3<f64>;
 /// A unit quaternion for rigid-body orientation.
 pub type Rotation = nalgebra::UnitQuaternion<f64>;
 
-/// Standard gravity in m/s² (used for Γ = A/g and defaults).
-pub const STANDARD_GRAVITY_M_S2: f64 = 9.80665;
+/// Gravity of the excitation intensity Γ = A/g [D Eq. 3.11] and of the defaults, m/s²: the
+/// dissertation's rounded 9.81 (the conventional standard value is 9.80665).
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
 
 /// Component `v` of `a` perpendicular to the unit vector `n`: `a − (a·n) n`.
 #[inline]

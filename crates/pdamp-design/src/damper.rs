@@ -5,8 +5,9 @@
 
 use crate::DesignError;
 use crate::convergence::{ConvergenceSpec, RunningEstimate, has_converged};
+use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 use pdamp_dem::{HarmonicTranslation, Motion, Vec3, World};
-use pdamp_io::scenario::{STANDARD_GRAVITY_M_S2, Scenario};
+use pdamp_io::scenario::Scenario;
 use pdamp_signal::Complex64;
 use pdamp_signal::complex_power::complex_power;
 use serde::{Deserialize, Serialize};

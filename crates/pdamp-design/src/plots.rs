@@ -41,7 +41,8 @@ pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Resul
 
 /// The grid's amplitude-axis value of the displacement amplitude `x_m` at `f_hz`.
 fn axis_value(grid: &FieldGrid, f_hz: f64, x_m: f64) -> f64 {
-    use pdamp_io::scenario::{AmplitudeAxis, STANDARD_GRAVITY_M_S2};
+    use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
+    use pdamp_io::scenario::AmplitudeAxis;
     let w2 = (2.0 * std::f64::consts::PI * f_hz).powi(2);
     match grid.amplitude_axis {
         AmplitudeAxis::Displacement => x_m,
@@ -53,7 +54,7 @@ fn axis_value(grid: &FieldGrid, f_hz: f64, x_m: f64) -> f64 {
 /// Lines drawn over the η̄ map as in D's figures: A = g (Γ = 1, where the bed can lift off) and,
 /// when the bed's clearance h is known, the bouncing optimum X_opt = h/π [D Eq. 6.11, 7.16, 8.2].
 fn eta_overlays(grid: &FieldGrid, clearance_m: Option<f64>) -> Vec<pdamp_plot::Polyline> {
-    use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
+    use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
     let fs = line_frequencies(grid);
     let line = |label: &str, x_of_f: &dyn Fn(f64) -> f64, dashed: bool| {
         let mut l = pdamp_plot::Polyline::new(

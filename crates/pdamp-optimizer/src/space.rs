@@ -8,7 +8,7 @@
 
 use crate::error::DesignError;
 use crate::study::{DesignStudy, Direction, ObjectiveSpec};
-use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
+use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 use pdamp_structure::effective::EffectiveDamper;
 use pdamp_structure::free::CoupledDamper;
 use pdamp_structure::scenario::{DamperSpec, RollingLayerSpec};

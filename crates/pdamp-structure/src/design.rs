@@ -2,7 +2,7 @@
 //! vibration guideline [D Eq. 5.15, 5.17], the forced-vibration optimum [D Eq. 5.20–5.23] and
 //! the coated-wall design of D Sect. 8.1.5 [D Eq. 8.3–8.12, Tab. 8.4].
 
-use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
+use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 use serde::Serialize;
 use std::f64::consts::PI;
 

@@ -15,7 +15,7 @@
 
 use crate::StructureError;
 use crate::effective::{EffectiveDamper, EffectiveState};
-use pdamp_io::scenario::STANDARD_GRAVITY_M_S2;
+use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 use std::f64::consts::{PI, TAU};
 
 /// $S(\tau) = \int_0^\tau \sqrt{25 + 10\sin^2 s}\,ds$ (Simpson, 400 intervals; smooth integrand).

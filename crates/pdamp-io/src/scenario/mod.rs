@@ -172,8 +172,9 @@ pub struct Scenario {
     pub fields: Option<FieldsSpec>,
 }
 
-/// Standard gravity used for the excitation intensity Γ = A/g [D Eq. 3.11], m/s².
-pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
+/// Gravity of the excitation intensity Γ = A/g [D Eq. 3.11], m/s² (a physical constant: it lives
+/// in `pdamp_dem::math`).
+pub use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 
 /// A particle damper moved harmonically, $x_c = X \sin(\Omega t)$ along `direction`
 /// [D Eq. 3.8–3.11].
