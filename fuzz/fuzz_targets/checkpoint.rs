@@ -1,5 +1,5 @@
-//! cargo-fuzz target: the checkpoint reader must never panic (`pdamp_io::fuzz::checkpoint`).
+//! cargo-fuzz target: the checkpoint reader must never panic (`pdamp_scenario::fuzz::checkpoint`).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| pdamp_io::fuzz::checkpoint(data));
+fuzz_target!(|data: &[u8]| pdamp_scenario::fuzz::checkpoint(data));

@@ -73,7 +73,8 @@ pub(crate) fn run(args: BenchArgs) -> Result<()> {
     }
     bench_limits(particles, steps)?;
     if !peer && settled.is_none() && export_liggghts.is_none() {
-        let r = pdamp_io::bench::shaken_box_bench(particles, steps).map_err(anyhow::Error::msg)?;
+        let r = pdamp_scenario::bench::shaken_box_bench(particles, steps)
+            .map_err(anyhow::Error::msg)?;
         println!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
@@ -89,30 +90,31 @@ pub(crate) fn run(args: BenchArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let mut world = pdamp_io::bench::settled_shaken_box(particles, settled.as_deref())
+    let mut world = pdamp_scenario::bench::settled_shaken_box(particles, settled.as_deref())
         .map_err(anyhow::Error::msg)?;
     if let Some(dir) = &export_liggghts {
-        pdamp_io::bench::write_liggghts_case(&world, steps, dir).map_err(anyhow::Error::msg)?;
+        pdamp_scenario::bench::write_liggghts_case(&world, steps, dir)
+            .map_err(anyhow::Error::msg)?;
     }
-    let r = pdamp_io::bench::run_peer(&mut world, steps);
+    let r = pdamp_scenario::bench::run_peer(&mut world, steps);
     println!("{}", serde_json::to_string_pretty(&r)?);
     Ok(())
 }
 
 /// `pdamp bench`: the shaken box's size and length within the machine (see
-/// [`pdamp_io::estimate`]).
+/// [`pdamp_scenario::estimate`]).
 fn bench_limits(particles: usize, steps: u64) -> Result<()> {
     if particles == 0 || steps == 0 {
         bail!("--particles and --steps must be >= 1");
     }
-    let mut sc = pdamp_io::examples::shaken_box(particles.min(1000), 0.0);
+    let mut sc = pdamp_scenario::examples::shaken_box(particles.min(1000), 0.0);
     if let Some(g) = sc.particles.first_mut() {
         g.count = Some(particles);
     }
     sc.simulation.duration_s = steps as f64 * sc.simulation.time_step_s;
     sc.output.vtk_interval_s = 0.0;
     sc.output.energy_interval_s = sc.simulation.duration_s.max(1e-12);
-    pdamp_io::estimate::Estimate::of(&sc, 1, rayon::current_num_threads())
+    pdamp_scenario::estimate::Estimate::of(&sc, 1, rayon::current_num_threads())
         .check()
         .map_err(|e| anyhow::anyhow!("--particles/--steps: {e}"))
 }

@@ -4,7 +4,10 @@
 use anyhow::{Result, anyhow, bail};
 
 /// Warnings about a scenario that runs but is unlikely to be what the user wants.
-fn scenario_warnings(sc: &pdamp_io::scenario::Scenario, world: &pdamp_dem::World) -> Vec<String> {
+fn scenario_warnings(
+    sc: &pdamp_scenario::schema::Scenario,
+    world: &pdamp_dem::World,
+) -> Vec<String> {
     let mut w = Vec::new();
     for b in &world.bodies {
         for wall in &b.walls {
@@ -168,7 +171,7 @@ pub(crate) fn cmd_check(scenario: &std::path::Path) -> Result<()> {
             scenario.display()
         );
     }
-    let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
+    let (sc, world) = pdamp_scenario::schema::Scenario::load_and_build(scenario)?;
     let p = &world.particles;
     let bed_mass: f64 = p.mass.iter().sum();
     let (rmin, rmax) = p
@@ -187,7 +190,7 @@ pub(crate) fn cmd_check(scenario: &std::path::Path) -> Result<()> {
         "time_step_s": sc.simulation.time_step_s,
         "shortest_contact_time_s": tc,
         "time_step_over_contact_time": sc.simulation.time_step_s / tc,
-        "estimate": pdamp_io::estimate::Estimate::of(
+        "estimate": pdamp_scenario::estimate::Estimate::of(
             &sc,
             sc.fields
                 .as_ref()

@@ -47,7 +47,7 @@ impl PointArgs {
     }
 
     /// Puts the point into the scenario's `[damper]` and validates it again.
-    pub(crate) fn apply(&self, sc: &mut pdamp_io::scenario::Scenario) -> Result<()> {
+    pub(crate) fn apply(&self, sc: &mut pdamp_scenario::schema::Scenario) -> Result<()> {
         if !self.any() {
             return Ok(());
         }
@@ -113,19 +113,19 @@ fn energy_plot(out: &std::path::Path) -> Result<()> {
 pub(crate) fn cmd_run(
     scenario: &str,
     out: &std::path::Path,
-    options: pdamp_io::run::RunOptions,
+    options: pdamp_scenario::run::RunOptions,
     overwrite: bool,
     point: PointArgs,
 ) -> Result<()> {
     let (mut sc, base) = if scenario == "builtin:shaken-box" {
         (
-            pdamp_io::examples::shaken_box(2000, 0.5),
+            pdamp_scenario::examples::shaken_box(2000, 0.5),
             PathBuf::from("."),
         )
     } else {
         let path = PathBuf::from(scenario);
         // Everything is checked (and the world built once) before any output is written.
-        let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(&path)?;
+        let (sc, _) = pdamp_scenario::schema::Scenario::load_and_build(&path)?;
         let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         (sc, base)
     };
@@ -163,7 +163,7 @@ pub(crate) fn cmd_run(
         dir.set_outcome(&s);
         serde_json::to_string_pretty(&s.map_err(anyhow::Error::msg)?)?
     } else {
-        let s = pdamp_io::run::run_scenario(&sc, &base, out, options, tick)
+        let s = pdamp_scenario::run::run_scenario(&sc, &base, out, options, tick)
             .map_err(anyhow::Error::msg)
             .and_then(|s| energy_plot(out).map(|()| s));
         dir.set_outcome(&s);
@@ -181,7 +181,7 @@ pub(crate) fn cmd_fields(
     device: Device,
     overwrite: bool,
 ) -> Result<()> {
-    let (sc, world) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
+    let (sc, world) = pdamp_scenario::schema::Scenario::load_and_build(scenario)?;
     #[cfg(feature = "gpu")]
     if device == Device::Gpu {
         // Before any bed is prepared: what the GPU kernels lack is said at once.
@@ -201,7 +201,7 @@ pub(crate) fn cmd_fields(
     };
     let grid = pdamp_design::FieldGrid::from_spec(spec).map_err(anyhow::Error::msg)?;
     let points = grid.frequencies_hz.len() * grid.amplitude_values.len();
-    pdamp_io::estimate::Estimate::of(&sc, points, rayon::current_num_threads())
+    pdamp_scenario::estimate::Estimate::of(&sc, points, rayon::current_num_threads())
         .check()
         .map_err(|e| {
             anyhow::anyhow!("{}: the field of {points} points: {e}", scenario.display())
@@ -281,8 +281,8 @@ pub(crate) fn cmd_settle(
     packing: usize,
     overwrite: bool,
 ) -> Result<()> {
-    let (sc, _) = pdamp_io::scenario::Scenario::load_and_build(scenario)?;
-    let sc = pdamp_io::prepare::scenario_for_packing(&sc, packing);
+    let (sc, _) = pdamp_scenario::schema::Scenario::load_and_build(scenario)?;
+    let sc = pdamp_scenario::prepare::scenario_for_packing(&sc, packing);
     let inputs = scenario_inputs(scenario, &sc);
     let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let mut dir = open_out(
@@ -308,7 +308,9 @@ pub(crate) fn cmd_settle(
         .map(|p| p.to_path_buf())
         .unwrap_or_default();
     let bar = progress::Progress::new();
-    let s = pdamp_io::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| bar.set(phase, f));
+    let s = pdamp_scenario::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| {
+        bar.set(phase, f)
+    });
     dir.set_outcome(&s);
     dir.close()?;
     let s = s.map_err(anyhow::Error::msg)?;

@@ -13,12 +13,12 @@ use std::time::Instant;
 pub fn bench(n: usize, steps: u64, batch: usize, settle_steps: u64) -> Result<serde_json::Value> {
     let t_setup = Instant::now();
     let gpu = GpuDevice::open()?;
-    let sc = pdamp_io::examples::shaken_box(n, 1.0);
+    let sc = pdamp_scenario::examples::shaken_box(n, 1.0);
     let mut worlds: Vec<World> = Vec::with_capacity(batch);
     let mut motions = Vec::with_capacity(batch);
     for k in 0..batch {
         let mut s = sc.clone();
-        if let pdamp_io::scenario::MotionSpec::Harmonic(h) = &mut s.bodies[0].motion {
+        if let pdamp_scenario::schema::MotionSpec::Harmonic(h) = &mut s.bodies[0].motion {
             h.frequency_hz *= 1.0 + k as f64 / batch as f64;
         }
         let mut w = s.build_world(Path::new(".")).map_err(|e| anyhow!(e))?;

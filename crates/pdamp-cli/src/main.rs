@@ -94,7 +94,7 @@ fn run_cli() -> Result<()> {
         Ok(c) => c,
         Err(e) => e.exit(),
     };
-    pdamp_io::estimate::set_force(cli.force);
+    pdamp_scenario::estimate::set_force(cli.force);
     progress::set_quiet(cli.quiet);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let threads = match cli.threads {
@@ -134,7 +134,7 @@ fn dispatch(command: Command) -> Result<()> {
             cmd_run(
                 &scenario,
                 &out,
-                pdamp_io::run::RunOptions {
+                pdamp_scenario::run::RunOptions {
                     checkpoint_interval_s,
                     resume,
                 },
@@ -197,7 +197,7 @@ fn dispatch(command: Command) -> Result<()> {
             }
             print!(
                 "{}",
-                pdamp_io::examples::shaken_box(particles, duration_s).to_toml()
+                pdamp_scenario::examples::shaken_box(particles, duration_s).to_toml()
             );
             Ok(())
         }

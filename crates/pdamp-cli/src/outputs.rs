@@ -123,7 +123,7 @@ fn same_command(a: &[String], b: &[String]) -> bool {
 /// The scenario file and the files it reads (meshes, beds): inputs no output may replace.
 pub(crate) fn scenario_inputs(
     scenario: &std::path::Path,
-    sc: &pdamp_io::scenario::Scenario,
+    sc: &pdamp_scenario::schema::Scenario,
 ) -> Vec<std::path::PathBuf> {
     let base = scenario
         .parent()

@@ -412,7 +412,7 @@ pub fn run_couple(args: CoupleArgs) -> Result<()> {
             args.checkpoint_interval_s
         ));
     }
-    let options = pdamp_io::run::RunOptions {
+    let options = pdamp_scenario::run::RunOptions {
         checkpoint_interval_s: args.checkpoint_interval_s,
         resume: args.resume,
     };

@@ -183,7 +183,7 @@ fn stl_container_example_checks_and_runs() {
 #[test]
 fn polydisperse_example_checks_and_runs() {
     let toml = examples().join("polydisperse_box_damper.toml");
-    let sc = pdamp_io::scenario::Scenario::load(&toml).unwrap();
+    let sc = pdamp_scenario::schema::Scenario::load(&toml).unwrap();
     assert_eq!(sc.particles.len(), 1);
     let (lo, hi) = match sc.particles[0].size {
         SizeDistribution::Uniform {

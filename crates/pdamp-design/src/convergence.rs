@@ -17,7 +17,7 @@
 //! power scale, so the η̄ test is the Ẽ test; its floor keeps η̄ ≈ 0 (a stuck bed) from demanding
 //! an impossible relative accuracy.
 
-pub use pdamp_io::scenario::ConvergenceSpec;
+pub use pdamp_scenario::schema::ConvergenceSpec;
 
 /// Running estimate after a number of evaluated cycles.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

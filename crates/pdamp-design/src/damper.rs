@@ -7,7 +7,7 @@ use crate::DesignError;
 use crate::convergence::{ConvergenceSpec, RunningEstimate, has_converged};
 use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
 use pdamp_dem::{HarmonicTranslation, Motion, Vec3, World};
-use pdamp_io::scenario::Scenario;
+use pdamp_scenario::schema::Scenario;
 use pdamp_signal::Complex64;
 use pdamp_signal::complex_power::complex_power;
 use serde::{Deserialize, Serialize};
@@ -201,7 +201,7 @@ pub fn harmonic_amplitude(t_s: &[f64], x: &[f64], frequency_hz: f64) -> (f64, f6
 /// The `[damper]` section of a scenario and the index of its container body.
 fn container_of(
     scenario: &Scenario,
-) -> Result<(&pdamp_io::scenario::DamperSpec, usize), DesignError> {
+) -> Result<(&pdamp_scenario::schema::DamperSpec, usize), DesignError> {
     let spec = scenario
         .damper
         .as_ref()
@@ -218,7 +218,7 @@ fn container_of(
 
 impl Damper {
     /// Builds the world of a damper scenario and prepares its bed (drop-down, settling) as the
-    /// scenario says ([`pdamp_io::prepare::prepare_bed`]); `progress` gets the fraction done.
+    /// scenario says ([`pdamp_scenario::prepare::prepare_bed`]); `progress` gets the fraction done.
     pub fn from_scenario(
         scenario: &Scenario,
         base_dir: &Path,
@@ -226,16 +226,17 @@ impl Damper {
     ) -> Result<Self, DesignError> {
         // The damper section is checked before the (costly) bed preparation.
         container_of(scenario)?;
-        let prepared = pdamp_io::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))
-            .map_err(DesignError::from)?;
+        let prepared =
+            pdamp_scenario::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))
+                .map_err(DesignError::from)?;
         Self::from_prepared(scenario, prepared)
     }
 
-    /// The damper of `scenario` on a bed prepared already ([`pdamp_io::prepare::prepare_bed`],
-    /// or one saved by another process and read with [`pdamp_io::prepare::load_prepared`]).
+    /// The damper of `scenario` on a bed prepared already ([`pdamp_scenario::prepare::prepare_bed`],
+    /// or one saved by another process and read with [`pdamp_scenario::prepare::load_prepared`]).
     pub fn from_prepared(
         scenario: &Scenario,
-        prepared: pdamp_io::prepare::PreparedBed,
+        prepared: pdamp_scenario::prepare::PreparedBed,
     ) -> Result<Self, DesignError> {
         let (spec, container) = container_of(scenario)?;
         let mut world = prepared.world;
@@ -413,7 +414,7 @@ impl Damper {
                 observer.on_step(w, cycle, phase, self);
                 if w.counters
                     .steps
-                    .is_multiple_of(pdamp_io::run::HEALTH_CHECK_STEPS)
+                    .is_multiple_of(pdamp_scenario::run::HEALTH_CHECK_STEPS)
                 {
                     w.complete_step();
                     if let Err(e) = w.check_health() {

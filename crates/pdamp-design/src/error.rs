@@ -264,7 +264,7 @@ pub enum DesignError {
     },
     /// The bed cannot be prepared or a prepared bed read back.
     #[error(transparent)]
-    Prepare(#[from] pdamp_io::prepare::PrepareError),
+    Prepare(#[from] pdamp_scenario::prepare::PrepareError),
     /// A point's checkpoint cannot be written or read back.
     #[error(transparent)]
     Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
@@ -295,7 +295,7 @@ impl DesignError {
             | DesignError::ReadSummary { .. }
             | DesignError::VtkFrames(_)
             | DesignError::IoOutput(_)
-            | DesignError::Prepare(pdamp_io::prepare::PrepareError::Output(_)) => true,
+            | DesignError::Prepare(pdamp_scenario::prepare::PrepareError::Output(_)) => true,
             DesignError::Batch(e) => e.is_output(),
             e => e.foreign_text().is_some_and(|s| s.starts_with("output:")),
         }
@@ -424,7 +424,7 @@ mod tests {
 
     #[test]
     fn wrapped_texts_keep_their_kind() {
-        use pdamp_io::prepare::PrepareError;
+        use pdamp_scenario::prepare::PrepareError;
         let no_space = std::io::Error::other("no space");
         let e = DesignError::Prepare(PrepareError::Output(no_space.into()));
         assert!(e.is_output() && !e.is_checkpoint());
@@ -440,7 +440,7 @@ mod tests {
         );
         let e = DesignError::Checkpoint(pdamp_io::checkpoint::CheckpointError::Damaged);
         assert!(e.is_checkpoint() && !e.is_interrupted());
-        let bad = pdamp_io::InputError::message("scenario.x: bad key");
+        let bad = pdamp_scenario::InputError::message("scenario.x: bad key");
         assert!(!DesignError::Prepare(PrepareError::Input(bad)).is_output());
         let shared = DesignError::Batch(Arc::new(DesignError::Interrupted));
         assert!(shared.is_interrupted());

@@ -4,7 +4,7 @@
 
 use crate::DesignError;
 use crate::damper::{Damper, PointResult};
-use pdamp_io::scenario::{AmplitudeAxis, FieldsSpec};
+use pdamp_scenario::schema::{AmplitudeAxis, FieldsSpec};
 use std::path::{Path, PathBuf};
 use std::sync::{Condvar, Mutex};
 
@@ -321,7 +321,7 @@ fn failed_point(f: f64, x: f64) -> PointResult {
         frequency_hz: f,
         amplitude_m: x,
         acceleration_m_s2: a,
-        intensity: a / pdamp_io::scenario::STANDARD_GRAVITY_M_S2,
+        intensity: a / pdamp_scenario::schema::STANDARD_GRAVITY_M_S2,
         velocity_amplitude_m_s: x * w,
         dissipated_energy_per_cycle_j: f64::NAN,
         loss_factor: f64::NAN,
@@ -520,7 +520,7 @@ pub fn run_fields_on(
 #[derive(Debug, Clone)]
 pub struct PointCheckpoints {
     /// Digest of the packing's scenario and the files it reads
-    /// ([`pdamp_io::run::scenario_content_digest`]): a checkpoint of another scenario is refused.
+    /// ([`pdamp_scenario::run::scenario_content_digest`]): a checkpoint of another scenario is refused.
     pub scenario_digest: String,
     /// Wall-clock seconds between checkpoints (≤ 0: only on a stop request).
     pub interval_s: f64,

@@ -422,7 +422,7 @@ impl PointObserver for MotionRecorder {
             let prev_slot = (prev / (2.0 * PI) * *frames as f64).floor();
             if slot != prev_slot || self.vtk_frames.is_empty() {
                 let idx = self.vtk_frames.len();
-                match pdamp_io::run::write_snapshot(w, dir, idx) {
+                match pdamp_scenario::run::write_snapshot(w, dir, idx) {
                     Ok(f) => self
                         .vtk_frames
                         .push((w.time_s, f.to_string_lossy().into_owned())),

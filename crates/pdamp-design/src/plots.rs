@@ -42,7 +42,7 @@ pub fn field_maps(grid: &FieldGrid, points: &[PointResult], out: &Path) -> Resul
 /// The grid's amplitude-axis value of the displacement amplitude `x_m` at `f_hz`.
 fn axis_value(grid: &FieldGrid, f_hz: f64, x_m: f64) -> f64 {
     use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
-    use pdamp_io::scenario::AmplitudeAxis;
+    use pdamp_scenario::schema::AmplitudeAxis;
     let w2 = (2.0 * std::f64::consts::PI * f_hz).powi(2);
     match grid.amplitude_axis {
         AmplitudeAxis::Displacement => x_m,
@@ -109,7 +109,7 @@ fn line_frequencies(grid: &FieldGrid) -> Vec<f64> {
 /// values when fewer than two do) that cross the map's range, each annotated "X = … mm".
 /// None on a displacement axis (X is the axis itself).
 fn constant_x_overlays(grid: &FieldGrid) -> Vec<Polyline> {
-    use pdamp_io::scenario::AmplitudeAxis;
+    use pdamp_scenario::schema::AmplitudeAxis;
     if grid.amplitude_axis == AmplitudeAxis::Displacement || grid.frequencies_hz.is_empty() {
         return Vec::new();
     }
@@ -637,7 +637,7 @@ pub fn value_map(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pdamp_io::scenario::AmplitudeAxis;
+    use pdamp_scenario::schema::AmplitudeAxis;
 
     /// A recorder on a 20 × 10 × 6 mm box (one particle, excitation along x, gravity −z) with
     /// 10 cells along the excitation: cells of 2 mm; phase 0 filled with a made-up field.
@@ -773,7 +773,8 @@ mod tests {
             let f = l.x[20];
             let w = 2.0 * std::f64::consts::PI * f;
             assert!(
-                (l.y[20] / (x_mm * 1e-3 * w * w / pdamp_io::scenario::STANDARD_GRAVITY_M_S2) - 1.0)
+                (l.y[20] / (x_mm * 1e-3 * w * w / pdamp_scenario::schema::STANDARD_GRAVITY_M_S2)
+                    - 1.0)
                     .abs()
                     < 1e-12
             );

@@ -2,12 +2,13 @@
 //! trajectories, VTK animation of the last cycle and plots.
 
 use crate::DesignError;
-use crate::damper::{Damper, PointResult};
+use crate::damper::{Damper, POINT_KIND, PointCheckpoint, PointCheckpointing, PointResult};
 use crate::ensemble::EnsembleStat;
 use crate::fields::{FieldGrid, FieldsOutcome};
 use crate::motion::MotionRecorder;
 use pdamp_dem::bed_statistics::BedStatistics;
-use pdamp_io::scenario::Scenario;
+use pdamp_io::checkpoint as ck;
+use pdamp_scenario::schema::Scenario;
 use serde::Serialize;
 use std::path::Path;
 
@@ -188,7 +189,7 @@ pub fn run_other_packings(
     let members: Vec<Result<PackingResult, DesignError>> = (1..packings)
         .into_par_iter()
         .map(|k| {
-            let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
+            let sk = pdamp_scenario::prepare::scenario_for_packing(sc, k);
             // A resumed run reuses the packings finished before (same scenario: the
             // checkpoint's digest was checked; same seed).
             if reuse
@@ -231,7 +232,7 @@ pub fn run_damper_scenario(
     out: &Path,
     progress: impl FnMut(&str, f64),
 ) -> Result<DamperRunSummary, DesignError> {
-    let options = pdamp_io::run::RunOptions {
+    let options = pdamp_scenario::run::RunOptions {
         checkpoint_interval_s: 0.0,
         resume: false,
     };
@@ -246,9 +247,7 @@ pub fn finished_damper_summary(
     base_dir: &Path,
     out: &Path,
 ) -> Result<Option<String>, DesignError> {
-    use crate::damper::{POINT_KIND, PointCheckpoint};
-    use pdamp_io::checkpoint as ck;
-    let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
+    let digest = pdamp_scenario::run::scenario_content_digest(sc, base_dir);
     match ck::load::<PointCheckpoint>(&out.join(ck::CHECKPOINT_FILE), POINT_KIND, &digest)
         .map_err(DesignError::from)?
     {
@@ -272,12 +271,10 @@ pub fn run_damper_scenario_with(
     sc: &Scenario,
     base_dir: &Path,
     out: &Path,
-    options: pdamp_io::run::RunOptions,
+    options: pdamp_scenario::run::RunOptions,
     mut progress: impl FnMut(&str, f64),
 ) -> Result<DamperRunSummary, DesignError> {
-    use crate::damper::{POINT_KIND, PointCheckpoint, PointCheckpointing};
-    use pdamp_io::checkpoint as ck;
-    let digest = pdamp_io::run::scenario_content_digest(sc, base_dir);
+    let digest = pdamp_scenario::run::scenario_content_digest(sc, base_dir);
     let ck_path = out.join(ck::CHECKPOINT_FILE);
     let checkpointing = PointCheckpointing {
         path: ck_path.clone(),
@@ -289,9 +286,7 @@ pub fn run_damper_scenario_with(
     let spec = sc.damper.as_ref().ok_or(DesignError::NoDamperSection)?;
     let f = spec.frequency_hz.ok_or(DesignError::NoFrequency)?;
     let x = spec.amplitude_at(f).ok_or(DesignError::NoAmplitude)?;
-    pdamp_io::provenance::Provenance::of(sc)
-        .write(sc, out)
-        .map_err(DesignError::write(out))?;
+    pdamp_scenario::provenance::write(sc, out).map_err(DesignError::write(out))?;
     let damper = Damper::from_scenario(sc, base_dir, |p| progress("settling", p))?;
     let omega = 2.0 * std::f64::consts::PI * f;
     let steps_per_cycle = (1.0 / (f * damper.time_step_s)).ceil();
@@ -326,11 +321,14 @@ pub fn run_damper_scenario_with(
         let pvd_path = out.join("particles.pvd");
         let mut pvd = pdamp_io::vtk::PvdSeries::new(pvd_path.clone());
         for (idx, (t, _)) in rec.vtk_frames.iter().enumerate() {
-            pvd.add_frame(*t, &pdamp_io::run::snapshot_files(&damper.settled, idx))
-                .map_err(|source| DesignError::Pvd {
-                    path: pvd_path.clone(),
-                    source,
-                })?;
+            pvd.add_frame(
+                *t,
+                &pdamp_scenario::run::snapshot_files(&damper.settled, idx),
+            )
+            .map_err(|source| DesignError::Pvd {
+                path: pvd_path.clone(),
+                source,
+            })?;
         }
     }
     write_velocity_fields(&rec, &out.join("velocity_fields.csv"))?;
@@ -379,7 +377,7 @@ pub fn run_damper_scenario_with(
     let summary = DamperRunSummary {
         pdamp_version: env!("CARGO_PKG_VERSION").to_string(),
         title: sc.title.clone(),
-        scenario_digest: pdamp_io::run::scenario_digest(sc),
+        scenario_digest: pdamp_scenario::run::scenario_digest(sc),
         seed: sc.simulation.seed,
         particles: damper.settled.particles.len(),
         bed_mass_kg: damper.bed_mass_kg,
@@ -531,13 +529,13 @@ pub enum BedSource<'a> {
 }
 
 /// File of the saved bed of packing `k` of a field or sweep in `dir`:
-/// `dir/beds/packing_KKK.pdprep` ([`pdamp_io::prepare::save_prepared`]).
+/// `dir/beds/packing_KKK.pdprep` ([`pdamp_scenario::prepare::save_prepared`]).
 pub fn prepared_bed_path(dir: &Path, k: usize) -> std::path::PathBuf {
     dir.join("beds").join(format!("packing_{k:03}.pdprep"))
 }
 
 /// The damper of packing `k` of the field of `sc` (packing 0: the scenario's own seed; see
-/// [`pdamp_io::prepare::scenario_for_packing`]), its bed taken from `beds`.
+/// [`pdamp_scenario::prepare::scenario_for_packing`]), its bed taken from `beds`.
 pub fn field_damper(
     sc: &Scenario,
     base_dir: &Path,
@@ -545,23 +543,23 @@ pub fn field_damper(
     beds: BedSource<'_>,
     progress: impl FnMut(f64),
 ) -> Result<Damper, DesignError> {
-    let sk = pdamp_io::prepare::scenario_for_packing(sc, k);
+    let sk = pdamp_scenario::prepare::scenario_for_packing(sc, k);
     let BedSource::Saved(dir) = beds else {
         return Damper::from_scenario(&sk, base_dir, progress);
     };
     let path = prepared_bed_path(dir, k);
     if let Some(prepared) =
-        pdamp_io::prepare::load_prepared(&path, &sk, base_dir).map_err(DesignError::from)?
+        pdamp_scenario::prepare::load_prepared(&path, &sk, base_dir).map_err(DesignError::from)?
     {
         return Damper::from_prepared(&sk, prepared);
     }
     let mut progress = progress;
-    let prepared = pdamp_io::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))
+    let prepared = pdamp_scenario::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))
         .map_err(DesignError::from)?;
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(DesignError::write(parent))?;
     }
-    pdamp_io::prepare::save_prepared(&path, &prepared, &sk, base_dir)
+    pdamp_scenario::prepare::save_prepared(&path, &prepared, &sk, base_dir)
         .map_err(DesignError::IoOutput)?;
     Damper::from_prepared(&sk, prepared)
 }
@@ -579,9 +577,7 @@ pub fn run_fields_scenario_from(
 ) -> Result<FieldsOutcome, DesignError> {
     let spec = sc.fields.as_ref().ok_or(DesignError::NoFieldsSection)?;
     let grid = FieldGrid::from_spec(spec)?;
-    pdamp_io::provenance::Provenance::of(sc)
-        .write(sc, out)
-        .map_err(DesignError::write(out))?;
+    pdamp_scenario::provenance::write(sc, out).map_err(DesignError::write(out))?;
     // Stored points are reused only for the same physics: everything but the grid itself and
     // the single-point excitation must match.
     let mut physics = sc.clone();
@@ -594,7 +590,8 @@ pub fn run_fields_scenario_from(
         d.motion_output = Default::default();
     }
     // The content of meshes and bed files counts, not only their paths.
-    let fingerprint = physics.to_toml() + &pdamp_io::run::referenced_files_digest(sc, base_dir);
+    let fingerprint =
+        physics.to_toml() + &pdamp_scenario::run::referenced_files_digest(sc, base_dir);
     let fp_path = out.join("points").join("scenario_physics.toml");
     std::fs::create_dir_all(out.join("points")).map_err(DesignError::write(out.join("points")))?;
     match std::fs::read_to_string(&fp_path) {

@@ -10,10 +10,10 @@
 //! a half-width of t₀.₉₇₅,₇ σ/√K); the seeds are fixed, so the outcome is deterministic.
 
 use pdamp_design::report::run_damper_scenario;
-use pdamp_io::prepare::packing_seed;
+use pdamp_scenario::prepare::packing_seed;
 
-fn scenario(first_packing: usize) -> pdamp_io::scenario::Scenario {
-    let mut s = pdamp_io::examples::shaken_box_damper(2000, 8);
+fn scenario(first_packing: usize) -> pdamp_scenario::schema::Scenario {
+    let mut s = pdamp_scenario::examples::shaken_box_damper(2000, 8);
     s.materials[0].youngs_modulus_pa = 2e7;
     s.simulation.time_step_s = 1e-5;
     s.simulation.skin_m = Some(4e-4);
@@ -90,7 +90,7 @@ fn ensemble_ci_contains_an_independent_ensemble_mean() {
 /// map of the confidence half-width is drawn.
 #[test]
 fn fields_on_an_ensemble_report_means_and_intervals() {
-    let mut s = pdamp_io::examples::shaken_box_damper(150, 3);
+    let mut s = pdamp_scenario::examples::shaken_box_damper(150, 3);
     s.materials[0].youngs_modulus_pa = 2e7;
     s.simulation.time_step_s = 1e-5;
     s.simulation.skin_m = Some(4e-4);
@@ -98,7 +98,7 @@ fn fields_on_an_ensemble_report_means_and_intervals() {
     d.cycles = 3;
     d.transient_cycles = 1;
     s.fields = Some(
-        pdamp_io::scenario::Scenario::from_toml(
+        pdamp_scenario::schema::Scenario::from_toml(
             "[simulation]\nduration_s = 0.0\ntime_step_s = 1e-5\n[[materials]]\nname = \"a\"\ndensity_kg_m3 = 1.0\nyoungs_modulus_pa = 1.0\npoisson_ratio = 0.3\n[contact]\nnormal = { law = \"hertz\" }\n[fields]\nfrequencies_hz = [30.0, 60.0]\namplitudes_m = [1e-3, 2e-3]\n",
         )
         .unwrap()

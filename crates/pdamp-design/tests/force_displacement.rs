@@ -13,7 +13,7 @@
 
 use pdamp_design::motion::FORCE_DISPLACEMENT_COLUMNS;
 use pdamp_design::report::run_damper_scenario;
-use pdamp_io::scenario::{DamperSpec, MotionOutputSpec};
+use pdamp_scenario::schema::{DamperSpec, MotionOutputSpec};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -25,8 +25,8 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The shaken box (100 spheres of 1 mm, restitution 0.6, friction 0.3) as a damper point:
 /// 20 Hz, X = 2 mm (Γ = 3.2), 6 cycles of which 2 are transient; m_con = 0.2 kg.
-fn scenario() -> pdamp_io::scenario::Scenario {
-    let mut sc = pdamp_io::examples::shaken_box(100, 0.0);
+fn scenario() -> pdamp_scenario::schema::Scenario {
+    let mut sc = pdamp_scenario::examples::shaken_box(100, 0.0);
     sc.damper = Some(DamperSpec {
         container_body: "box".into(),
         container_mass_kg: 0.2,

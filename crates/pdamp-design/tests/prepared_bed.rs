@@ -1,4 +1,4 @@
-//! A bed prepared by one process and saved (`pdamp_io::prepare::save_prepared`) continues in
+//! A bed prepared by one process and saved (`pdamp_scenario::prepare::save_prepared`) continues in
 //! another bit for bit: the tasks of a sweep on other nodes start from the same state as a
 //! local field run that prepared the bed itself (issue 27).
 
@@ -17,7 +17,7 @@ fn without_time(mut r: pdamp_design::PointResult) -> pdamp_design::PointResult {
 #[test]
 fn a_saved_prepared_bed_continues_bit_for_bit() {
     let base = examples();
-    let sc = pdamp_io::scenario::Scenario::load(&base.join("damper_cylinder_small.toml"))
+    let sc = pdamp_scenario::schema::Scenario::load(&base.join("damper_cylinder_small.toml"))
         .expect("scenario");
     let dir = std::env::temp_dir().join(format!("pdamp_prepared_bed_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -47,8 +47,8 @@ fn a_saved_prepared_bed_continues_bit_for_bit() {
 
     // The saved bed belongs to its scenario: another seed's packing, a changed material or a
     // damaged file is refused with the reason, never silently used.
-    let other = pdamp_io::prepare::scenario_for_packing(&sc, 2);
-    let Err(e) = pdamp_io::prepare::load_prepared(&prepared_bed_path(&dir, 1), &other, &base)
+    let other = pdamp_scenario::prepare::scenario_for_packing(&sc, 2);
+    let Err(e) = pdamp_scenario::prepare::load_prepared(&prepared_bed_path(&dir, 1), &other, &base)
     else {
         panic!("another packing's scenario must be refused");
     };

@@ -145,8 +145,8 @@ fn stuck_bed_has_no_damping_and_full_mass() {
 /// cycle from the complex power agrees with the ledger's within 2 %.
 #[test]
 fn complex_power_matches_ledger_on_shaken_box() {
-    let mut sc = pdamp_io::examples::shaken_box(200, 0.0);
-    sc.damper = Some(pdamp_io::scenario::DamperSpec {
+    let mut sc = pdamp_scenario::examples::shaken_box(200, 0.0);
+    sc.damper = Some(pdamp_scenario::schema::DamperSpec {
         container_body: "box".into(),
         container_mass_kg: 0.2,
         direction: [1.0, 0.0, 0.0],
@@ -219,7 +219,7 @@ fn complex_power_matches_ledger_on_shaken_box() {
 #[test]
 fn fields_grid_is_resumable_and_deterministic() {
     use pdamp_design::fields::{FIELD_COLUMNS, FieldGrid, run_fields};
-    use pdamp_io::scenario::AmplitudeAxis;
+    use pdamp_scenario::schema::AmplitudeAxis;
     let r = 1e-3;
     let h = 4e-3;
     let model = ContactModel {
@@ -406,7 +406,7 @@ fn convergence_stops_early_within_tolerance_of_the_full_run() {
 #[test]
 fn fields_thread_split_does_not_change_results() {
     use pdamp_design::fields::{FieldGrid, ThreadSplit, run_fields_with};
-    use pdamp_io::scenario::AmplitudeAxis;
+    use pdamp_scenario::schema::AmplitudeAxis;
     let damper = stuck_bed_damper(3, 1);
     let grid = FieldGrid {
         frequencies_hz: vec![200.0, 400.0],
@@ -475,7 +475,7 @@ fn fields_thread_split_does_not_change_results() {
 fn turned_bed_is_at_rest_before_the_excitation() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples/damper_cylinder_small.toml");
-    let sc = pdamp_io::scenario::Scenario::load(&path).expect("scenario");
+    let sc = pdamp_scenario::schema::Scenario::load(&path).expect("scenario");
     assert!(sc.settle.as_ref().unwrap().gravity_m_s2.is_some());
     let damper = Damper::from_scenario(&sc, path.parent().unwrap(), |_| {}).expect("damper");
     let mut w = damper.settled.clone();

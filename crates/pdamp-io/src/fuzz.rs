@@ -12,25 +12,6 @@ pub fn stl(bytes: &[u8]) {
     }
 }
 
-/// Scenario TOML: parsing, validation and the error location lookup. Worlds are not built
-/// (that would place as many particles as the input asks for).
-pub fn scenario(bytes: &[u8]) {
-    let text = String::from_utf8_lossy(bytes);
-    let base = std::path::Path::new("/nonexistent-pdamp-fuzz");
-    match crate::scenario::Scenario::from_toml_in(&text, base) {
-        Ok(s) => {
-            if let Err(m) = s.validate() {
-                let _ = crate::scenario::locate_key(&text, m.key());
-            } else {
-                let _ = s.to_toml();
-            }
-        }
-        Err(m) => {
-            let _ = crate::scenario::locate_key(&text, m.key());
-        }
-    }
-}
-
 /// Numeric CSV (`fields.csv`, `energy.csv`, …): [`crate::csv::parse_csv_f64`].
 pub fn csv(bytes: &[u8]) {
     let _ = crate::csv::parse_csv_f64(&String::from_utf8_lossy(bytes));
@@ -39,18 +20,6 @@ pub fn csv(bytes: &[u8]) {
 /// Restitution tables: [`crate::restitution::parse_restitution_table`].
 pub fn restitution_table(bytes: &[u8]) {
     let _ = crate::restitution::parse_restitution_table(&String::from_utf8_lossy(bytes));
-}
-
-/// Checkpoint files of `pdamp run` ([`crate::run::inspect_run_checkpoint`]).
-pub fn checkpoint(bytes: &[u8]) {
-    let _ = crate::run::inspect_run_checkpoint(bytes);
-    // Again with a valid trailing digest, so that mutated payloads reach the decoder itself.
-    if bytes.len() > 24 {
-        let mut b = bytes[..bytes.len() - 16].to_vec();
-        let sum = crate::checkpoint::digest(&b);
-        b.extend_from_slice(sum.as_bytes());
-        let _ = crate::run::inspect_run_checkpoint(&b);
-    }
 }
 
 /// LAMMPS / LIGGGHTS data files ([`crate::bed_formats::read_lammps_data`]); a bed that reads
@@ -101,13 +70,12 @@ pub fn bed_native(bytes: &[u8]) {
 /// A named fuzz entry point.
 pub type Target = (&'static str, fn(&[u8]));
 
-/// All readers by name (for the harnesses).
-pub const TARGETS: [Target; 8] = [
+/// All readers of this crate by name (for the harnesses; the scenario and run-checkpoint
+/// readers are `pdamp_scenario::fuzz::TARGETS`).
+pub const TARGETS: [Target; 6] = [
     ("stl", stl),
-    ("scenario", scenario),
     ("csv", csv),
     ("restitution_table", restitution_table),
-    ("checkpoint", checkpoint),
     ("lammps_data", lammps_data),
     ("bed_csv", bed_csv),
     ("bed_native", bed_native),

@@ -379,7 +379,7 @@ pub fn evaluate_design(
             .map_err(|e| DesignError::output(&path, e))?;
         // the beds are saved beside the points (`beds/packing_KKK.pdprep`): a rerun reads them
         // instead of dropping them again
-        let run = pdamp_io::scenario::Scenario::load(&path)
+        let run = pdamp_scenario::schema::Scenario::load(&path)
             .map_err(|e| format!("{}: {e}", path.display()))
             .and_then(|sc| {
                 pdamp_design::report::run_fields_scenario_from(

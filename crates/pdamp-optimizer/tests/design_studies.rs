@@ -602,7 +602,7 @@ fn effective_fields_rank_the_best_design_with_every_coating() {
     pdamp_structure::report::run_couple(
         &scn,
         &run,
-        pdamp_io::run::RunOptions {
+        pdamp_scenario::run::RunOptions {
             checkpoint_interval_s: 0.0,
             resume: false,
         },
@@ -895,7 +895,7 @@ fn coated_study_builds_a_three_dimensional_bed_with_coated_end_walls() {
     // the scenario is a valid DEM damper scenario
     let p = std::env::temp_dir().join(format!("pdamp_coated_{}.toml", std::process::id()));
     std::fs::write(&p, &text).unwrap();
-    let loaded = pdamp_io::scenario::Scenario::load(&p);
+    let loaded = pdamp_scenario::schema::Scenario::load(&p);
     std::fs::remove_file(&p).unwrap();
     let loaded = loaded.unwrap();
     assert_eq!(loaded.particles[0].count, Some(1264));

@@ -14,7 +14,7 @@
 //! damper gives another decay on every packing, so a damping ratio is reported as the mean
 //! over K independently prepared beds with its 95 % confidence interval (Student's t,
 //! [`pdamp_design::ensemble::EnsembleStat`]). Packing k is prepared with the seed
-//! [`pdamp_io::prepare::packing_seed`]`(seed, k)` (packing 0 is the scenario's own seed) and
+//! [`pdamp_scenario::prepare::packing_seed`]`(seed, k)` (packing 0 is the scenario's own seed) and
 //! runs in `packing_KKK/` ([`run_ensemble`]; in a study, below each value's folder), resumable
 //! like every run.
 
@@ -421,11 +421,11 @@ fn read_tip(dir: &Path) -> Result<(Vec<f64>, Vec<f64>), StudyError> {
     ))
 }
 
-/// The scenario of packing `k`: the powder prepared with [`pdamp_io::prepare::packing_seed`].
+/// The scenario of packing `k`: the powder prepared with [`pdamp_scenario::prepare::packing_seed`].
 pub fn with_packing(base: &CantileverScenario, k: usize) -> Result<CantileverScenario, StudyError> {
     let mut s = base.clone();
     let p = s.powder.as_mut().ok_or(StudyError::NoPowder)?;
-    p.prep.seed = pdamp_io::prepare::packing_seed(p.prep.seed, k);
+    p.prep.seed = pdamp_scenario::prepare::packing_seed(p.prep.seed, k);
     Ok(s)
 }
 

@@ -47,14 +47,14 @@ pub(crate) fn run(
     let (sc, base) = (&scenario.inner, &scenario.base_dir);
     let pool = crate::detach::pool(threads)?;
     detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        let options = pdamp_io::run::RunOptions {
+        let options = pdamp_scenario::run::RunOptions {
             checkpoint_interval_s: 0.0,
             resume: false,
         };
         if sc.damper.is_some() {
             pdamp_design::report::run_damper_scenario(sc, base, &out, |phase, f| p.set(phase, f))?;
         } else {
-            pdamp_io::run::run_scenario(sc, base, &out, options, |phase, f| p.set(phase, f))?;
+            pdamp_scenario::run::run_scenario(sc, base, &out, options, |phase, f| p.set(phase, f))?;
         }
         Ok(std::fs::read_to_string(out.join("summary.json"))?)
     })
@@ -112,7 +112,7 @@ pub(crate) fn couple(
         )));
     }
     std::fs::create_dir_all(&out).map_err(io_err)?;
-    let options = pdamp_io::run::RunOptions {
+    let options = pdamp_scenario::run::RunOptions {
         checkpoint_interval_s,
         resume,
     };

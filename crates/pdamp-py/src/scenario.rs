@@ -18,19 +18,19 @@ create_exception!(
 /// against.
 #[pyclass(name = "Scenario", module = "pdamp._pdamp")]
 pub(crate) struct PyScenario {
-    pub(crate) inner: pdamp_io::scenario::Scenario,
+    pub(crate) inner: pdamp_scenario::schema::Scenario,
     pub(crate) base_dir: PathBuf,
 }
 
 fn scenario_error(path: &Path, text: Option<&str>, message: String) -> PyErr {
     ScenarioError::new_err(
-        pdamp_io::scenario::ScenarioError::invalid(path, text, message).to_string(),
+        pdamp_scenario::schema::ScenarioError::invalid(path, text, message).to_string(),
     )
 }
 
 /// Parses and validates TOML text as the command line does (`source` names it in messages).
-fn parse(text: &str, base_dir: &Path, source: &Path) -> PyResult<pdamp_io::scenario::Scenario> {
-    let sc = pdamp_io::scenario::Scenario::from_toml_in(text, base_dir)
+fn parse(text: &str, base_dir: &Path, source: &Path) -> PyResult<pdamp_scenario::schema::Scenario> {
+    let sc = pdamp_scenario::schema::Scenario::from_toml_in(text, base_dir)
         .map_err(|m| scenario_error(source, Some(text), m.to_string()))?;
     sc.validate()
         .map_err(|m| scenario_error(source, Some(text), m.to_string()))?;
@@ -127,7 +127,7 @@ impl PyScenario {
     /// Reads and validates a scenario file (paths in it relative to its folder).
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Self> {
-        let inner = pdamp_io::scenario::Scenario::load(&path)
+        let inner = pdamp_scenario::schema::Scenario::load(&path)
             .map_err(|e| ScenarioError::new_err(e.to_string()))?;
         let base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         Ok(Self { inner, base_dir })

@@ -139,7 +139,7 @@ impl PyWorld {
         let drive = drive.unwrap_or_default();
         let declared_driven = |name: &str| {
             sc.bodies.iter().any(|s| {
-                s.name == name && matches!(s.motion, pdamp_io::scenario::MotionSpec::Driven)
+                s.name == name && matches!(s.motion, pdamp_scenario::schema::MotionSpec::Driven)
             })
         };
         if let Some(name) = drive.keys().find(|n| !declared_driven(n)) {
@@ -172,16 +172,21 @@ impl PyWorld {
             if let (true, Some(spec)) = (settle, &sc.settle) {
                 let mut bad = None;
                 let max = spec.max_duration_s;
-                let r = pdamp_io::run::settle_with_or_break(&mut world, spec, main_gravity, |w| {
-                    if let Err(e) = health(w) {
-                        bad = Some(e);
-                        return ControlFlow::Break(());
-                    }
-                    if poll("settling", w.time_s / max) {
-                        return ControlFlow::Break(());
-                    }
-                    ControlFlow::Continue(())
-                });
+                let r = pdamp_scenario::run::settle_with_or_break(
+                    &mut world,
+                    spec,
+                    main_gravity,
+                    |w| {
+                        if let Err(e) = health(w) {
+                            bad = Some(e);
+                            return ControlFlow::Break(());
+                        }
+                        if poll("settling", w.time_s / max) {
+                            return ControlFlow::Break(());
+                        }
+                        ControlFlow::Continue(())
+                    },
+                );
                 if let Some(e) = bad {
                     return Err(format!("settling: {e}").into());
                 }
@@ -216,7 +221,7 @@ impl PyWorld {
                 if world
                     .counters
                     .steps
-                    .is_multiple_of(pdamp_io::run::HEALTH_CHECK_STEPS)
+                    .is_multiple_of(pdamp_scenario::run::HEALTH_CHECK_STEPS)
                 {
                     health(world)?;
                 }
@@ -252,7 +257,7 @@ impl PyWorld {
             world.run_until_or_break_deferred(t_end, |w| {
                 if w.counters
                     .steps
-                    .is_multiple_of(pdamp_io::run::HEALTH_CHECK_STEPS)
+                    .is_multiple_of(pdamp_scenario::run::HEALTH_CHECK_STEPS)
                 {
                     w.complete_step();
                     if let Err(e) = health(w) {

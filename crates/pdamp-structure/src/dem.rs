@@ -43,6 +43,7 @@ use nalgebra::DVector;
 use pdamp_dem::math::Rotation;
 use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3, WorldState};
 use pdamp_design::Damper;
+use pdamp_scenario::run::SnapshotSeries;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -653,16 +654,10 @@ fn check_same_time_step(beds: &[DemBed], dt: f64) -> Result<(), StructureError> 
 
 /// The first bed's ParaView series of a checkpointed run: a frame every `interval_s` of its
 /// `bed_vtk` settings (`None` without them).
-fn bed_snapshots(
-    ck: Option<&CouplingCheckpoint>,
-    dt: f64,
-) -> Option<pdamp_io::run::SnapshotSeries> {
-    match ck.and_then(|c| c.bed_vtk.as_ref()) {
-        Some(b) => pdamp_io::run::SnapshotSeries::every_steps_for(b.interval_s, dt).map(|every| {
-            pdamp_io::run::SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding)
-        }),
-        None => None,
-    }
+fn bed_snapshots(ck: Option<&CouplingCheckpoint>, dt: f64) -> Option<SnapshotSeries> {
+    let b = ck.and_then(|c| c.bed_vtk.as_ref())?;
+    SnapshotSeries::every_steps_for(b.interval_s, dt)
+        .map(|every| SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding))
 }
 
 /// Every bed's energy ledger added to the run's energy exchange: wall work, change of the

@@ -395,7 +395,7 @@ pub fn tabulate(
                 f,
                 x,
                 a,
-                a / pdamp_io::scenario::STANDARD_GRAVITY_M_S2,
+                a / pdamp_scenario::schema::STANDARD_GRAVITY_M_S2,
                 s.dissipated_energy_per_cycle_j,
                 s.dissipated_energy_per_cycle_j / (std::f64::consts::TAU * e_kin_total),
                 s.dissipated_energy_per_cycle_j / (std::f64::consts::PI * mb * v * v),

@@ -177,7 +177,7 @@ pub enum StructureError {
     Interrupted(pdamp_io::checkpoint::Interrupted),
     /// A located error of a scenario or structure file (line and column of the key).
     #[error("{0}")]
-    Scenario(pdamp_io::scenario::ScenarioError),
+    Scenario(pdamp_scenario::schema::ScenarioError),
     /// A Matrix Market reader error or a check of K and M.
     #[error(transparent)]
     MatrixMarket(#[from] MatrixMarketError),
@@ -208,7 +208,7 @@ pub enum StructureError {
     /// The VTK frames of a coupled run cannot be written (pdamp-io; boxed: a run error carries
     /// a whole health report).
     #[error(transparent)]
-    Snapshots(Box<pdamp_io::run::RunError>),
+    Snapshots(Box<pdamp_scenario::run::RunError>),
     /// A checkpoint's world state does not fit the scenario's bed (pdamp-dem).
     #[error(transparent)]
     State(#[from] pdamp_dem::state::StateError),
@@ -227,8 +227,8 @@ fn quoted(path: Option<&Path>) -> String {
     }
 }
 
-impl From<pdamp_io::run::RunError> for StructureError {
-    fn from(e: pdamp_io::run::RunError) -> Self {
+impl From<pdamp_scenario::run::RunError> for StructureError {
+    fn from(e: pdamp_scenario::run::RunError) -> Self {
         StructureError::Snapshots(Box::new(e))
     }
 }
@@ -288,7 +288,7 @@ impl StructureError {
     /// read): [`StructureError::Scenario`] with the line and column of the key the message
     /// starts with.
     pub fn located(self, path: &Path, text: Option<&str>) -> Self {
-        pdamp_io::scenario::ScenarioError::invalid(path, text, self.to_string()).into()
+        pdamp_scenario::schema::ScenarioError::invalid(path, text, self.to_string()).into()
     }
 }
 
@@ -306,7 +306,7 @@ macro_rules! wrap {
 }
 
 wrap!(
-    Scenario(pdamp_io::scenario::ScenarioError),
+    Scenario(pdamp_scenario::schema::ScenarioError),
     Csv(pdamp_io::csv::CsvError),
     Plot(pdamp_plot::PlotError),
     Io(std::io::Error),

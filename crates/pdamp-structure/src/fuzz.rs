@@ -42,7 +42,8 @@ pub fn structure_scenario(bytes: &[u8]) {
     let text = String::from_utf8_lossy(bytes);
     let locate = |m: crate::StructureError| {
         let m = m.to_string();
-        let _ = pdamp_io::scenario::locate_key(&text, pdamp_io::scenario::leading_key_path(&m));
+        let _ =
+            pdamp_scenario::schema::locate_key(&text, pdamp_scenario::schema::leading_key_path(&m));
     };
     let spec = if let Ok(f) = toml::from_str::<crate::scenario::StructureFile>(&text) {
         Some(f.structure)

@@ -14,7 +14,7 @@ use std::path::Path;
 fn decay(example: &str) -> Vec<(f64, f64, f64)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let out = std::env::temp_dir().join(format!("pdamp-{example}-{}", std::process::id()));
-    let options = pdamp_io::run::RunOptions {
+    let options = pdamp_scenario::run::RunOptions {
         checkpoint_interval_s: 0.0,
         resume: false,
     };

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use pdamp_design::FieldGrid;
 use pdamp_design::fields::{StoredPoint, stored_point};
 use pdamp_design::report::{BedSource, field_damper, prepared_bed_path};
-use pdamp_io::scenario::Scenario;
+use pdamp_scenario::schema::Scenario;
 use pdamp_sweep::status::Stored;
 use pdamp_sweep::{SweepManifest, Task};
 use std::path::{Path, PathBuf};
@@ -84,9 +84,9 @@ fn describe(
                     String::new()
                 },
                 match grid.amplitude_axis {
-                    pdamp_io::scenario::AmplitudeAxis::Displacement => "X",
-                    pdamp_io::scenario::AmplitudeAxis::Acceleration => "A",
-                    pdamp_io::scenario::AmplitudeAxis::Intensity => "Γ",
+                    pdamp_scenario::schema::AmplitudeAxis::Displacement => "X",
+                    pdamp_scenario::schema::AmplitudeAxis::Acceleration => "A",
+                    pdamp_scenario::schema::AmplitudeAxis::Intensity => "Γ",
                 }
             );
             (
@@ -111,7 +111,7 @@ pub(crate) fn create(scenario: &Path, out: &Path) -> Result<SweepManifest> {
         kind: FIELDS_KIND.into(),
         title: sc.title.clone(),
         scenario_source: source,
-        scenario_digest: pdamp_io::run::scenario_content_digest(&sc, &base_dir),
+        scenario_digest: pdamp_scenario::run::scenario_content_digest(&sc, &base_dir),
         base_dir,
         parameters: serde_json::Value::Null,
         tasks: tasks
@@ -239,8 +239,8 @@ pub(super) fn execute_field_tasks(
             &points,
             pdamp_design::ThreadSplit::default(),
             Some(&pdamp_design::fields::PointCheckpoints {
-                scenario_digest: pdamp_io::run::scenario_content_digest(
-                    &pdamp_io::prepare::scenario_for_packing(sc, k),
+                scenario_digest: pdamp_scenario::run::scenario_content_digest(
+                    &pdamp_scenario::prepare::scenario_for_packing(sc, k),
                     &m.base_dir,
                 ),
                 interval_s: 60.0,

@@ -10,7 +10,7 @@
 use anyhow::{Context, Result, bail};
 use pdamp_design::FieldGrid;
 use pdamp_design::report::BedSource;
-use pdamp_io::scenario::Scenario;
+use pdamp_scenario::schema::Scenario;
 use pdamp_sweep::slurm::SlurmOptions;
 use pdamp_sweep::status::{Stored, TaskState};
 use pdamp_sweep::{SweepManifest, Task};
@@ -226,7 +226,7 @@ fn open(dir: &Path, m: &SweepManifest) -> Result<Opened> {
             let sc = Scenario::from_toml_in(&text, &m.base_dir)
                 .and_then(|s| s.validate().map(|_| s).map_err(Into::into))
                 .map_err(|e| anyhow::anyhow!("{}: {e}", copy.display()))?;
-            let digest = pdamp_io::run::scenario_content_digest(&sc, &m.base_dir);
+            let digest = pdamp_scenario::run::scenario_content_digest(&sc, &m.base_dir);
             if digest != m.scenario_digest {
                 return Err(changed(&digest));
             }

@@ -206,7 +206,7 @@ fn run_one(
     pdamp_structure::report::run_couple(
         &cscn,
         &run_out,
-        pdamp_io::run::RunOptions {
+        pdamp_scenario::run::RunOptions {
             checkpoint_interval_s: 0.0,
             resume: false,
         },
@@ -334,7 +334,7 @@ fn announce(
 }
 
 pub(crate) fn seed(space: &Space, packing: usize) -> u64 {
-    pdamp_io::prepare::packing_seed(space.study.file.search.seed, packing)
+    pdamp_scenario::prepare::packing_seed(space.study.file.search.seed, packing)
 }
 
 /// max_damping: one free decay per packing and mode ([`DecayPlan`] × [`DEM_DECAY_MARGIN`]),

@@ -19,7 +19,7 @@ mod validate;
 use std::path::PathBuf;
 
 use pdamp_io::checkpoint as ck;
-pub use pdamp_io::run::RunOptions;
+pub use pdamp_scenario::run::RunOptions;
 use serde::{Deserialize, Serialize};
 
 pub use self::beam::{build_structure, cavity_interface, empty_beam_modes, timoshenko_reference};

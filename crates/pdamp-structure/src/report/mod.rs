@@ -16,8 +16,8 @@ use crate::modal::ModalStructure;
 use crate::modal_fit;
 use crate::scenario::{AnalysisSpec, CoupleScenario, DamperSpec, ForceSpec, load_structure};
 use pdamp_io::csv::write_csv_atomic;
-use pdamp_io::scenario::VtkFormat;
 use pdamp_plot::{Axis, LinePlot, Marker, Series, line_plot};
+use pdamp_scenario::schema::VtkFormat;
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -84,7 +84,7 @@ pub fn run_couple_default(
     out: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<serde_json::Value, StructureError> {
-    let options = pdamp_io::run::RunOptions {
+    let options = pdamp_scenario::run::RunOptions {
         checkpoint_interval_s: 0.0,
         resume: false,
     };
@@ -98,7 +98,7 @@ pub fn run_couple_default(
 pub fn run_couple(
     path: &Path,
     out: &Path,
-    options: pdamp_io::run::RunOptions,
+    options: pdamp_scenario::run::RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<serde_json::Value, StructureError> {
     let (scn, structure_spec) = CoupleScenario::load(path)?;
@@ -305,7 +305,7 @@ fn load_dem_beds(
             base.join(scenario)
         };
         let in_damper = |e: StructureError| e.context(format!("dampers[{i}]: {}", p.display()));
-        let sc = pdamp_io::scenario::Scenario::load(&p).map_err(|e| in_damper(e.into()))?;
+        let sc = pdamp_scenario::schema::Scenario::load(&p).map_err(|e| in_damper(e.into()))?;
         inputs.extend_from_slice(sc.to_toml().as_bytes());
         if bed_vtk.is_none() {
             bed_vtk = Some((sc.output.vtk_interval_s, sc.output.vtk_format));
@@ -331,7 +331,7 @@ fn load_dem_beds(
 fn coupling_checkpoint(
     out: &Path,
     inputs: &[u8],
-    options: &pdamp_io::run::RunOptions,
+    options: &pdamp_scenario::run::RunOptions,
     bed_vtk: Option<BedVtkOutput>,
 ) -> CouplingCheckpoint {
     CouplingCheckpoint {

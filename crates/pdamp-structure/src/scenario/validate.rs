@@ -109,7 +109,7 @@ pub fn on_beam(key: &str, x: f64, length_m: f64) -> Result<(), StructureError> {
 /// looked up in the file.
 pub fn locate(path: &Path, message: impl Into<String>) -> String {
     let text = std::fs::read_to_string(path).ok();
-    pdamp_io::scenario::ScenarioError::invalid(path, text.as_deref(), message).to_string()
+    pdamp_scenario::schema::ScenarioError::invalid(path, text.as_deref(), message).to_string()
 }
 
 /// [`locate`] as a typed error: `error` located in the file `path` (read again for the key's

@@ -1,7 +1,7 @@
 //! A suite of mistaken scenarios: each must be refused before any work starts, with a message
 //! that names the file, the offending key with its line and column, and the fix.
 
-use pdamp_io::scenario::{Scenario, ScenarioError};
+use pdamp_scenario::schema::{Scenario, ScenarioError};
 use std::path::PathBuf;
 
 /// A small valid damper scenario; every case below changes one thing in it.

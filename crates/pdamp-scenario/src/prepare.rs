@@ -5,14 +5,14 @@
 //! ensembles, so that every command makes its beds the same way.
 
 use crate::InputError;
-use crate::bed::{BedFile, save_bed};
-use crate::checkpoint::CheckpointError;
 use crate::error::Source;
-pub use crate::scenario::excitation_direction;
-use crate::scenario::{Preparation, Scenario};
+pub use crate::schema::excitation_direction;
+use crate::schema::{Preparation, Scenario};
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::drop_down::DropDownReport;
 use pdamp_dem::{Bed, Vec3, World};
+use pdamp_io::bed::{BedFile, save_bed};
+use pdamp_io::checkpoint::CheckpointError;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -146,7 +146,7 @@ struct PreparedFile {
     fill_statistics: Option<BedStatistics>,
 }
 
-/// Saves a prepared bed to `path` (atomic; the checkpoint framing of [`crate::checkpoint`],
+/// Saves a prepared bed to `path` (atomic; the checkpoint framing of [`pdamp_io::checkpoint`],
 /// kind [`PREPARED_KIND`], keyed by [`crate::provenance::scenario_content_digest`] of `scenario`),
 /// so that another process — a task of a sweep on another node — continues from the same bits
 /// with [`load_prepared`] instead of preparing the bed again.
@@ -157,9 +157,9 @@ pub fn save_prepared(
     base_dir: &Path,
 ) -> Result<(), CheckpointError> {
     let digest = crate::provenance::scenario_content_digest(scenario, base_dir);
-    crate::checkpoint::save(
+    pdamp_io::checkpoint::save(
         path,
-        &crate::checkpoint::CheckpointHeader::new(PREPARED_KIND, &digest),
+        &pdamp_io::checkpoint::CheckpointHeader::new(PREPARED_KIND, &digest),
         &PreparedFile {
             state: prepared.world.save_state(),
             settling_time_s: prepared.settling_time_s,
@@ -180,21 +180,17 @@ pub fn load_prepared(
     base_dir: &Path,
 ) -> Result<Option<PreparedBed>, PrepareError> {
     let digest = crate::provenance::scenario_content_digest(scenario, base_dir);
-    let Some(f) = crate::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest).map_err(
-        |e| match e {
+    let Some(f) = pdamp_io::checkpoint::load::<PreparedFile>(path, PREPARED_KIND, &digest)
+        .map_err(|e| match e {
             CheckpointError::Io { path, cause } => PrepareError::prepared(path, cause),
             CheckpointError::InFile { path, cause } => PrepareError::prepared(path, *cause),
             e => PrepareError::Checkpoint(e),
-        },
-    )?
+        })?
     else {
         return Ok(None);
     };
-    let mut world = scenario.build_world_with(
-        base_dir,
-        crate::scenario::Preparation::Check,
-        &mut |_, _| {},
-    )?;
+    let mut world =
+        scenario.build_world_with(base_dir, crate::schema::Preparation::Check, &mut |_, _| {})?;
     let why = |e: pdamp_dem::state::StateError| PrepareError::prepared(path, e);
     world.set_particles_of(&f.state).map_err(why)?;
     world.restore_state(f.state).map_err(why)?;
@@ -250,9 +246,7 @@ pub fn settle_scenario(
     let io = |e: std::io::Error| PrepareError::Output(e.into());
     let prepared = prepare_bed(scenario, base_dir, progress)?;
     let world = &prepared.world;
-    crate::provenance::Provenance::of(scenario)
-        .write(scenario, out)
-        .map_err(io)?;
+    crate::provenance::write(scenario, out).map_err(io)?;
     let stats = bed_statistics(world, excitation_direction(scenario));
     let digest = crate::provenance::scenario_digest(scenario);
     let bed = Bed::from_world(world);
@@ -267,9 +261,9 @@ pub fn settle_scenario(
         },
         &digest,
     )?;
-    crate::atomic::write_atomic(
+    pdamp_io::atomic::write_atomic(
         out.join("bed.csv"),
-        crate::bed_formats::write_bed_csv(&bed).as_bytes(),
+        pdamp_io::bed_formats::write_bed_csv(&bed).as_bytes(),
     )
     .map_err(io)?;
     let densities: Vec<f64> = world.materials.iter().map(|m| m.density_kg_m3).collect();
@@ -281,20 +275,23 @@ pub fn settle_scenario(
             hi[k] = hi[k].max(x[k] + r);
         }
     }
-    crate::atomic::write_atomic(
+    pdamp_io::atomic::write_atomic(
         out.join("bed.data"),
-        crate::bed_formats::write_lammps_data(&bed, &densities, (lo, hi)).as_bytes(),
+        pdamp_io::bed_formats::write_lammps_data(&bed, &densities, (lo, hi)).as_bytes(),
     )
     .map_err(io)?;
-    crate::vtk::write_particles_vtp(
+    pdamp_io::vtk::write_particles_vtp(
         out.join("bed.vtp"),
         &p.position,
         &p.radius,
         &[
-            ("velocity_m_s", crate::vtk::PointField::Vector(&p.velocity)),
+            (
+                "velocity_m_s",
+                pdamp_io::vtk::PointField::Vector(&p.velocity),
+            ),
             (
                 "material",
-                crate::vtk::PointField::Int(
+                pdamp_io::vtk::PointField::Int(
                     &p.material.iter().map(|&m| m as u32).collect::<Vec<_>>(),
                 ),
             ),
@@ -322,6 +319,6 @@ pub fn settle_scenario(
         .to_vec(),
     };
     let json = serde_json::to_string_pretty(&summary)?;
-    crate::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
+    pdamp_io::atomic::write_atomic(out.join("summary.json"), json.as_bytes()).map_err(io)?;
     Ok(summary)
 }

@@ -224,7 +224,7 @@ impl Scenario {
                     }
                     GeometrySpec::Stl(s) => {
                         let path = base_dir.join(&s.path);
-                        let mut mesh = crate::stl::read_stl(&path).map_err(|e| {
+                        let mut mesh = pdamp_io::stl::read_stl(&path).map_err(|e| {
                             InputError::at(format!("bodies[{bi}].walls[{wi}].geometry.path"), e)
                         })?;
                         mesh = mesh
@@ -303,11 +303,11 @@ impl Scenario {
         let read = || std::fs::read_to_string(path).map_err(|e| InputError::read(&key, path, e));
         let (bed, state) = match format {
             BedFormat::Native => {
-                let f = crate::bed::load_bed(path).map_err(|e| InputError::at(&key, e))?;
+                let f = pdamp_io::bed::load_bed(path).map_err(|e| InputError::at(&key, e))?;
                 (f.bed, f.state)
             }
             BedFormat::Lammps => {
-                let mut bed = crate::bed_formats::read_lammps_data(&read()?, &pl.type_materials)
+                let mut bed = pdamp_io::bed_formats::read_lammps_data(&read()?, &pl.type_materials)
                     .map_err(|e| InputError::file(&key, path, e))?;
                 if pl.type_materials.is_empty() {
                     bed.materials = vec![material.to_string()];
@@ -316,7 +316,7 @@ impl Scenario {
                 (bed, None)
             }
             BedFormat::Csv => (
-                crate::bed_formats::read_bed_csv(&read()?, material)
+                pdamp_io::bed_formats::read_bed_csv(&read()?, material)
                     .map_err(|e| InputError::file(&key, path, e))?,
                 None,
             ),
@@ -419,7 +419,7 @@ impl Scenario {
         let total = radii.len().max(1) as f64;
         pdamp_dem::drop_down::drop_down(&w, radii, mat, &spec, |_, placed| {
             progress("drop-down", placed as f64 / total);
-            if crate::checkpoint::stop_requested() {
+            if pdamp_io::checkpoint::stop_requested() {
                 std::ops::ControlFlow::Break(())
             } else {
                 std::ops::ControlFlow::Continue(())

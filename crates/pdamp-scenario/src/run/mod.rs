@@ -1,15 +1,15 @@
 //! Running a scenario to files: settling, the main run, `energy.csv`, VTK snapshots with a
 //! `.pvd` series, and `summary.json`.
 
-use crate::checkpoint::CheckpointError;
-use crate::csv::CsvWriter;
 pub use crate::error::RunError;
 pub use crate::provenance::{referenced_files_digest, scenario_content_digest, scenario_digest};
-use crate::scenario::Scenario;
-use crate::vtk::{PvdSeries, VtkEncoding};
+use crate::schema::Scenario;
 use pdamp_dem::WorldState;
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::{Vec3, World};
+use pdamp_io::checkpoint::CheckpointError;
+use pdamp_io::csv::CsvWriter;
+use pdamp_io::vtk::{PvdSeries, VtkEncoding};
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -190,7 +190,7 @@ impl RunCheckpoint {
 /// Decodes a `run` checkpoint file of any scenario and returns its simulated time, s (for
 /// inspection and fuzzing; never panics).
 pub fn inspect_run_checkpoint(bytes: &[u8]) -> Result<f64, CheckpointError> {
-    let c: RunCheckpoint = crate::checkpoint::decode(bytes, RUN_KIND, None)?;
+    let c: RunCheckpoint = pdamp_io::checkpoint::decode(bytes, RUN_KIND, None)?;
     Ok(c.world.map_or(0.0, |w| w.time_s()))
 }
 
@@ -212,7 +212,7 @@ fn report_failure(
         "message": h.message,
     });
     let _ = std::fs::create_dir_all(out_dir);
-    let _ = crate::atomic::write_atomic(
+    let _ = pdamp_io::atomic::write_atomic(
         out_dir.join("failure.json"),
         serde_json::to_string_pretty(&json)
             .unwrap_or_default()
@@ -231,8 +231,8 @@ const RUN_KIND: &str = "run";
 /// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
 /// `progress(phase, fraction)` is called regularly. Checkpoints every
 /// `options.checkpoint_interval_s` of wall-clock time and on a stop request
-/// ([`crate::checkpoint::request_stop`]), which ends the run with an error starting with
-/// [`crate::checkpoint::INTERRUPTED`]. With `options.resume`, continues from the last
+/// ([`pdamp_io::checkpoint::request_stop`]), which ends the run with an error starting with
+/// [`pdamp_io::checkpoint::INTERRUPTED`]. With `options.resume`, continues from the last
 /// checkpoint; the outputs then equal those of an uninterrupted run (timing fields aside).
 pub fn run_scenario(
     scenario: &Scenario,
@@ -241,7 +241,7 @@ pub fn run_scenario(
     options: RunOptions,
     mut progress: impl FnMut(&str, f64),
 ) -> Result<RunSummary, RunError> {
-    use crate::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
+    use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
     let mut world = scenario.build_world(base_dir)?;
     let digest = scenario_content_digest(scenario, base_dir);
     let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
@@ -256,9 +256,7 @@ pub fn run_scenario(
     {
         return finished_summary(out_dir);
     }
-    crate::provenance::Provenance::of(scenario)
-        .write(scenario, out_dir)
-        .map_err(RunError::output)?;
+    crate::provenance::write(scenario, out_dir).map_err(RunError::output)?;
     let start = std::time::Instant::now();
     let wall_before = resumed.as_ref().map_or(0.0, |c| c.wall_time_s);
     let wall = |start: &std::time::Instant| wall_before + start.elapsed().as_secs_f64();
@@ -390,15 +388,15 @@ pub fn run_scenario(
 #[allow(clippy::too_many_arguments)]
 fn settle_phase(
     world: &mut World,
-    spec: &crate::scenario::SettleSpec,
+    spec: &crate::schema::SettleSpec,
     main_gravity: Vec3,
     progress: &mut dyn FnMut(&str, f64),
-    timer: &mut crate::checkpoint::CheckpointTimer,
-    (ck_path, header): (&Path, &crate::checkpoint::CheckpointHeader),
+    timer: &mut pdamp_io::checkpoint::CheckpointTimer,
+    (ck_path, header): (&Path, &pdamp_io::checkpoint::CheckpointHeader),
     wall: &dyn Fn() -> f64,
     out_dir: &Path,
 ) -> Result<f64, RunError> {
-    use crate::checkpoint as ck;
+    use pdamp_io::checkpoint as ck;
     let mut health = None;
     let mut err = None;
     let max = spec.max_duration_s;
@@ -445,18 +443,18 @@ fn write_finished(
     summary: &RunSummary,
     world: &World,
     out_dir: &Path,
-    (ck_path, header): (&Path, &crate::checkpoint::CheckpointHeader),
+    (ck_path, header): (&Path, &pdamp_io::checkpoint::CheckpointHeader),
     wall_s: f64,
 ) -> Result<(), RunError> {
     let json = serde_json::to_string_pretty(summary)?;
-    crate::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes())
+    pdamp_io::atomic::write_atomic(out_dir.join("summary.json"), json.as_bytes())
         .map_err(RunError::output)?;
     let done = RunCheckpoint {
         phase: RunPhase::Finished,
         world: None,
         ..RunCheckpoint::settling(world, wall_s)
     };
-    crate::checkpoint::save(ck_path, header, &done)?;
+    pdamp_io::checkpoint::save(ck_path, header, &done)?;
     Ok(())
 }
 
@@ -631,9 +629,10 @@ fn open_fresh_outputs(
     let vtk_dir = out_dir.join("vtk");
     let vtk_every = scenario.output.vtk_interval_s;
     // The bed the main run starts from (measured once; a resumed run reads it back).
-    let stats = bed_statistics(world, crate::scenario::excitation_direction(scenario));
+    let stats = bed_statistics(world, crate::schema::excitation_direction(scenario));
     let json = serde_json::to_string_pretty(&stats)?;
-    crate::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes()).map_err(io)?;
+    pdamp_io::atomic::write_atomic(out_dir.join(BED_STATISTICS_FILE), json.as_bytes())
+        .map_err(io)?;
     let mut series = if vtk_every > 0.0 {
         std::fs::create_dir_all(&vtk_dir).map_err(io)?;
         Some(PvdSeries::new(pvd_path))
@@ -662,13 +661,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("pdamp-digest-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let mut sc = crate::examples::shaken_box(10, 0.01);
-        sc.bodies[0].walls[0].geometry =
-            crate::scenario::GeometrySpec::Stl(crate::scenario::StlSpec {
-                path: "box.stl".into(),
-                scale: 1.0,
-                translation_m: [0.0; 3],
-                flip_normals: false,
-            });
+        sc.bodies[0].walls[0].geometry = crate::schema::GeometrySpec::Stl(crate::schema::StlSpec {
+            path: "box.stl".into(),
+            scale: 1.0,
+            translation_m: [0.0; 3],
+            flip_normals: false,
+        });
         std::fs::write(dir.join("box.stl"), "solid a\nendsolid a\n").unwrap();
         let a = scenario_content_digest(&sc, &dir);
         assert_eq!(a, scenario_content_digest(&sc, &dir));

@@ -3,7 +3,7 @@
 //! shipped example never fails on a key or a placement a change made wrong; and every damper
 //! example starts from a drop-down bed unless its comment says why it keeps a crystal.
 
-use pdamp_io::scenario::{PlacementMethod, Scenario};
+use pdamp_scenario::schema::{PlacementMethod, Scenario};
 use std::path::PathBuf;
 
 fn examples() -> PathBuf {

@@ -32,7 +32,7 @@ pub enum BenchError {
     Input(#[from] crate::InputError),
     /// The settled bed cannot be stored.
     #[error(transparent)]
-    Checkpoint(#[from] crate::checkpoint::CheckpointError),
+    Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
     /// The stored settled bed does not fit the box.
     #[error(transparent)]
     State(#[from] pdamp_dem::state::StateError),
@@ -92,7 +92,7 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Bench
     let sc = shaken_box(n, 1.0);
     let mut world = sc.build_world(Path::new("."))?;
     let kind = format!("bench-settled-{n}-layers");
-    let digest = crate::checkpoint::digest(format!("{sc:?}").as_bytes());
+    let digest = pdamp_io::checkpoint::digest(format!("{sc:?}").as_bytes());
     // The settled bed is a cache: one written for another scenario or by another version of
     // the bench (e.g. another particle numbering) is settled again and overwritten.
     // A file that is not a settled bed of the bench is the user's: never overwritten.
@@ -106,18 +106,18 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Bench
             return Err(BenchError::NotSettledBed(path.to_path_buf()));
         }
     }
-    let cached = match cache.map(|path| crate::checkpoint::load::<WorldState>(path, &kind, &digest))
-    {
-        Some(Ok(state)) => state,
-        Some(Err(e)) => {
-            eprintln!(
-                "settled bed {}: {e}; settling again",
-                cache.unwrap().display()
-            );
-            None
-        }
-        None => None,
-    };
+    let cached =
+        match cache.map(|path| pdamp_io::checkpoint::load::<WorldState>(path, &kind, &digest)) {
+            Some(Ok(state)) => state,
+            Some(Err(e)) => {
+                eprintln!(
+                    "settled bed {}: {e}; settling again",
+                    cache.unwrap().display()
+                );
+                None
+            }
+            None => None,
+        };
     if let Some(state) = cached {
         world.restore_state(state)?;
         world.restart_clock();
@@ -126,8 +126,8 @@ pub fn settled_shaken_box(n: usize, cache: Option<&Path>) -> Result<World, Bench
     settle(&mut world, SETTLE_S, 0.0, |_| {});
     world.initialize();
     if let Some(path) = cache {
-        let header = crate::checkpoint::CheckpointHeader::new(&kind, &digest);
-        crate::checkpoint::save(path, &header, &world.save_state())?;
+        let header = pdamp_io::checkpoint::CheckpointHeader::new(&kind, &digest);
+        pdamp_io::checkpoint::save(path, &header, &world.save_state())?;
     }
     Ok(world)
 }

@@ -2,10 +2,10 @@
 //! that lists them.
 
 use crate::error::RunError;
-use crate::vtk::{
+use pdamp_dem::{Geometry, Vec3, World};
+use pdamp_io::vtk::{
     PointField, PvdSeries, VtkEncoding, write_mesh_vtp_with, write_particles_vtp_with,
 };
-use pdamp_dem::{Geometry, Vec3, World};
 use std::path::{Path, PathBuf};
 
 /// Writes the particles and all mesh-like walls of `world` as VTK files into `dir`
@@ -14,7 +14,7 @@ pub fn write_snapshot(
     world: &World,
     dir: &Path,
     index: usize,
-) -> Result<PathBuf, crate::vtk::VtkError> {
+) -> Result<PathBuf, pdamp_io::vtk::VtkError> {
     write_snapshot_with(world, dir, index, VtkEncoding::default())
 }
 
@@ -25,7 +25,7 @@ pub fn write_snapshot_with(
     dir: &Path,
     index: usize,
     encoding: VtkEncoding,
-) -> Result<PathBuf, crate::vtk::VtkError> {
+) -> Result<PathBuf, pdamp_io::vtk::VtkError> {
     let p = &world.particles;
     let name = format!("particles_{index:06}.vtp");
     let speed: Vec<f64> = p.velocity.iter().map(|v| v.norm()).collect();
@@ -133,7 +133,7 @@ impl SnapshotSeries {
         }
         let dir = self.out.join(&self.subdir);
         std::fs::create_dir_all(&dir).map_err(|e| {
-            RunError::output(crate::csv::CsvError::Io {
+            RunError::output(pdamp_io::csv::CsvError::Io {
                 path: dir.clone(),
                 source: e,
             })

@@ -571,11 +571,11 @@ pub enum VtkFormat {
     Ascii,
 }
 
-impl From<VtkFormat> for crate::vtk::VtkEncoding {
+impl From<VtkFormat> for pdamp_io::vtk::VtkEncoding {
     fn from(f: VtkFormat) -> Self {
         match f {
-            VtkFormat::Binary => crate::vtk::VtkEncoding::Binary,
-            VtkFormat::Ascii => crate::vtk::VtkEncoding::Ascii,
+            VtkFormat::Binary => pdamp_io::vtk::VtkEncoding::Binary,
+            VtkFormat::Ascii => pdamp_io::vtk::VtkEncoding::Ascii,
         }
     }
 }
@@ -795,7 +795,7 @@ impl Scenario {
     /// `restitution_table_csv` are read from CSV files relative to it
     /// ([`crate::restitution::inline_tables`]). No validation.
     pub fn from_toml_in(text: &str, base_dir: &Path) -> Result<Self, InputError> {
-        if !text.contains(crate::restitution::TABLE_KEY) {
+        if !text.contains(pdamp_io::restitution::TABLE_KEY) {
             return Ok(Self::from_toml(text)?);
         }
         let mut doc: toml::Table = toml::from_str(text)?;

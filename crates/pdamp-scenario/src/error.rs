@@ -2,7 +2,7 @@
 //! ([`pdamp_dem::ParameterError`]) or a file a key names that cannot be read or used. The
 //! cause of a wrapped error is part of the message (not `source()`), so that a chain printer
 //! (`anyhow`'s `{:#}`) shows it once. File-level
-//! errors (which scenario file, which line) are [`crate::scenario::ScenarioError`].
+//! errors (which scenario file, which line) are [`crate::schema::ScenarioError`].
 
 use pdamp_dem::ParameterError;
 use std::path::PathBuf;
@@ -121,7 +121,7 @@ pub enum RunError {
     Input(#[from] crate::InputError),
     /// A checkpoint cannot be written or read back.
     #[error(transparent)]
-    Checkpoint(#[from] crate::checkpoint::CheckpointError),
+    Checkpoint(#[from] pdamp_io::checkpoint::CheckpointError),
     /// The checkpoint does not fit the scenario's world.
     #[error(transparent)]
     State(#[from] pdamp_dem::state::StateError),
@@ -133,7 +133,7 @@ pub enum RunError {
     Output(crate::error::Source),
     /// A ParaView file or series cannot be written or continued.
     #[error(transparent)]
-    Vtk(#[from] crate::vtk::VtkError),
+    Vtk(#[from] pdamp_io::vtk::VtkError),
     /// The summary of a finished run cannot be read back.
     #[error("summary.json: {0}")]
     Summary(serde_json::Error),
@@ -141,9 +141,9 @@ pub enum RunError {
     #[error(transparent)]
     Json(#[from] serde_json::Error),
     /// Stopped on request; the checkpoint is on disk (the text starts with
-    /// [`crate::checkpoint::INTERRUPTED`]).
+    /// [`pdamp_io::checkpoint::INTERRUPTED`]).
     #[error(transparent)]
-    Interrupted(#[from] crate::checkpoint::Interrupted),
+    Interrupted(#[from] pdamp_io::checkpoint::Interrupted),
     /// A health check failed; `failure.json` names the particle.
     #[error(
         "{health} (during {phase}; outputs written so far are kept in {}, see failure.json)",

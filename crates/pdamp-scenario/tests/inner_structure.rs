@@ -2,7 +2,7 @@
 //! [D Sect. 8.1.4]: a sphere dropped on it comes to rest on its top face, one dropped beside it
 //! falls past it to the container floor.
 
-use pdamp_io::scenario::Scenario;
+use pdamp_scenario::schema::Scenario;
 
 const TOML: &str = r#"
 title = "plate inside a box"

@@ -1,7 +1,7 @@
 //! Built-in scenarios: the shaken-box benchmark (DEM-core issue) used by `pdamp bench`, by the
 //! default example and by tests.
 
-use crate::scenario::*;
+use crate::schema::*;
 use pdamp_dem::contact::{ContactModel, FrictionLaw, NormalLaw};
 use pdamp_dem::generate::{Region, SizeDistribution};
 use pdamp_dem::walls::BoxInside;

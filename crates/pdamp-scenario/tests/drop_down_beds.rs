@@ -4,8 +4,8 @@
 
 use pdamp_dem::bed_statistics::bed_statistics;
 use pdamp_dem::{Vec3, World};
-use pdamp_io::prepare::{PreparedBed, prepare_bed, settle_scenario};
-use pdamp_io::scenario::Scenario;
+use pdamp_scenario::prepare::{PreparedBed, prepare_bed, settle_scenario};
+use pdamp_scenario::schema::Scenario;
 use std::path::Path;
 use std::sync::OnceLock;
 

@@ -113,7 +113,7 @@ pub fn settle_after_turn(
 /// Settles `world` as `spec` says (with its own gravity if given) and restarts the clock.
 pub fn settle_with(
     world: &mut World,
-    spec: &crate::scenario::SettleSpec,
+    spec: &crate::schema::SettleSpec,
     mut tick: impl FnMut(f64),
 ) -> f64 {
     let g = world.gravity_m_s2;
@@ -129,7 +129,7 @@ pub fn settle_with(
 /// after settling (needed when resuming: the restored world carries the settling gravity).
 pub fn settle_with_or_break(
     world: &mut World,
-    spec: &crate::scenario::SettleSpec,
+    spec: &crate::schema::SettleSpec,
     main_gravity_m_s2: Vec3,
     hook: impl FnMut(&World) -> ControlFlow<()>,
 ) -> Option<f64> {
