@@ -248,6 +248,7 @@ pub(crate) fn cmd_fields(
         engine,
         |f| bar.set("settling", f),
         |done, total| bar.count("points", done, total),
+        crate::cancel(),
     );
     dir.set_outcome(&outcome);
     dir.close()?;
@@ -308,9 +309,13 @@ pub(crate) fn cmd_settle(
         .map(|p| p.to_path_buf())
         .unwrap_or_default();
     let bar = progress::Progress::new();
-    let s = pdamp_scenario::prepare::settle_scenario(&sc, &base, out, &mut |phase, f| {
-        bar.set(phase, f)
-    });
+    let s = pdamp_scenario::prepare::settle_scenario(
+        &sc,
+        &base,
+        out,
+        &mut |phase, f| bar.set(phase, f),
+        crate::cancel(),
+    );
     dir.set_outcome(&s);
     dir.close()?;
     let s = s.map_err(anyhow::Error::msg)?;

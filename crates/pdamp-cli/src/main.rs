@@ -10,6 +10,7 @@
 use anyhow::{Context, Result, bail};
 use cli::{Cli, Command, cli_command, negative_values};
 use dem_commands::{Device, cmd_fields, cmd_run, cmd_settle};
+use pdamp_dem::time_loop::CancelToken;
 
 mod bench;
 mod check;
@@ -52,9 +53,29 @@ impl Traced {
     }
 }
 
+/// The process's stop request: Ctrl-C / SIGTERM cancel it ([`on_signal`]); every long run of a
+/// command is handed it (`RunOptions::cancelled_by`, `Damper::cancelled_by`, …).
+pub(crate) fn cancel() -> &'static CancelToken {
+    static CANCEL: std::sync::OnceLock<CancelToken> = std::sync::OnceLock::new();
+    CANCEL.get_or_init(CancelToken::new)
+}
+
+/// Ctrl-C / SIGTERM: inside a run that stops cleanly (its loop has armed [`cancel`]) the first
+/// signal asks it to write a checkpoint and stop; otherwise, or on a second signal, the process
+/// ends at once with status 130.
+fn on_signal() {
+    let c = cancel();
+    if c.is_armed() && !c.is_cancelled() {
+        c.cancel();
+        eprintln!("\nstopping after the next checkpoint (press Ctrl-C again to abort at once)");
+    } else {
+        std::process::exit(130);
+    }
+}
+
 fn main() -> std::process::ExitCode {
     // Ctrl-C / SIGTERM: long runs write a checkpoint and stop (see `--resume`).
-    let _ = ctrlc::set_handler(pdamp_io::checkpoint::on_signal);
+    let _ = ctrlc::set_handler(on_signal);
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
@@ -134,10 +155,8 @@ fn dispatch(command: Command) -> Result<()> {
             cmd_run(
                 &scenario,
                 &out,
-                pdamp_scenario::run::RunOptions {
-                    checkpoint_interval_s,
-                    resume,
-                },
+                pdamp_scenario::run::RunOptions::new(checkpoint_interval_s, resume)
+                    .cancelled_by(cancel()),
                 overwrite,
                 point,
             )

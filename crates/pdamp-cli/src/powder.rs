@@ -153,10 +153,10 @@ impl CheckpointArgs {
                 self.checkpoint_interval_s
             ));
         }
-        Ok(cantilever::RunOptions {
-            checkpoint_interval_s: self.checkpoint_interval_s,
-            resume: self.resume,
-        })
+        Ok(
+            cantilever::RunOptions::new(self.checkpoint_interval_s, self.resume)
+                .cancelled_by(crate::cancel()),
+        )
     }
 }
 

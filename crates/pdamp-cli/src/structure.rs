@@ -412,10 +412,8 @@ pub fn run_couple(args: CoupleArgs) -> Result<()> {
             args.checkpoint_interval_s
         ));
     }
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s: args.checkpoint_interval_s,
-        resume: args.resume,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(args.checkpoint_interval_s, args.resume)
+        .cancelled_by(crate::cancel());
     let s = in_out_dir(
         &args.out,
         args.resume,

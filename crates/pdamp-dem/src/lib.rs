@@ -26,6 +26,7 @@ pub mod math;
 pub mod neighbor;
 pub mod particles;
 pub mod state;
+pub mod time_loop;
 pub mod wall_repeat;
 pub mod walls;
 pub mod world;

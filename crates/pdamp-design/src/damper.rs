@@ -6,12 +6,14 @@
 use crate::DesignError;
 use crate::convergence::{ConvergenceSpec, RunningEstimate, has_converged};
 use pdamp_dem::math::STANDARD_GRAVITY_M_S2;
+use pdamp_dem::time_loop::{CancelToken, LoopControl, LoopEnd, LoopEvent};
 use pdamp_dem::{HarmonicTranslation, Motion, Vec3, World};
 use pdamp_scenario::schema::Scenario;
 use pdamp_signal::Complex64;
 use pdamp_signal::complex_power::complex_power;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -41,6 +43,9 @@ pub struct Damper {
     /// Statistics of the bed as filled, before the container was turned (fills under
     /// `settle.gravity_m_s2`); its clearance is D's h.
     pub fill_statistics: Option<pdamp_dem::bed_statistics::BedStatistics>,
+    /// The stop request its points honour (a point then checkpoints, where it keeps
+    /// checkpoints, and ends with [`DesignError::PointInterrupted`]); clones share it.
+    pub cancel: CancelToken,
 }
 
 /// Result of one excitation point.
@@ -136,6 +141,23 @@ pub struct PointCheckpointing {
     pub resume: bool,
 }
 
+impl PointCheckpointing {
+    /// The checkpoint `dir/checkpoint.bin` of a point of the scenario with `scenario_digest`,
+    /// at the interval and `resume` of `options`.
+    pub fn in_dir(
+        dir: &Path,
+        scenario_digest: &str,
+        options: &pdamp_scenario::run::RunOptions,
+    ) -> Self {
+        Self {
+            path: dir.join(pdamp_io::checkpoint::CHECKPOINT_FILE),
+            scenario_digest: scenario_digest.to_string(),
+            interval_s: options.checkpoint_interval_s,
+            resume: options.resume,
+        }
+    }
+}
+
 /// Kind tag of damper-point checkpoints.
 pub const POINT_KIND: &str = "damper-point";
 
@@ -222,14 +244,34 @@ impl Damper {
     pub fn from_scenario(
         scenario: &Scenario,
         base_dir: &Path,
+        progress: impl FnMut(f64),
+    ) -> Result<Self, DesignError> {
+        Self::from_scenario_cancellable(scenario, base_dir, progress, &CancelToken::new())
+    }
+
+    /// [`Damper::from_scenario`] whose drop-down and points stop when `cancel` is cancelled.
+    pub fn from_scenario_cancellable(
+        scenario: &Scenario,
+        base_dir: &Path,
         mut progress: impl FnMut(f64),
+        cancel: &CancelToken,
     ) -> Result<Self, DesignError> {
         // The damper section is checked before the (costly) bed preparation.
         container_of(scenario)?;
-        let prepared =
-            pdamp_scenario::prepare::prepare_bed(scenario, base_dir, &mut |_, f| progress(f))
-                .map_err(DesignError::from)?;
-        Self::from_prepared(scenario, prepared)
+        let prepared = pdamp_scenario::prepare::prepare_bed(
+            scenario,
+            base_dir,
+            &mut |_, f| progress(f),
+            cancel,
+        )
+        .map_err(DesignError::from)?;
+        Ok(Self::from_prepared(scenario, prepared)?.cancelled_by(cancel))
+    }
+
+    /// The same damper, its points stopped by `cancel`.
+    pub fn cancelled_by(mut self, cancel: &CancelToken) -> Self {
+        self.cancel = cancel.clone();
+        self
     }
 
     /// The damper of `scenario` on a bed prepared already ([`pdamp_scenario::prepare::prepare_bed`],
@@ -254,6 +296,7 @@ impl Damper {
             settled: world,
             convergence: spec.convergence.clone(),
             fill_statistics: prepared.fill_statistics,
+            cancel: CancelToken::new(),
         })
     }
 
@@ -301,6 +344,7 @@ impl Damper {
             settling_time_s: 0.0,
             convergence: None,
             fill_statistics: None,
+            cancel: CancelToken::new(),
         }
     }
 
@@ -342,7 +386,7 @@ impl Damper {
         observer: &mut dyn PointObserver,
         checkpointing: Option<&PointCheckpointing>,
     ) -> Result<PointResult, DesignError> {
-        use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
+        use pdamp_io::checkpoint::{self as ck, CheckpointHeader};
         let start = std::time::Instant::now();
         let omega = 2.0 * PI * frequency_hz;
         let period = 1.0 / frequency_hz;
@@ -378,7 +422,8 @@ impl Damper {
         }
         let resumed_in = (first_cycle > 0 || w.time_s > 0.0).then_some(first_cycle);
         let header = checkpointing.map(|c| CheckpointHeader::new(POINT_KIND, &c.scenario_digest));
-        let mut timer = CheckpointTimer::new(checkpointing.map_or(0.0, |c| c.interval_s));
+        let mut control =
+            LoopControl::new(&self.cancel, checkpointing.map_or(0.0, |c| c.interval_s));
         let sample = |w: &World, times: &mut Vec<f64>, force: &mut Vec<f64>, vel: &mut Vec<f64>| {
             let t = w.time_s;
             let (s, c) = (omega * t).sin_cos();
@@ -389,7 +434,6 @@ impl Damper {
             force.push(m_con * a_c - f_p);
             vel.push(amplitude_m * omega * c);
         };
-        let mut save_error = None;
         for cycle in first_cycle..self.cycles {
             let t_end = (cycle + 1) as f64 * period;
             // (A point resumed inside this cycle has done its start already.)
@@ -403,7 +447,21 @@ impl Damper {
             // An observer that reads particles gets every step complete (then this is
             // `World::step`); otherwise the half kicks are deferred (same results).
             let deferred = !observer.reads_particles();
-            w.run_until_or_break_deferred(t_end, |w| {
+            let end = w.run_controlled(t_end, deferred, &mut control, |w, event| {
+                if event == LoopEvent::Checkpoint {
+                    if let (Some(c), Some(h)) = (checkpointing, &header) {
+                        let obs = observer.save_state()?;
+                        let p = rec.progress(
+                            (frequency_hz, amplitude_m),
+                            cycle,
+                            w.save_state(),
+                            obs,
+                            wall_before + start.elapsed().as_secs_f64(),
+                        );
+                        ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))?;
+                    }
+                    return Ok(ControlFlow::Continue(()));
+                }
                 if !deferred {
                     w.complete_step();
                 }
@@ -419,39 +477,13 @@ impl Damper {
                     w.complete_step();
                     if let Err(e) = w.check_health() {
                         health = Some(e);
-                        return std::ops::ControlFlow::Break(());
+                        return Ok(ControlFlow::Break(()));
                     }
                 }
-                let stop = pdamp_io::checkpoint::stop_requested();
-                if let (Some(c), Some(h)) = (checkpointing, &header)
-                    && (stop || timer.due())
-                {
-                    w.complete_step();
-                    let r = observer.save_state().and_then(|obs| {
-                        let p = rec.progress(
-                            (frequency_hz, amplitude_m),
-                            cycle,
-                            w.save_state(),
-                            obs,
-                            wall_before + start.elapsed().as_secs_f64(),
-                        );
-                        ck::save(&c.path, h, &PointCheckpoint::Running(Box::new(p)))
-                            .map_err(DesignError::from)
-                    });
-                    if let Err(e) = r {
-                        save_error = Some(e);
-                        return std::ops::ControlFlow::Break(());
-                    }
-                }
-                if stop {
-                    return std::ops::ControlFlow::Break(());
-                }
-                std::ops::ControlFlow::Continue(())
-            });
-            if let Some(e) = save_error.take() {
-                return Err(e);
-            }
-            check_cycle_end(health, &w, (frequency_hz, amplitude_m), cycle)?;
+                Ok::<_, DesignError>(ControlFlow::Continue(()))
+            })?;
+            let cancelled = end == LoopEnd::Cancelled;
+            check_cycle_end(health, cancelled, &w, (frequency_hz, amplitude_m), cycle)?;
             if let Some(c) = &self.convergence
                 && evaluating
             {
@@ -499,6 +531,7 @@ impl Damper {
 /// bed whose kinetic energy diverged ends the point with its error.
 fn check_cycle_end(
     health: Option<pdamp_dem::health::HealthError>,
+    cancelled: bool,
     w: &World,
     (frequency_hz, amplitude_m): (f64, f64),
     cycle: u32,
@@ -511,7 +544,7 @@ fn check_cycle_end(
             source,
         });
     }
-    if pdamp_io::checkpoint::stop_requested() {
+    if cancelled {
         return Err(DesignError::PointInterrupted {
             frequency_hz,
             amplitude_m,

@@ -396,7 +396,7 @@ pub fn run_fields_on(
     engine: PointEngine<'_>,
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, DesignError> {
-    let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
+    let _armed = damper.cancel.arm();
     std::fs::create_dir_all(out_dir.join("points"))
         .map_err(DesignError::write(out_dir.join("points")))?;
     let points = grid.points();
@@ -550,7 +550,7 @@ pub fn run_field_points(
     checkpoints: Option<&PointCheckpoints>,
     on_point: impl Fn(usize, &Result<PointResult, DesignError>) + Sync,
 ) -> Result<Vec<(usize, PointRun)>, DesignError> {
-    let _stoppable = pdamp_io::checkpoint::StoppableSection::enter();
+    let _armed = damper.cancel.arm();
     std::fs::create_dir_all(out_dir.join("points"))
         .map_err(DesignError::write(out_dir.join("points")))?;
     let points = grid.points();
@@ -573,7 +573,7 @@ pub fn run_field_points(
     let particles = damper.settled.particles.len();
     let ran = run_split(&pending, split, particles, |k| {
         let (i, j, f, x) = points[k];
-        if pdamp_io::checkpoint::stop_requested() {
+        if damper.cancel.is_cancelled() {
             // Stopped (SIGTERM of a cancelled task): the points not started stay missing.
             return Err(DesignError::Interrupted);
         }

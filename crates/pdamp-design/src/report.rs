@@ -7,6 +7,7 @@ use crate::ensemble::EnsembleStat;
 use crate::fields::{FieldGrid, FieldsOutcome};
 use crate::motion::MotionRecorder;
 use pdamp_dem::bed_statistics::BedStatistics;
+use pdamp_dem::time_loop::CancelToken;
 use pdamp_io::checkpoint as ck;
 use pdamp_scenario::schema::Scenario;
 use serde::Serialize;
@@ -232,10 +233,7 @@ pub fn run_damper_scenario(
     out: &Path,
     progress: impl FnMut(&str, f64),
 ) -> Result<DamperRunSummary, DesignError> {
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s: 0.0,
-        resume: false,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
     run_damper_scenario_with(sc, base_dir, out, options, progress)
 }
 
@@ -275,19 +273,19 @@ pub fn run_damper_scenario_with(
     mut progress: impl FnMut(&str, f64),
 ) -> Result<DamperRunSummary, DesignError> {
     let digest = pdamp_scenario::run::scenario_content_digest(sc, base_dir);
-    let ck_path = out.join(ck::CHECKPOINT_FILE);
-    let checkpointing = PointCheckpointing {
-        path: ck_path.clone(),
-        scenario_digest: digest.clone(),
-        interval_s: options.checkpoint_interval_s,
-        resume: options.resume,
-    };
-    let _stoppable = ck::StoppableSection::enter();
+    let checkpointing = PointCheckpointing::in_dir(out, &digest, &options);
+    let ck_path = checkpointing.path.clone();
+    let _armed = options.cancel.arm();
     let spec = sc.damper.as_ref().ok_or(DesignError::NoDamperSection)?;
     let f = spec.frequency_hz.ok_or(DesignError::NoFrequency)?;
     let x = spec.amplitude_at(f).ok_or(DesignError::NoAmplitude)?;
     pdamp_scenario::provenance::write(sc, out).map_err(DesignError::write(out))?;
-    let damper = Damper::from_scenario(sc, base_dir, |p| progress("settling", p))?;
+    let damper = Damper::from_scenario_cancellable(
+        sc,
+        base_dir,
+        |p| progress("settling", p),
+        &options.cancel,
+    )?;
     let omega = 2.0 * std::f64::consts::PI * f;
     let steps_per_cycle = (1.0 / (f * damper.time_step_s)).ceil();
     let mo = &spec.motion_output;
@@ -493,11 +491,20 @@ pub fn run_fields_scenario(
     on_point: impl Fn(usize, usize) + Sync,
 ) -> Result<FieldsOutcome, DesignError> {
     let engine = crate::fields::PointEngine::Cpu(crate::fields::ThreadSplit::default());
-    run_fields_scenario_on(sc, base_dir, out, engine, settle_progress, on_point)
+    let cancel = CancelToken::new();
+    run_fields_scenario_on(
+        sc,
+        base_dir,
+        out,
+        engine,
+        settle_progress,
+        on_point,
+        &cancel,
+    )
 }
 
 /// [`run_fields_scenario`] with the points on the CPU engine or the GPU backend (the beds are
-/// prepared on the CPU either way).
+/// prepared on the CPU either way); its points stop when `cancel` is cancelled.
 pub fn run_fields_scenario_on(
     sc: &Scenario,
     base_dir: &Path,
@@ -505,6 +512,7 @@ pub fn run_fields_scenario_on(
     engine: crate::fields::PointEngine<'_>,
     settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
+    cancel: &CancelToken,
 ) -> Result<FieldsOutcome, DesignError> {
     run_fields_scenario_from(
         sc,
@@ -514,6 +522,7 @@ pub fn run_fields_scenario_on(
         BedSource::Prepare,
         settle_progress,
         on_point,
+        cancel,
     )
 }
 
@@ -554,8 +563,13 @@ pub fn field_damper(
         return Damper::from_prepared(&sk, prepared);
     }
     let mut progress = progress;
-    let prepared = pdamp_scenario::prepare::prepare_bed(&sk, base_dir, &mut |_, f| progress(f))
-        .map_err(DesignError::from)?;
+    let prepared = pdamp_scenario::prepare::prepare_bed(
+        &sk,
+        base_dir,
+        &mut |_, f| progress(f),
+        &pdamp_dem::time_loop::CancelToken::new(),
+    )
+    .map_err(DesignError::from)?;
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(DesignError::write(parent))?;
     }
@@ -566,6 +580,7 @@ pub fn field_damper(
 
 /// [`run_fields_scenario_on`] with the beds from `beds` (a sweep's collect step reads the
 /// beds its tasks saved and, with [`crate::fields::PointEngine::Stored`], only its store).
+#[allow(clippy::too_many_arguments)]
 pub fn run_fields_scenario_from(
     sc: &Scenario,
     base_dir: &Path,
@@ -574,6 +589,7 @@ pub fn run_fields_scenario_from(
     beds: BedSource<'_>,
     mut settle_progress: impl FnMut(f64),
     on_point: impl Fn(usize, usize) + Sync,
+    cancel: &CancelToken,
 ) -> Result<FieldsOutcome, DesignError> {
     let spec = sc.fields.as_ref().ok_or(DesignError::NoFieldsSection)?;
     let grid = FieldGrid::from_spec(spec)?;
@@ -609,7 +625,8 @@ pub fn run_fields_scenario_from(
     }
     let packings = sc.damper.as_ref().map_or(1, |d| d.packings);
     if packings == 1 {
-        let damper = field_damper(sc, base_dir, 0, beds, &mut settle_progress)?;
+        let damper =
+            field_damper(sc, base_dir, 0, beds, &mut settle_progress)?.cancelled_by(cancel);
         let bed = damper.bed_statistics();
         write_bed_statistics(
             out,
@@ -627,7 +644,8 @@ pub fn run_fields_scenario_from(
     for k in 0..packings {
         let damper = field_damper(sc, base_dir, k, beds, |f| {
             settle_progress((k as f64 + f) / packings as f64)
-        })?;
+        })?
+        .cancelled_by(cancel);
         let dir = out.join("packings").join(format!("packing_{k:03}"));
         std::fs::create_dir_all(&dir).map_err(DesignError::write(&dir))?;
         let bed = damper.bed_statistics();

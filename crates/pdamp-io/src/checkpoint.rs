@@ -5,68 +5,19 @@
 //! ([`pdamp_dem::WorldState`]), `energy.csv` is cut back to the rows of the checkpoint, and VTK
 //! frames after it are written again.
 //!
-//! Stopping on request: [`request_stop`] (called by the CLI's SIGINT/SIGTERM handler) makes the
-//! running loop write a checkpoint and return [`Interrupted`].
+//! Stopping on request: a loop whose `pdamp_dem::time_loop::CancelToken` is cancelled (by the
+//! CLI's SIGINT/SIGTERM handler, a Python session) writes a checkpoint and returns
+//! [`Interrupted`]. The wall-clock cadence is [`CheckpointTimer`] (of the engine's time loop).
 
+pub use pdamp_dem::time_loop::CheckpointTimer;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// File name of the checkpoint inside the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 
 /// Format version of the checkpoint file; bumped when the layout changes.
 pub const CHECKPOINT_FORMAT: u32 = 3;
-
-static STOP: AtomicBool = AtomicBool::new(false);
-static STOPPABLE: AtomicBool = AtomicBool::new(false);
-
-/// Asks running loops to write a checkpoint and stop (async-signal-safe: one atomic store).
-pub fn request_stop() {
-    STOP.store(true, Ordering::SeqCst);
-}
-
-/// What the CLI's SIGINT/SIGTERM handler does: inside a loop that can stop cleanly (see
-/// [`StoppableSection`]) the first signal asks it to checkpoint and stop; otherwise, or on a
-/// second signal, the process exits at once with status 130.
-pub fn on_signal() {
-    if STOPPABLE.load(Ordering::SeqCst) && !STOP.load(Ordering::SeqCst) {
-        request_stop();
-        eprintln!("\nstopping after the next checkpoint (press Ctrl-C again to abort at once)");
-    } else {
-        std::process::exit(130);
-    }
-}
-
-/// Marks a region of code that polls [`stop_requested`] and stops cleanly; while one is alive
-/// a signal asks for a stop instead of ending the process.
-#[derive(Debug)]
-pub struct StoppableSection(());
-
-impl StoppableSection {
-    /// Enters the section.
-    pub fn enter() -> Self {
-        STOPPABLE.store(true, Ordering::SeqCst);
-        Self(())
-    }
-}
-
-impl Drop for StoppableSection {
-    fn drop(&mut self) {
-        STOPPABLE.store(false, Ordering::SeqCst);
-    }
-}
-
-/// Withdraws a stop request once the stopped run has returned, so that the next run in the same
-/// process (a Python session after Ctrl-C) is not stopped at once.
-pub fn clear_stop() {
-    STOP.store(false, Ordering::SeqCst);
-}
-
-/// True once [`request_stop`] was called.
-pub fn stop_requested() -> bool {
-    STOP.load(Ordering::Relaxed)
-}
 
 /// Error text prefix of a run stopped on request after its checkpoint was written.
 pub const INTERRUPTED: &str = "interrupted";
@@ -333,45 +284,6 @@ pub fn decode_part<T: for<'de> Deserialize<'de>>(bytes: &[u8]) -> Result<T, Chec
         .with_limit(bytes.len() as u64)
         .deserialize(bytes)
         .map_err(|e| CheckpointError::UnreadablePart(e.to_string()))
-}
-
-/// Decides when to write the next checkpoint: every `interval` of wall-clock time (checked
-/// every 64 calls, so the clock is not read every step).
-#[derive(Debug)]
-pub struct CheckpointTimer {
-    interval: std::time::Duration,
-    last: std::time::Instant,
-    calls: u32,
-}
-
-impl CheckpointTimer {
-    /// A timer firing every `interval_s` seconds of wall-clock time (≤ 0: never).
-    pub fn new(interval_s: f64) -> Self {
-        Self {
-            // (An interval beyond what a Duration holds, infinity included, means never.)
-            interval: if interval_s > 0.0 && interval_s < 1e15 {
-                std::time::Duration::from_secs_f64(interval_s)
-            } else {
-                std::time::Duration::MAX
-            },
-            last: std::time::Instant::now(),
-            calls: 0,
-        }
-    }
-
-    /// True if a checkpoint is due now (then the timer restarts).
-    pub fn due(&mut self) -> bool {
-        self.calls = self.calls.wrapping_add(1);
-        if !self.calls.is_multiple_of(64) || self.interval == std::time::Duration::MAX {
-            return false;
-        }
-        if self.last.elapsed() >= self.interval {
-            self.last = std::time::Instant::now();
-            true
-        } else {
-            false
-        }
-    }
 }
 
 #[cfg(test)]

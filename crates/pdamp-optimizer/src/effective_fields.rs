@@ -390,6 +390,7 @@ pub fn evaluate_design(
                     pdamp_design::report::BedSource::Saved(&dir),
                     |_| {},
                     |_, _| {},
+                    &pdamp_dem::time_loop::CancelToken::new(),
                 )
                 .map_err(|e| format!("{}: {e}", dir.display()))
             });

@@ -602,10 +602,7 @@ fn effective_fields_rank_the_best_design_with_every_coating() {
     pdamp_structure::report::run_couple(
         &scn,
         &run,
-        pdamp_scenario::run::RunOptions {
-            checkpoint_interval_s: 0.0,
-            resume: false,
-        },
+        pdamp_scenario::run::RunOptions::new(0.0, false),
         &mut |_| {},
     )
     .unwrap();

@@ -604,11 +604,12 @@ impl StudyRun {
     }
 
     /// Runs it in its folder unless finished, continuing an interrupted run from its checkpoint
-    /// (written every `checkpoint_interval_s` and on SIGTERM, so a preempted or cancelled task
-    /// loses at most that much).
+    /// (written every `checkpoint_interval_s` and when `cancel` is cancelled — the CLI's
+    /// SIGTERM —, so a preempted or cancelled task loses at most that much).
     pub fn run(
         &self,
         checkpoint_interval_s: f64,
+        cancel: &pdamp_dem::time_loop::CancelToken,
         progress: &mut dyn FnMut(&str, f64),
     ) -> Result<bool, StudyError> {
         if self.finished()? {
@@ -621,10 +622,7 @@ impl StudyRun {
         cantilever::run_in_dir(
             &self.scenario,
             &self.dir,
-            cantilever::RunOptions {
-                checkpoint_interval_s,
-                resume,
-            },
+            cantilever::RunOptions::new(checkpoint_interval_s, resume).cancelled_by(cancel),
             progress,
         )?;
         Ok(true)
@@ -717,7 +715,7 @@ fn run_planned(
                 let label = format!("run {}/{n} ({}): {stage}", q + 1, run.label);
                 progress(&label, f)
             };
-            let r = cantilever::run_in_dir(sc, &run.dir, options, &mut prog)?;
+            let r = cantilever::run_in_dir(sc, &run.dir, options.clone(), &mut prog)?;
             let row = StudyRow::of(run.value, run.packing, &r);
             (r.time_s, r.tip_m, row)
         };

@@ -24,15 +24,17 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-const OPTIONS: RunOptions = RunOptions {
-    checkpoint_interval_s: 0.0,
-    resume: false,
-};
-
 #[test]
 fn ensemble_of_three_packings() {
     let out = tmp("run");
-    let e = study::run_ensemble(&tiny(), 3, &out, OPTIONS, &mut |_, _| {}).unwrap();
+    let e = study::run_ensemble(
+        &tiny(),
+        3,
+        &out,
+        RunOptions::new(0.0, false),
+        &mut |_, _| {},
+    )
+    .unwrap();
     assert_eq!(e.packings, 3);
     assert_eq!(e.seeds, vec![1, 1_000_004, 2_000_007]);
     for k in 0..3 {
@@ -68,29 +70,53 @@ fn ensemble_of_three_packings() {
     assert!(out.join("ensemble.json").exists());
     // Packing 0 is the scenario's own run: the same as a single run of it.
     let single = tmp("single");
-    let r =
-        pdamp_powder::cantilever::run_in_dir(&tiny(), &single, OPTIONS, &mut |_, _| {}).unwrap();
+    let r = pdamp_powder::cantilever::run_in_dir(
+        &tiny(),
+        &single,
+        RunOptions::new(0.0, false),
+        &mut |_, _| {},
+    )
+    .unwrap();
     assert_eq!(r.prep.as_ref().unwrap().settled_packing_density, settled[0]);
     // Run again: the finished packings are reused, with the same result.
-    let again = study::run_ensemble(&tiny(), 3, &out, OPTIONS, &mut |_, _| {}).unwrap();
+    let again = study::run_ensemble(
+        &tiny(),
+        3,
+        &out,
+        RunOptions::new(0.0, false),
+        &mut |_, _| {},
+    )
+    .unwrap();
     assert_eq!(
         serde_json::to_string(&again.settled_packing_density).unwrap(),
         serde_json::to_string(&e.settled_packing_density).unwrap()
     );
     // Too few packings and an empty beam are refused.
     assert!(
-        study::run_ensemble(&tiny(), 1, &tmp("one"), OPTIONS, &mut |_, _| {})
-            .unwrap_err()
-            .to_string()
-            .contains("at least 2")
+        study::run_ensemble(
+            &tiny(),
+            1,
+            &tmp("one"),
+            RunOptions::new(0.0, false),
+            &mut |_, _| {}
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("at least 2")
     );
     let mut empty = tiny();
     empty.powder = None;
     assert!(
-        study::run_ensemble(&empty, 2, &tmp("empty"), OPTIONS, &mut |_, _| {})
-            .unwrap_err()
-            .to_string()
-            .contains("[powder] section")
+        study::run_ensemble(
+            &empty,
+            2,
+            &tmp("empty"),
+            RunOptions::new(0.0, false),
+            &mut |_, _| {}
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("[powder] section")
     );
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&single);
@@ -105,7 +131,7 @@ fn study_with_packings_writes_the_ensemble_per_value() {
         &[0.2, 0.4],
         2,
         &out,
-        OPTIONS,
+        RunOptions::new(0.0, false),
         &mut |_, _| {},
     )
     .unwrap();

@@ -69,12 +69,9 @@ fn write_checkpoint_seeds() {
     std::fs::create_dir_all(&seeds).unwrap();
     let ck = dir.join("checkpoint.bin");
     // the coupled run right after the preparation (its first checkpoint), then finished
-    let opts = RunOptions {
-        checkpoint_interval_s: 1e6,
-        resume: false,
-    };
+    let opts = RunOptions::new(1e6, false);
     let mut copied = false;
-    cantilever::run_in_dir(&sc, &dir, opts, &mut |stage, _| {
+    cantilever::run_in_dir(&sc, &dir, opts.clone(), &mut |stage, _| {
         if stage == "coupled run" && !copied {
             std::fs::copy(&ck, seeds.join("running.bin")).unwrap();
             copied = true;
@@ -82,10 +79,11 @@ fn write_checkpoint_seeds() {
     })
     .unwrap();
     std::fs::copy(&ck, seeds.join("finished.bin")).unwrap();
-    // a preparation stopped at once (the stop request cannot be withdrawn: last)
+    // a preparation stopped at once
     let _ = std::fs::remove_dir_all(&dir);
-    pdamp_io::checkpoint::request_stop();
-    let e = cantilever::run_in_dir(&sc, &dir, opts, &mut |_, _| {})
+    let cancel = pdamp_dem::time_loop::CancelToken::new();
+    cancel.cancel();
+    let e = cantilever::run_in_dir(&sc, &dir, opts.cancelled_by(&cancel), &mut |_, _| {})
         .unwrap_err()
         .to_string();
     assert!(e.starts_with(pdamp_io::checkpoint::INTERRUPTED), "{e}");

@@ -48,10 +48,7 @@ fn study(sc: &CantileverScenario, out: &std::path::Path) -> Result<Vec<f64>, Stu
         pdamp_powder::study::StudyParameter::PackingDensity,
         &[0.45],
         out,
-        RunOptions {
-            checkpoint_interval_s: 0.0,
-            resume: false,
-        },
+        RunOptions::new(0.0, false),
         &mut |_, _| {},
     )
     .map(|rows| rows.iter().map(|r| r.energy_closure).collect())
@@ -146,10 +143,7 @@ fn study_values_are_validated_before_any_run() {
             p,
             &[0.45, v],
             &out,
-            RunOptions {
-                checkpoint_interval_s: 0.0,
-                resume: false,
-            },
+            RunOptions::new(0.0, false),
             &mut |_, _| {},
         )
         .unwrap_err()
@@ -168,10 +162,7 @@ fn infinite_checkpoint_interval_is_refused_before_writing() {
     let e = cantilever::run_in_dir(
         &tiny(),
         &out,
-        RunOptions {
-            checkpoint_interval_s: f64::INFINITY,
-            resume: false,
-        },
+        RunOptions::new(f64::INFINITY, false),
         &mut |_, _| {},
     )
     .unwrap_err()

@@ -12,9 +12,13 @@ const POLL: Duration = Duration::from_millis(50);
 
 /// Progress of a run as the library reports it (`phase`, fraction done in [0, 1]); the workers
 /// write it, the calling thread hands the latest value to the Python callback.
+/// Its `cancel` token is the run's stop request (fresh for every call, so a stopped run leaves
+/// nothing behind for the next).
 #[derive(Default)]
 pub(crate) struct Progress {
     latest: Mutex<Option<(String, f64)>>,
+    /// Cancelled on Ctrl-C or an exception of the callback; the work hands it to the library.
+    pub(crate) cancel: pdamp_dem::time_loop::CancelToken,
 }
 
 impl Progress {
@@ -67,9 +71,9 @@ pub(crate) fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
 /// Runs `f` on `pool` with the GIL released; an error of the library becomes a
 /// `RuntimeError`. The calling thread wakes every 50 ms (or when `f` ends): it hands the
 /// latest progress to `callback(phase, fraction)` and checks Python's signals. Ctrl-C
-/// (KeyboardInterrupt), or an exception raised by the callback, asks the run to stop at its next
-/// check ([`pdamp_io::checkpoint::request_stop`]), waits for it and raises the exception; the
-/// stop request is withdrawn afterwards, so the next run starts normally.
+/// (KeyboardInterrupt), or an exception raised by the callback, cancels the run's token
+/// ([`Progress::cancel`], which the work hands to the library), waits for the run to stop at its
+/// next check and raises the exception; the next call gets a fresh token.
 pub(crate) fn detached<T: Send>(
     py: Python<'_>,
     pool: &rayon::ThreadPool,
@@ -95,7 +99,7 @@ pub(crate) fn detached<T: Send>(
                     _ => Ok(()),
                 };
                 if let Err(e) = delivered.and_then(|()| py.check_signals()) {
-                    pdamp_io::checkpoint::request_stop();
+                    progress.cancel.cancel();
                     raised = Some(e);
                 }
             }
@@ -106,7 +110,6 @@ pub(crate) fn detached<T: Send>(
         run.join()
     });
     if let Some(e) = raised {
-        pdamp_io::checkpoint::clear_stop();
         return Err(e);
     }
     if let Some(cb) = callback {
@@ -252,14 +255,15 @@ impl WorldPool {
         } else if short && callback.is_none() {
             let pool = self.own()?;
             detached_short(py, pool, || {
-                work(&mut |_, _| pdamp_io::checkpoint::stop_requested())
+                // (Nothing watches a short run: Ctrl-C is seen right after it.)
+                work(&mut |_, _| false)
             })
         } else {
             let pool = self.own()?;
             detached(py, pool, callback, |p: &Progress| {
                 work(&mut |phase, f| {
                     p.set(phase, f);
-                    pdamp_io::checkpoint::stop_requested()
+                    p.cancel.is_cancelled()
                 })
             })
         }?;

@@ -47,12 +47,11 @@ pub(crate) fn run(
     let (sc, base) = (&scenario.inner, &scenario.base_dir);
     let pool = crate::detach::pool(threads)?;
     detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        let options = pdamp_scenario::run::RunOptions {
-            checkpoint_interval_s: 0.0,
-            resume: false,
-        };
+        let options = pdamp_scenario::run::RunOptions::new(0.0, false).cancelled_by(&p.cancel);
         if sc.damper.is_some() {
-            pdamp_design::report::run_damper_scenario(sc, base, &out, |phase, f| p.set(phase, f))?;
+            pdamp_design::report::run_damper_scenario_with(sc, base, &out, options, |phase, f| {
+                p.set(phase, f)
+            })?;
         } else {
             pdamp_scenario::run::run_scenario(sc, base, &out, options, |phase, f| p.set(phase, f))?;
         }
@@ -76,12 +75,14 @@ pub(crate) fn fields<'py>(
     let (sc, base) = (&scenario.inner, &scenario.base_dir);
     let pool = crate::detach::pool(threads)?;
     let (header, rows) = detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        pdamp_design::report::run_fields_scenario(
+        pdamp_design::report::run_fields_scenario_on(
             sc,
             base,
             &out,
+            pdamp_design::PointEngine::Cpu(pdamp_design::ThreadSplit::default()),
             |f| p.set("settling", f),
             |done, total| p.set("points", done as f64 / total.max(1) as f64),
+            &p.cancel,
         )?;
         Ok(pdamp_io::csv::read_csv_f64(out.join("fields.csv"))?)
     })?;
@@ -112,15 +113,15 @@ pub(crate) fn couple(
         )));
     }
     std::fs::create_dir_all(&out).map_err(io_err)?;
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s,
-        resume,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(checkpoint_interval_s, resume);
     let pool = crate::detach::pool(threads)?;
     let v = detached(py, &pool, progress.as_ref(), |p: &Progress| {
-        let v = pdamp_structure::report::run_couple(&path, &out, options, &mut |f| {
-            p.set("running", f)
-        })?;
+        let v = pdamp_structure::report::run_couple(
+            &path,
+            &out,
+            options.cancelled_by(&p.cancel),
+            &mut |f| p.set("running", f),
+        )?;
         p.set("running", 1.0);
         Ok(v)
     })?;
@@ -170,18 +171,24 @@ pub(crate) fn powder_run(
         ));
     }
     std::fs::create_dir_all(&out).map_err(io_err)?;
-    let options = RunOptions {
-        checkpoint_interval_s,
-        resume,
-    };
+    let options = RunOptions::new(checkpoint_interval_s, resume);
     let pool = crate::detach::pool(threads)?;
     detached(py, &pool, progress.as_ref(), |p: &Progress| {
         let mut tick = |phase: &str, f: f64| p.set(phase, f);
         let json = if packings == 1 {
-            serde_json::to_string(&run_in_dir(&sc, &out, options, &mut tick)?)
+            serde_json::to_string(&run_in_dir(
+                &sc,
+                &out,
+                options.cancelled_by(&p.cancel),
+                &mut tick,
+            )?)
         } else {
             serde_json::to_string(&pdamp_powder::study::run_ensemble(
-                &sc, packings, &out, options, &mut tick,
+                &sc,
+                packings,
+                &out,
+                options.cancelled_by(&p.cancel),
+                &mut tick,
             )?)
         };
         Ok(json?)

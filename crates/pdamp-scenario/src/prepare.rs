@@ -10,6 +10,7 @@ pub use crate::schema::excitation_direction;
 use crate::schema::{Preparation, Scenario};
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
 use pdamp_dem::drop_down::DropDownReport;
+use pdamp_dem::time_loop::CancelToken;
 use pdamp_dem::{Bed, Vec3, World};
 use pdamp_io::bed::{BedFile, save_bed};
 use pdamp_io::checkpoint::CheckpointError;
@@ -81,14 +82,16 @@ pub fn scenario_for_packing(scenario: &Scenario, k: usize) -> Scenario {
 }
 
 /// Builds and settles the bed of `scenario` (paths relative to `base_dir`);
-/// `progress(phase, fraction)` follows the drop-down and the settling.
+/// `progress(phase, fraction)` follows the drop-down and the settling; a drop-down stops when
+/// `cancel` is cancelled.
 pub fn prepare_bed(
     scenario: &Scenario,
     base_dir: &Path,
     progress: &mut dyn FnMut(&str, f64),
+    cancel: &CancelToken,
 ) -> Result<PreparedBed, PrepareError> {
     let (mut world, drop_down) =
-        scenario.build_world_reporting(base_dir, Preparation::Full, progress)?;
+        scenario.build_world_reporting(base_dir, Preparation::Full, progress, cancel)?;
     // A damper's bed is made in the container at rest (its excitation belongs to the points).
     if let Some(d) = &scenario.damper
         && let Some(b) = world.bodies.iter_mut().find(|b| b.name == d.container_body)
@@ -241,10 +244,11 @@ pub fn settle_scenario(
     base_dir: &Path,
     out: &Path,
     progress: &mut dyn FnMut(&str, f64),
+    cancel: &CancelToken,
 ) -> Result<SettleSummary, PrepareError> {
     let start = std::time::Instant::now();
     let io = |e: std::io::Error| PrepareError::Output(e.into());
-    let prepared = prepare_bed(scenario, base_dir, progress)?;
+    let prepared = prepare_bed(scenario, base_dir, progress, cancel)?;
     let world = &prepared.world;
     crate::provenance::write(scenario, out).map_err(io)?;
     let stats = bed_statistics(world, excitation_direction(scenario));

@@ -93,7 +93,7 @@ fn prepared_cube() -> &'static PreparedBed {
     BED.get_or_init(|| {
         let sc = Scenario::from_toml(&cube(CUBE_DROP, true)).expect("parse");
         sc.validate().expect("valid");
-        prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("drop-down")
+        prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()).expect("drop-down")
     })
 }
 
@@ -167,7 +167,8 @@ fn drop_down_around_inner_rod() {
     }
     // The drop-down.
     let sc = Scenario::from_toml(&cylinder_with_rod("drop_down")).expect("parse");
-    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("drop-down");
+    let bed =
+        prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()).expect("drop-down");
     let s = bed_statistics(&bed.world, None);
     eprintln!("cylinder with rod: {s:#?}");
     let (pp, pw) = max_overlaps(&bed.world);
@@ -237,7 +238,14 @@ placement = {{ method = "random", region = {{ type = "box", min_m = [-0.02, -0.0
 fn saved_bed_continues_bit_for_bit() {
     let dir = tempdir("saved_bed");
     let sc = Scenario::from_toml(&cube(CUBE_DROP, true)).expect("parse");
-    settle_scenario(&sc, Path::new("."), &dir, &mut |_, _| {}).expect("settle");
+    settle_scenario(
+        &sc,
+        Path::new("."),
+        &dir,
+        &mut |_, _| {},
+        &Default::default(),
+    )
+    .expect("settle");
     let reference = prepared_cube();
     let file = format!(
         r#"{{ method = "file", path = "{}" }}"#,
@@ -273,7 +281,14 @@ fn saved_bed_continues_bit_for_bit() {
 fn lammps_and_csv_beds_import_and_run() {
     let dir = tempdir("lammps_bed");
     let sc = Scenario::from_toml(&cube(CUBE_DROP, true)).expect("parse");
-    settle_scenario(&sc, Path::new("."), &dir, &mut |_, _| {}).expect("settle");
+    settle_scenario(
+        &sc,
+        Path::new("."),
+        &dir,
+        &mut |_, _| {},
+        &Default::default(),
+    )
+    .expect("settle");
     let text = std::fs::read_to_string(dir.join("bed.data")).unwrap();
     let names = vec!["steel".to_string()];
     let bed = pdamp_io::bed_formats::read_lammps_data(&text, &names).expect("read");
@@ -314,7 +329,14 @@ fn lammps_and_csv_beds_import_and_run() {
 fn mismatched_bed_is_refused() {
     let dir = tempdir("bad_bed");
     let sc = Scenario::from_toml(&cube(CUBE_DROP, true)).expect("parse");
-    settle_scenario(&sc, Path::new("."), &dir, &mut |_, _| {}).expect("settle");
+    settle_scenario(
+        &sc,
+        Path::new("."),
+        &dir,
+        &mut |_, _| {},
+        &Default::default(),
+    )
+    .expect("settle");
     let file = format!(
         r#"{{ method = "file", path = "{}" }}"#,
         dir.join("bed.pdbed").display()
@@ -390,7 +412,8 @@ fn two_drop_down_groups_stack() {
     let two = two.replace("count = 1000", "count = 300");
     let sc = Scenario::from_toml(&two).expect("parse");
     sc.validate().expect("valid");
-    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("two groups drop");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default())
+        .expect("two groups drop");
     assert_eq!(bed.world.particles.len(), 700);
     assert_eq!(bed.drop_down.len(), 2);
     let (pp, pw) = max_overlaps(&bed.world);
@@ -431,7 +454,7 @@ fn cube58(placement: &str) -> String {
 fn open_lid_fills_a_cube_with_less_than_a_diameter_of_clearance() {
     let closed = Scenario::from_toml(&cube58(CUBE_DROP)).expect("parse");
     closed.validate().expect("valid");
-    let Err(err) = prepare_bed(&closed, Path::new("."), &mut |_, _| {}) else {
+    let Err(err) = prepare_bed(&closed, Path::new("."), &mut |_, _| {}, &Default::default()) else {
         panic!("the closed cube cannot be filled")
     };
     let err = err.to_string();
@@ -443,7 +466,8 @@ fn open_lid_fills_a_cube_with_less_than_a_diameter_of_clearance() {
     );
     let sc = Scenario::from_toml(&cube58(&open)).expect("parse");
     sc.validate().expect("valid");
-    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("open-lid fill");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default())
+        .expect("open-lid fill");
     let report = &bed.drop_down[0];
     eprintln!("open lid: {report:?}");
     let p = &bed.world.particles;
@@ -489,7 +513,8 @@ fn open_lid_cylinder_and_errors() {
     assert!(text.contains("open_lid"), "{text}");
     let sc = Scenario::from_toml(&text).expect("parse");
     sc.validate().expect("valid");
-    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("open-lid fill");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default())
+        .expect("open-lid fill");
     let report = &bed.drop_down[0];
     assert!(report.bed_top_above_lid_m.unwrap() < 0.0, "{report:?}");
     assert_eq!(bed.world.particles.len(), 300);
@@ -503,7 +528,7 @@ fn open_lid_cylinder_and_errors() {
         "base_center_m = [0.0, 0.0, 0.045], axis = [0.0, 0.0, -1.0], radius_m = 0.02, length_m = 0.045 }, open_lid",
     );
     let sc = Scenario::from_toml(&low).expect("parse");
-    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
+    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()) else {
         panic!("no lid wall")
     };
     let err = err.to_string();
@@ -515,7 +540,7 @@ fn open_lid_cylinder_and_errors() {
         ", open_lid = { headroom_m = 0.03, max_close_duration_s = 0.02 }",
     );
     let sc = Scenario::from_toml(&full).expect("parse");
-    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
+    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()) else {
         panic!("the lid cannot close")
     };
     let err = err.to_string();
@@ -549,7 +574,7 @@ fn pouring_from_an_inlet() {
     );
     let sc = Scenario::from_toml(&cube(&inlet, true)).expect("parse");
     sc.validate().expect("valid");
-    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}).expect("pour");
+    let bed = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()).expect("pour");
     let report = &bed.drop_down[0];
     eprintln!("inlet: {report:?}");
     assert_eq!(bed.world.particles.len(), 1000);
@@ -572,7 +597,7 @@ fn pouring_from_an_inlet() {
         "0.0], max_m = [0.008, 0.008, 0.006]",
     );
     let sc = Scenario::from_toml(&cube(&low, true)).expect("parse");
-    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}) else {
+    let Err(err) = prepare_bed(&sc, Path::new("."), &mut |_, _| {}, &Default::default()) else {
         panic!("the pile blocks an inlet at the floor")
     };
     let err = err.to_string();

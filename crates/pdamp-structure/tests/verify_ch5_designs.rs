@@ -14,10 +14,7 @@ use std::path::Path;
 fn decay(example: &str) -> Vec<(f64, f64, f64)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let out = std::env::temp_dir().join(format!("pdamp-{example}-{}", std::process::id()));
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s: 0.0,
-        resume: false,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
     pdamp_structure::report::run_couple(&root.join(example), &out, options, &mut |_| {}).unwrap();
     let (header, rows) = pdamp_io::csv::read_csv_f64(out.join("damping.csv")).unwrap();
     let col = |n: &str| header.iter().position(|h| h == n).unwrap();

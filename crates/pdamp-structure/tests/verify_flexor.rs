@@ -8,10 +8,7 @@ use std::path::Path;
 fn flexor_initial_amplitude_follows_eq_5_19_and_frequency_eq_3_33() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let out = std::env::temp_dir().join(format!("pdamp-flexor-{}", std::process::id()));
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s: 0.0,
-        resume: false,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
     let s = pdamp_structure::report::run_couple(
         &root.join("couple_ch5_flexor_formulas.toml"),
         &out,

@@ -203,7 +203,8 @@ pub(super) fn execute_field_tasks(
             );
             let _ = std::fs::remove_file(&bed_file);
         }
-        let damper = field_damper(sc, &m.base_dir, k, BedSource::Saved(dir), |_| {});
+        let damper = field_damper(sc, &m.base_dir, k, BedSource::Saved(dir), |_| {})
+            .map(|d| d.cancelled_by(crate::cancel()));
         let points: Vec<usize> = indices
             .iter()
             .filter_map(|&i| match tasks[i] {

@@ -521,7 +521,7 @@ fn execute_tasks(dir: &Path, indices: &[usize]) -> Result<TasksRun> {
             // folder, so a requeued or resubmitted task continues where it was stopped.
             for &i in indices {
                 let task = &m.tasks[i];
-                match runs[i].run(60.0, &mut |_, _| {}) {
+                match runs[i].run(60.0, crate::cancel(), &mut |_, _| {}) {
                     Ok(ran) => {
                         run.ran += usize::from(ran);
                         let _ = std::fs::remove_file(dir.join(&task.error));
@@ -621,6 +621,7 @@ pub(crate) fn collect(dir: &Path) -> Result<()> {
         BedSource::Saved(dir),
         |_| {},
         |_, _| {},
+        crate::cancel(),
     );
     out_dir.set_outcome(&outcome);
     out_dir.close()?;

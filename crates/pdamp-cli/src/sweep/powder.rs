@@ -122,10 +122,7 @@ pub(super) fn collect_powder(
         &[],
     )?;
     // Every run is finished (checked above): nothing runs, everything is read back.
-    let options = pdamp_powder::cantilever::RunOptions {
-        checkpoint_interval_s: 0.0,
-        resume: false,
-    };
+    let options = pdamp_powder::cantilever::RunOptions::new(0.0, false);
     let result: Result<serde_json::Value> = match what {
         PowderSweep::Study {
             parameter,

@@ -568,20 +568,7 @@ impl World {
         let tol = 1e-12 * t_end_s.abs().max(1e-300);
         let mut reached = true;
         while self.time_s < t_end_s - tol {
-            let dt_nominal = self.dt_s;
-            let remaining = t_end_s - self.time_s;
-            let short = remaining < dt_nominal;
-            if short {
-                self.dt_s = remaining;
-            }
-            if deferred {
-                self.step_deferred();
-            } else {
-                self.step();
-            }
-            if short && matches!(self.integrator, Integrator::VelocityVerlet) {
-                self.dt_s = dt_nominal;
-            }
+            self.step_towards(t_end_s, deferred);
             if observer(self).is_break() {
                 reached = self.time_s >= t_end_s - tol;
                 break;
@@ -589,6 +576,66 @@ impl World {
         }
         self.complete_step();
         reached
+    }
+
+    /// One step towards `t_end_s`, shortened to land on it (velocity Verlet keeps its nominal
+    /// step afterwards); deferred half kick under [`World::step_deferred`].
+    #[inline]
+    fn step_towards(&mut self, t_end_s: f64, deferred: bool) {
+        let dt_nominal = self.dt_s;
+        let remaining = t_end_s - self.time_s;
+        let short = remaining < dt_nominal;
+        if short {
+            self.dt_s = remaining;
+        }
+        if deferred {
+            self.step_deferred();
+        } else {
+            self.step();
+        }
+        if short && matches!(self.integrator, Integrator::VelocityVerlet) {
+            self.dt_s = dt_nominal;
+        }
+    }
+
+    /// Steps until `t_end_s` on the engine's time loop ([`crate::time_loop::run`]): after each
+    /// step `on(world, LoopEvent::Step)` observes it (`Break` ends the run early); when
+    /// `control` has a checkpoint due or is cancelled, `on(world, LoopEvent::Checkpoint)` writes
+    /// one on the completed state, and a cancelled run stops after it. With `deferred` the steps
+    /// are [`World::step_deferred`] (`on` calls [`World::complete_step`] before it reads
+    /// particles, as for [`World::run_until_or_break_deferred`]). The state is complete again
+    /// when this returns.
+    pub fn run_controlled<E>(
+        &mut self,
+        t_end_s: f64,
+        deferred: bool,
+        control: &mut crate::time_loop::LoopControl,
+        mut on: impl FnMut(
+            &mut World,
+            crate::time_loop::LoopEvent,
+        ) -> Result<std::ops::ControlFlow<()>, E>,
+    ) -> Result<crate::time_loop::LoopEnd, E> {
+        use crate::time_loop::{Flow, LoopEvent};
+        let tol = 1e-12 * t_end_s.abs().max(1e-300);
+        let end = crate::time_loop::run(control, |ev| match ev {
+            LoopEvent::Step => {
+                if self.time_s >= t_end_s - tol {
+                    return Ok(Flow::Finished);
+                }
+                self.step_towards(t_end_s, deferred);
+                Ok(match on(self, LoopEvent::Step)? {
+                    std::ops::ControlFlow::Continue(()) => Flow::Continue,
+                    std::ops::ControlFlow::Break(()) => Flow::Break,
+                })
+            }
+            LoopEvent::Checkpoint => {
+                self.complete_step();
+                let _ = on(self, LoopEvent::Checkpoint)?;
+                Ok(Flow::Continue)
+            }
+        });
+        self.complete_step();
+        end
     }
 
     /// Sets the clock back to zero and re-initialises (forces, body poses, ledger) while keeping

@@ -206,10 +206,7 @@ fn run_one(
     pdamp_structure::report::run_couple(
         &cscn,
         &run_out,
-        pdamp_scenario::run::RunOptions {
-            checkpoint_interval_s: 0.0,
-            resume: false,
-        },
+        pdamp_scenario::run::RunOptions::new(0.0, false),
         &mut |_| {},
     )
     .map_err(|error| DesignError::StructureFile {

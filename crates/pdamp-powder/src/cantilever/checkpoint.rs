@@ -48,6 +48,8 @@ pub(super) struct Checkpointing {
     pub(super) path: PathBuf,
     pub(super) header: CheckpointHeader,
     pub(super) interval_s: f64,
+    /// The stop request the run honours (then it checkpoints and ends interrupted).
+    pub(super) cancel: pdamp_dem::time_loop::CancelToken,
 }
 
 impl Checkpointing {

@@ -1,10 +1,11 @@
 //! The run: preparation of the powder, the coupled run and its checkpoints.
 
+use pdamp_dem::time_loop::{self, CancelToken, Flow, LoopControl, LoopEnd, LoopEvent};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
-use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
+use pdamp_io::checkpoint::{self as ck, CheckpointHeader};
 
 use super::checkpoint::{CHECKPOINT_KIND, Checkpointing, Phase, RunState, scenario_digest};
 use super::outputs::{create_dir, write_outputs};
@@ -32,9 +33,9 @@ pub fn run(
 
 /// Runs the scenario and writes its outputs ([`write_outputs`]) into `dir`, checkpointing
 /// into `DIR/checkpoint.bin` every `options.checkpoint_interval_s` of wall-clock time, once
-/// the preparation is finished (unless the interval is 0) and on a stop request
-/// ([`pdamp_io::checkpoint::request_stop`], the CLI's Ctrl-C/SIGTERM), which ends the run with
-/// an error starting with [`pdamp_io::checkpoint::INTERRUPTED`]. With `options.resume` the run
+/// the preparation is finished (unless the interval is 0) and when `options.cancel` is
+/// cancelled (the CLI's Ctrl-C/SIGTERM), which ends the run with
+/// [`CantileverError::Interrupted`]. With `options.resume` the run
 /// continues from the checkpoint (a checkpoint of another scenario is refused) and the
 /// outputs equal those of an uninterrupted run byte for byte, wall times aside; resuming a
 /// finished run returns its summary.
@@ -58,6 +59,7 @@ pub fn run_in_dir(
         path: dir.join(ck::CHECKPOINT_FILE),
         header: CheckpointHeader::new(CHECKPOINT_KIND, &digest),
         interval_s: options.checkpoint_interval_s,
+        cancel: options.cancel.clone(),
     };
     let resumed: Option<Phase> = if options.resume {
         ck::load(&c.path, CHECKPOINT_KIND, &digest).map_err(CantileverError::from)?
@@ -95,14 +97,22 @@ fn run_core(
     let (s, tip) = build_structure(&sc.beam, &sc.load, sc.run.gravity_m_s2);
     let dt = sc.run.time_step_s;
     let cavity = sc.beam.cavity();
-    let _stoppable = ckp.map(|_| ck::StoppableSection::enter());
-    let mut timer = CheckpointTimer::new(ckp.map_or(0.0, |c| c.interval_s));
+    // Without checkpoints a run is not stopped (it has nowhere to continue from).
+    let cancel = ckp.map_or_else(CancelToken::new, |c| c.cancel.clone());
+    let _armed = ckp.map(|_| cancel.arm());
+    let mut control = LoopControl::new(&cancel, ckp.map_or(0.0, |c| c.interval_s));
     let (preparing, running) = resumed_phase(resumed)?;
     // preparation (fresh, continued, or done before the checkpoint)
     let prepared = match (&running, &sc.powder) {
         (Some(_), _) => None,
         (None, Some(p)) => Some(prepare_powder(
-            p, cavity, dt, ckp, preparing, &mut timer, progress,
+            p,
+            cavity,
+            dt,
+            ckp,
+            preparing,
+            &mut control,
+            progress,
         )?),
         (None, None) => Some((
             PowderBed::at_rest(PowderLaw::PAPER, &[], &[], 8000.0, [0.0; 3], dt),
@@ -110,7 +120,7 @@ fn run_core(
         )),
     };
     let mut start = start_coupled(sc, s, cavity, running, prepared)?;
-    coupled_steps(sc, ckp, &mut timer, &mut start, tip, vtk_dir, progress)?;
+    coupled_steps(sc, ckp, &mut control, &mut start, tip, vtk_dir, progress)?;
     let CoupledStart { c, mut res, .. } = start;
     let t_release = sc.load.rise_s + sc.load.hold_s;
     finish_result(&c, &mut res, t_release);
@@ -142,7 +152,7 @@ fn prepare_powder(
     dt: f64,
     ckp: Option<&Checkpointing>,
     preparing: Option<Preparation>,
-    timer: &mut CheckpointTimer,
+    control: &mut LoopControl,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<(PowderBed, Option<PrepReport>), CantileverError> {
     let mut pr = preparing.unwrap_or_else(|| {
@@ -160,17 +170,12 @@ fn prepare_powder(
         let Some(c) = ckp else {
             return ControlFlow::Continue(());
         };
-        let stop = ck::stop_requested();
-        if stop || timer.due() {
-            if let Err(e) = c.save(&Phase::Preparing(Box::new(pr.snapshot()))) {
+        control
+            .checkpoint_or_stop(|| c.save(&Phase::Preparing(Box::new(pr.snapshot()))))
+            .unwrap_or_else(|e| {
                 err = Some(e);
-                return ControlFlow::Break(());
-            }
-            if stop {
-                return ControlFlow::Break(());
-            }
-        }
-        ControlFlow::Continue(())
+                ControlFlow::Break(())
+            })
     });
     let flow = flow?;
     if let Some(e) = err {
@@ -274,7 +279,7 @@ fn start_coupled(
 fn coupled_steps(
     sc: &CantileverScenario,
     ckp: Option<&Checkpointing>,
-    timer: &mut CheckpointTimer,
+    control: &mut LoopControl,
     start: &mut CoupledStart,
     tip: usize,
     vtk_dir: Option<&Path>,
@@ -334,7 +339,18 @@ fn coupled_steps(
     let every = ((sc.run.output_interval_s / dt).round() as u64).max(1);
     let e_every = (nsteps / 2000).max(1);
     let t_release = sc.load.rise_s + sc.load.hold_s;
-    for q in first..=nsteps {
+    let mut q = first - 1;
+    let end = time_loop::run(control, |event| {
+        if event == LoopEvent::Checkpoint {
+            if let Some(cp) = ckp {
+                cp.save(&state(c, res, q, wall(&clock)))?;
+            }
+            return Ok(Flow::Continue);
+        }
+        if q == nsteps {
+            return Ok(Flow::Finished);
+        }
+        q += 1;
         let it = c.step()?;
         let t = c.dynamics.t;
         let x = c.dynamics.d[3 * tip];
@@ -357,15 +373,12 @@ fn coupled_steps(
         if q % 200 == 0 {
             progress("coupled run", q as f64 / nsteps as f64);
         }
-        if let Some(cp) = ckp {
-            let stop = ck::stop_requested();
-            if stop || timer.due() {
-                cp.save(&state(c, res, q, wall(&clock)))?;
-                if stop {
-                    return Err(cp.interrupted(t));
-                }
-            }
-        }
+        Ok::<_, CantileverError>(Flow::Continue)
+    })?;
+    if end == LoopEnd::Cancelled
+        && let Some(cp) = ckp
+    {
+        return Err(cp.interrupted(c.dynamics.t));
     }
     res.wall_time_s = wall(&clock);
     Ok(())

@@ -6,6 +6,7 @@ pub use crate::provenance::{referenced_files_digest, scenario_content_digest, sc
 use crate::schema::Scenario;
 use pdamp_dem::WorldState;
 use pdamp_dem::bed_statistics::{BedStatistics, bed_statistics};
+use pdamp_dem::time_loop::{CancelToken, LoopControl, LoopEnd, LoopEvent};
 use pdamp_dem::{Vec3, World};
 use pdamp_io::checkpoint::CheckpointError;
 use pdamp_io::csv::CsvWriter;
@@ -127,13 +128,15 @@ pub fn ledger_row(w: &World) -> Vec<f64> {
     ]
 }
 
-/// How `run_scenario` checkpoints.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// How `run_scenario` checkpoints and stops.
+#[derive(Debug, Clone)]
 pub struct RunOptions {
     /// Wall-clock seconds between checkpoints (≤ 0: none, except on a stop request).
     pub checkpoint_interval_s: f64,
     /// Continue from `DIR/checkpoint.bin` if there is one.
     pub resume: bool,
+    /// Cancelling it makes the run write a checkpoint and return an "interrupted" error.
+    pub cancel: CancelToken,
 }
 
 impl Default for RunOptions {
@@ -141,7 +144,33 @@ impl Default for RunOptions {
         Self {
             checkpoint_interval_s: 60.0,
             resume: false,
+            cancel: CancelToken::new(),
         }
+    }
+}
+
+impl RunOptions {
+    /// Checkpoints every `checkpoint_interval_s`, continuing a checkpoint with `resume`, never
+    /// cancelled.
+    pub fn new(checkpoint_interval_s: f64, resume: bool) -> Self {
+        Self {
+            checkpoint_interval_s,
+            resume,
+            cancel: CancelToken::new(),
+        }
+    }
+
+    /// The same options stopped by `cancel`.
+    pub fn cancelled_by(self, cancel: &CancelToken) -> Self {
+        Self {
+            cancel: cancel.clone(),
+            ..self
+        }
+    }
+
+    /// The checkpoint cadence and stop request of a run with these options.
+    pub fn control(&self) -> LoopControl {
+        LoopControl::new(&self.cancel, self.checkpoint_interval_s)
     }
 }
 
@@ -230,10 +259,9 @@ const RUN_KIND: &str = "run";
 
 /// Runs `scenario` (paths relative to `base_dir`) and writes all outputs into `out_dir`.
 /// `progress(phase, fraction)` is called regularly. Checkpoints every
-/// `options.checkpoint_interval_s` of wall-clock time and on a stop request
-/// ([`pdamp_io::checkpoint::request_stop`]), which ends the run with an error starting with
-/// [`pdamp_io::checkpoint::INTERRUPTED`]. With `options.resume`, continues from the last
-/// checkpoint; the outputs then equal those of an uninterrupted run (timing fields aside).
+/// `options.checkpoint_interval_s` of wall-clock time and when `options.cancel` is cancelled,
+/// which ends the run with [`RunError::Interrupted`]. With `options.resume`, continues from the
+/// last checkpoint; the outputs then equal those of an uninterrupted run (timing fields aside).
 pub fn run_scenario(
     scenario: &Scenario,
     base_dir: &Path,
@@ -241,8 +269,8 @@ pub fn run_scenario(
     options: RunOptions,
     mut progress: impl FnMut(&str, f64),
 ) -> Result<RunSummary, RunError> {
-    use pdamp_io::checkpoint::{self as ck, CheckpointHeader, CheckpointTimer};
-    let mut world = scenario.build_world(base_dir)?;
+    use pdamp_io::checkpoint::{self as ck, CheckpointHeader};
+    let mut world = scenario.build_world_cancellable(base_dir, &options.cancel)?;
     let digest = scenario_content_digest(scenario, base_dir);
     let ck_path = out_dir.join(ck::CHECKPOINT_FILE);
     let header = CheckpointHeader::new(RUN_KIND, &digest);
@@ -260,7 +288,7 @@ pub fn run_scenario(
     let start = std::time::Instant::now();
     let wall_before = resumed.as_ref().map_or(0.0, |c| c.wall_time_s);
     let wall = |start: &std::time::Instant| wall_before + start.elapsed().as_secs_f64();
-    let mut timer = CheckpointTimer::new(options.checkpoint_interval_s);
+    let mut control = options.control();
     let interrupted = |t: f64| {
         RunError::Interrupted(ck::Interrupted {
             time_s: t,
@@ -268,7 +296,7 @@ pub fn run_scenario(
         })
     };
     let main_gravity = Vec3::from(scenario.simulation.gravity_m_s2);
-    let _stoppable = ck::StoppableSection::enter();
+    let _armed = options.cancel.arm();
     let mut health: Option<pdamp_dem::health::HealthError> = None;
 
     // Settling (fresh, or resumed in the middle of it).
@@ -280,7 +308,7 @@ pub fn run_scenario(
             spec,
             main_gravity,
             &mut progress,
-            &mut timer,
+            &mut control,
             (&ck_path, &header),
             &|| wall(&start),
             out_dir,
@@ -303,24 +331,37 @@ pub fn run_scenario(
         steps_at_start: steps0,
     } = open_outputs(state.take(), &mut world, scenario, out_dir, vtk_encoding)?;
     let t_end = scenario.simulation.duration_s;
-    let mut err: Option<RunError> = None;
-    let mut stopped = false;
     // Half kicks deferred (`World::step_deferred`: same results, one pass over the particles
     // less per step); the state is completed wherever it is read.
-    world.run_until_or_break_deferred(t_end, |w| {
+    let end = world.run_controlled(t_end, true, &mut control, |w, event| {
+        if event == LoopEvent::Checkpoint {
+            let bytes = csv.sync().map_err(csvio)?;
+            let c = RunCheckpoint {
+                phase: RunPhase::Running,
+                world: Some(w.save_state()),
+                settle_time_s: settle_t,
+                energy_csv_bytes: bytes,
+                energy_rows: csv.rows(),
+                next_energy_s: next_e,
+                next_vtk_s: next_v,
+                snapshot: snap,
+                pvd: series.as_ref().map_or(Vec::new(), |s| s.entries().to_vec()),
+                steps_at_start: steps0,
+                wall_time_s: wall(&start),
+            };
+            ck::save(&ck_path, &header, &c)?;
+            return Ok(ControlFlow::Continue(()));
+        }
         if w.counters.steps.is_multiple_of(HEALTH_CHECK_STEPS) {
             w.complete_step();
             if let Err(e) = w.check_health() {
                 health = Some(e);
-                return ControlFlow::Break(());
+                return Ok(ControlFlow::Break(()));
             }
         }
         if w.time_s >= next_e - 1e-12 {
             w.complete_step();
-            if let Err(e) = csv.write_row(&ledger_row(w)) {
-                err = Some(RunError::output(e));
-                return ControlFlow::Break(());
-            }
+            csv.write_row(&ledger_row(w)).map_err(RunError::output)?;
             next_e += e_every;
             progress("running", w.time_s / t_end);
         }
@@ -328,51 +369,17 @@ pub fn run_scenario(
             && w.time_s >= next_v - 1e-12
         {
             w.complete_step();
-            if let Err(e) = write_frame(w, &vtk_dir, snap, vtk_encoding, s) {
-                err = Some(e);
-                return ControlFlow::Break(());
-            }
+            write_frame(w, &vtk_dir, snap, vtk_encoding, s)?;
             snap += 1;
             next_v += vtk_every;
         }
-        let stop = ck::stop_requested();
-        if stop || timer.due() {
-            w.complete_step();
-            let r = csv.sync().map_err(csvio).and_then(|bytes| {
-                let c = RunCheckpoint {
-                    phase: RunPhase::Running,
-                    world: Some(w.save_state()),
-                    settle_time_s: settle_t,
-                    energy_csv_bytes: bytes,
-                    energy_rows: csv.rows(),
-                    next_energy_s: next_e,
-                    next_vtk_s: next_v,
-                    snapshot: snap,
-                    pvd: series.as_ref().map_or(Vec::new(), |s| s.entries().to_vec()),
-                    steps_at_start: steps0,
-                    wall_time_s: wall(&start),
-                };
-                ck::save(&ck_path, &header, &c).map_err(RunError::from)
-            });
-            if let Err(e) = r {
-                err = Some(e);
-                return ControlFlow::Break(());
-            }
-            if stop {
-                stopped = true;
-                return ControlFlow::Break(());
-            }
-        }
-        ControlFlow::Continue(())
-    });
-    if let Some(e) = err {
-        return Err(e);
-    }
+        Ok::<_, RunError>(ControlFlow::Continue(()))
+    })?;
     if let Some(h) = health {
         csv.sync().map_err(csvio)?;
         return Err(report_failure(out_dir, "running", &h));
     }
-    if stopped {
+    if end == LoopEnd::Cancelled {
         return Err(interrupted(world.time_s));
     }
     csv.sync().map_err(csvio)?;
@@ -384,14 +391,14 @@ pub fn run_scenario(
 }
 
 /// The settling before the main run ([`settle_with_or_break`]) under the health check, with
-/// checkpoints when `timer` is due or a stop is requested. Returns the settling time, s.
+/// checkpoints when `control` has one due or is cancelled. Returns the settling time, s.
 #[allow(clippy::too_many_arguments)]
 fn settle_phase(
     world: &mut World,
     spec: &crate::schema::SettleSpec,
     main_gravity: Vec3,
     progress: &mut dyn FnMut(&str, f64),
-    timer: &mut pdamp_io::checkpoint::CheckpointTimer,
+    control: &mut LoopControl,
     (ck_path, header): (&Path, &pdamp_io::checkpoint::CheckpointHeader),
     wall: &dyn Fn() -> f64,
     out_dir: &Path,
@@ -406,17 +413,12 @@ fn settle_phase(
             health = Some(e);
             return ControlFlow::Break(());
         }
-        let stop = ck::stop_requested();
-        if stop || timer.due() {
-            if let Err(e) = ck::save(ck_path, header, &RunCheckpoint::settling(w, wall())) {
+        control
+            .checkpoint_or_stop(|| ck::save(ck_path, header, &RunCheckpoint::settling(w, wall())))
+            .unwrap_or_else(|e| {
                 err = Some(e);
-                return ControlFlow::Break(());
-            }
-            if stop {
-                return ControlFlow::Break(());
-            }
-        }
-        ControlFlow::Continue(())
+                ControlFlow::Break(())
+            })
     });
     if let Some(e) = err {
         return Err(e.into());

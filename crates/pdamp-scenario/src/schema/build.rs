@@ -9,10 +9,15 @@ use crate::InputError;
 use pdamp_dem::generate::{
     Layering, Region, grid_packing, random_insertion_clear_of, tight_packing,
 };
+use pdamp_dem::time_loop::CancelToken;
 use pdamp_dem::walls::Geometry;
 use pdamp_dem::{BodyState, Integrator, Motion, ParameterError, RigidBody, Vec3, World};
 use std::path::Path;
 use std::sync::Arc;
+
+/// What a long preparation reports to (`progress(phase, fraction)`) and the stop request it
+/// honours.
+type Watch<'a> = (&'a mut dyn FnMut(&str, f64), &'a CancelToken);
 
 impl Scenario {
     /// Builds the world: bodies, walls (STL paths relative to `base_dir`), particles placed
@@ -32,17 +37,29 @@ impl Scenario {
         mode: Preparation,
         progress: &mut dyn FnMut(&str, f64),
     ) -> Result<World, InputError> {
-        self.build_world_reporting(base_dir, mode, progress)
+        self.build_world_reporting(base_dir, mode, progress, &CancelToken::new())
+            .map(|(w, _)| w)
+    }
+
+    /// [`Scenario::build_world`] whose drop-down stops when `cancel` is cancelled (the world is
+    /// then not built: an error names the drop-down).
+    pub fn build_world_cancellable(
+        &self,
+        base_dir: &Path,
+        cancel: &CancelToken,
+    ) -> Result<World, InputError> {
+        self.build_world_reporting(base_dir, Preparation::Full, &mut |_, _| {}, cancel)
             .map(|(w, _)| w)
     }
 
     /// [`Scenario::build_world_with`], also returning what each drop-down did (one report per
-    /// `drop_down` group, in group order).
+    /// `drop_down` group, in group order); a drop-down stops when `cancel` is cancelled.
     pub fn build_world_reporting(
         &self,
         base_dir: &Path,
         mode: Preparation,
         progress: &mut dyn FnMut(&str, f64),
+        cancel: &CancelToken,
     ) -> Result<(World, Vec<pdamp_dem::drop_down::DropDownReport>), InputError> {
         let mut reports = Vec::new();
         let mut world = self.world_with_bodies(base_dir)?;
@@ -116,8 +133,14 @@ impl Scenario {
                     placeholders.push((mat, radii));
                     continue;
                 }
-                let dropped =
-                    self.drop_down_group(&world, g, mat, region, &radii, seed, progress)?;
+                let dropped = self.drop_down_group(
+                    &world,
+                    (g, mat),
+                    region,
+                    &radii,
+                    seed,
+                    (progress, cancel),
+                )?;
                 reports.push(dropped.report.clone());
                 // Earlier groups settled further under this one.
                 for (i, x) in dropped.earlier_position_m.iter().enumerate() {
@@ -381,16 +404,14 @@ impl Scenario {
     }
 
     /// Drops group `g` into `world` under the filling gravity ([`Scenario::fill_gravity`]).
-    #[allow(clippy::too_many_arguments)]
     fn drop_down_group(
         &self,
         world: &World,
-        g: usize,
-        mat: u16,
+        (g, mat): (usize, u16),
         region: &Region,
         radii: &[f64],
         seed: u64,
-        progress: &mut dyn FnMut(&str, f64),
+        (progress, cancel): Watch<'_>,
     ) -> Result<pdamp_dem::drop_down::DroppedParticles, InputError> {
         self.check_drop_down_fits(g, region, radii)?;
         let pl = &self.particles[g].placement;
@@ -419,7 +440,7 @@ impl Scenario {
         let total = radii.len().max(1) as f64;
         pdamp_dem::drop_down::drop_down(&w, radii, mat, &spec, |_, placed| {
             progress("drop-down", placed as f64 / total);
-            if pdamp_io::checkpoint::stop_requested() {
+            if cancel.is_cancelled() {
                 std::ops::ControlFlow::Break(())
             } else {
                 std::ops::ControlFlow::Continue(())

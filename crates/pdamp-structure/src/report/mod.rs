@@ -84,10 +84,7 @@ pub fn run_couple_default(
     out: &Path,
     progress: &mut dyn FnMut(f64),
 ) -> Result<serde_json::Value, StructureError> {
-    let options = pdamp_scenario::run::RunOptions {
-        checkpoint_interval_s: 0.0,
-        resume: false,
-    };
+    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
     run_couple(path, out, options, progress)
 }
 
@@ -339,6 +336,7 @@ fn coupling_checkpoint(
         inputs_digest: pdamp_io::checkpoint::digest(inputs),
         interval_s: options.checkpoint_interval_s,
         resume: options.resume,
+        cancel: options.cancel.clone(),
         bed_vtk: bed_vtk.map(|(interval_s, format)| crate::dem::BedVtk {
             dir: out.to_path_buf(),
             pvd_name: "particles.pvd".into(),

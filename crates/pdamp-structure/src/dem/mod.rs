@@ -34,14 +34,17 @@
 //! $W_{s\to b} = -\sum \tfrac12(Q_n + Q_{n+1})\cdot(q_{n+1} - q_n)$, next to the DEM ledger
 //! (wall work, bed energy change, dissipation), so the exchange can be checked to close.
 
+mod checkpoint;
 use crate::StructureError;
 use crate::forced::SweepSpec;
 use crate::free::{FreeVibrationSpec, TimeHistory};
 use crate::integrate::{ModalIntegrator, generalized_force};
 use crate::modal::ModalStructure;
+use checkpoint::{COUPLE_KIND, CoupledState};
 use nalgebra::DVector;
 use pdamp_dem::math::Rotation;
-use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3, WorldState};
+use pdamp_dem::time_loop::{self, CancelToken, Flow, LoopControl, LoopEnd, LoopEvent};
+use pdamp_dem::{BodyState, Motion, PrescribedMotion, Vec3};
 use pdamp_design::Damper;
 use pdamp_scenario::run::SnapshotSeries;
 use serde::{Deserialize, Serialize};
@@ -64,6 +67,9 @@ pub struct CouplingCheckpoint {
     pub resume: bool,
     /// ParaView output of the bed during the run (`None`: none).
     pub bed_vtk: Option<BedVtk>,
+    /// Cancelling it makes the run write its checkpoint and end with
+    /// [`StructureError::Interrupted`].
+    pub cancel: CancelToken,
 }
 
 /// ParaView output of a coupled run's DEM bed: particles and container walls every
@@ -80,34 +86,6 @@ pub struct BedVtk {
     pub interval_s: f64,
     /// Array encoding (the damper scenario's `output.vtk_format`).
     pub encoding: pdamp_io::vtk::VtkEncoding,
-}
-
-/// Kind tag of coupled-DEM checkpoints.
-const COUPLE_KIND: &str = "couple-dem";
-
-/// State of [`coupled_run`] after a step.
-#[derive(Serialize, Deserialize)]
-struct CoupledState {
-    step: usize,
-    time_s: f64,
-    q: DVector<f64>,
-    v: DVector<f64>,
-    a: DVector<f64>,
-    world: WorldState,
-    time: Vec<f64>,
-    displacement: Vec<f64>,
-    velocity: Vec<f64>,
-    force: Vec<f64>,
-    #[serde(default)]
-    energy: DemEnergy,
-    #[serde(default)]
-    q_load: Option<DVector<f64>>,
-    /// The worlds of the beds after the first (several DEM dampers).
-    #[serde(default)]
-    more_worlds: Vec<WorldState>,
-    /// Their last raw loads.
-    #[serde(default)]
-    more_q_load: Vec<DVector<f64>>,
 }
 
 /// Container motion over one step: the structure's state at `t1` extrapolated quadratically.
@@ -561,24 +539,27 @@ fn coupled_run(
     {
         first = st.restore(&c.path, &mut runs, &mut it, &mut hist, &mut energy)?;
     }
-    let _stoppable = ck.map(|_| cp::StoppableSection::enter());
-    let mut timer = cp::CheckpointTimer::new(ck.map_or(0.0, |c| c.interval_s));
+    // Without checkpoints a run is not stopped (it has nowhere to continue from).
+    let cancel = ck.map_or_else(CancelToken::new, |c| c.cancel.clone());
+    let _armed = ck.map(|_| cancel.arm());
+    let mut control = LoopControl::new(&cancel, ck.map_or(0.0, |c| c.interval_s));
     let n_steps = (duration_s / dt).round() as usize;
-    // The first bed in ParaView: a frame every `interval_s` (frames of a resumed run's earlier
-    // steps are the interrupted run's).
-    let mut snapshots = bed_snapshots(ck, dt);
-    if let Some(s) = snapshots.as_mut() {
-        if first > 1 {
-            s.resume_after((first - 1) as u64, dt, &runs[0].w)
-                .map_err(StructureError::from)?;
-        } else {
-            s.on_step(0, 0.0, &runs[0].w)
-                .map_err(StructureError::from)?;
-        }
-    }
+    let mut snapshots = bed_snapshots(ck, dt, first, &runs[0].w)?;
     let every = sample_every.max(1);
     let report = (n_steps / 200).max(1);
-    for step in first..=n_steps {
+    let mut step = first - 1;
+    let end = time_loop::run(&mut control, |event| {
+        if event == LoopEvent::Checkpoint {
+            if let (Some(c), Some(h)) = (ck, &header) {
+                let st = CoupledState::capture(step, &it, &runs, &hist, energy);
+                cp::save(&c.path, h, &st).map_err(StructureError::from)?;
+            }
+            return Ok(Flow::Continue);
+        }
+        if step == n_steps {
+            return Ok(Flow::Finished);
+        }
+        step += 1;
         let t1 = step as f64 * dt;
         let q_prev = it.q.clone();
         it.verlet_drift();
@@ -613,19 +594,15 @@ fn coupled_run(
         if step % report == 0 {
             progress(step as f64 / n_steps as f64);
         }
-        if let (Some(c), Some(h)) = (ck, &header) {
-            let stop = cp::stop_requested();
-            if stop || timer.due() {
-                let st = CoupledState::capture(step, &it, &runs, &hist, energy);
-                cp::save(&c.path, h, &st).map_err(StructureError::from)?;
-                if stop {
-                    return Err(StructureError::Interrupted(cp::Interrupted {
-                        time_s: it.time_s,
-                        path: c.path.clone(),
-                    }));
-                }
-            }
-        }
+        Ok(Flow::Continue)
+    })?;
+    if end == LoopEnd::Cancelled
+        && let Some(c) = ck
+    {
+        return Err(StructureError::Interrupted(cp::Interrupted {
+            time_s: it.time_s,
+            path: c.path.clone(),
+        }));
     }
     add_bed_ledgers(&mut energy, &runs);
     energy.structure_energy_change_j = it.energy_j() - e_structure0;
@@ -653,11 +630,26 @@ fn check_same_time_step(beds: &[DemBed], dt: f64) -> Result<(), StructureError> 
 }
 
 /// The first bed's ParaView series of a checkpointed run: a frame every `interval_s` of its
-/// `bed_vtk` settings (`None` without them).
-fn bed_snapshots(ck: Option<&CouplingCheckpoint>, dt: f64) -> Option<SnapshotSeries> {
-    let b = ck.and_then(|c| c.bed_vtk.as_ref())?;
-    SnapshotSeries::every_steps_for(b.interval_s, dt)
-        .map(|every| SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding))
+/// `bed_vtk` settings (`None` without them), started at step `first` (frame 0 written; the
+/// frames of a resumed run's earlier steps are the interrupted run's).
+fn bed_snapshots(
+    ck: Option<&CouplingCheckpoint>,
+    dt: f64,
+    first: usize,
+    bed: &pdamp_dem::World,
+) -> Result<Option<SnapshotSeries>, StructureError> {
+    let Some(b) = ck.and_then(|c| c.bed_vtk.as_ref()) else {
+        return Ok(None);
+    };
+    let Some(every) = SnapshotSeries::every_steps_for(b.interval_s, dt) else {
+        return Ok(None);
+    };
+    let mut s = SnapshotSeries::new(&b.dir, &b.pvd_name, &b.subdir, every, b.encoding);
+    match first {
+        1 => s.on_step(0, 0.0, bed)?,
+        _ => s.resume_after((first - 1) as u64, dt, bed)?,
+    }
+    Ok(Some(s))
 }
 
 /// Every bed's energy ledger added to the run's energy exchange: wall work, change of the
@@ -669,73 +661,6 @@ fn add_bed_ledgers(energy: &mut DemEnergy, runs: &[BedRun]) {
         energy.bed_energy_change_j += l.total_mechanical_j()
             - (l.initial_kinetic_j + l.initial_potential_j + l.initial_elastic_j);
         energy.dissipated_j += l.dissipated_j();
-    }
-}
-
-impl CoupledState {
-    /// The state after `step`: the integrator, every bed's world and last raw load, the
-    /// history so far and the energy exchange.
-    fn capture(
-        step: usize,
-        it: &ModalIntegrator,
-        runs: &[BedRun],
-        hist: &TimeHistory,
-        energy: DemEnergy,
-    ) -> Self {
-        CoupledState {
-            step,
-            time_s: it.time_s,
-            q: it.q.clone(),
-            v: it.v.clone(),
-            a: it.a.clone(),
-            world: runs[0].w.save_state(),
-            time: hist.time_s.clone(),
-            displacement: hist.displacement_m.clone(),
-            velocity: hist.velocity_m_s.clone(),
-            force: hist.force_n.clone(),
-            energy,
-            q_load: Some(runs[0].q_raw.clone()),
-            more_worlds: runs[1..].iter().map(|r| r.w.save_state()).collect(),
-            more_q_load: runs[1..].iter().map(|r| r.q_raw.clone()).collect(),
-        }
-    }
-
-    /// Restores a checkpoint (read from `path`) into the beds, the integrator, the history and
-    /// the energy exchange; returns the first step still to run.
-    fn restore(
-        self,
-        path: &std::path::Path,
-        runs: &mut [BedRun],
-        it: &mut ModalIntegrator,
-        hist: &mut TimeHistory,
-        energy: &mut DemEnergy,
-    ) -> Result<usize, StructureError> {
-        let st = self;
-        if st.more_worlds.len() + 1 != runs.len() {
-            return Err(StructureError::invalid(
-                path.display().to_string(),
-                format!(
-                    "a checkpoint of {} DEM bed(s), the scenario has {}",
-                    st.more_worlds.len() + 1,
-                    runs.len()
-                ),
-            ));
-        }
-        let worlds = std::iter::once(st.world).chain(st.more_worlds);
-        for (r, ws) in runs.iter_mut().zip(worlds) {
-            r.w.restore_state(ws).map_err(StructureError::State)?;
-        }
-        (it.time_s, it.q, it.v, it.a) = (st.time_s, st.q, st.v, st.a);
-        hist.time_s = st.time;
-        hist.displacement_m = st.displacement;
-        hist.velocity_m_s = st.velocity;
-        hist.force_n = st.force;
-        *energy = st.energy;
-        let loads = st.q_load.into_iter().chain(st.more_q_load);
-        for (r, ql) in runs.iter_mut().zip(loads) {
-            r.q_raw = ql;
-        }
-        Ok(st.step + 1)
     }
 }
 
