@@ -2,7 +2,7 @@
 //! accepted as option values.
 
 use crate::dem_commands::{Device, PointArgs};
-use crate::{bench, cor, design, impact, powder, structure, sweep};
+use crate::{bench, cor, design, impact, powder, structure, sweep, validate};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -131,6 +131,9 @@ pub(crate) enum Command {
     Powder(powder::PowderArgs),
     /// Shaken-box benchmark; prints particle-timesteps per second as JSON.
     Bench(bench::BenchArgs),
+    /// pdamp against the numbers of the dissertation and the DEM–FEM paper: writes
+    /// validation.md and validation.csv (docs/validation.md is its output).
+    Validate(validate::ValidateArgs),
 }
 
 /// `pdamp` with `--opt -1` accepted as a value in every subcommand (clap takes `-1` for an

@@ -26,6 +26,7 @@ mod powder;
 mod progress;
 mod structure;
 mod sweep;
+mod validate;
 
 /// `provenance.json` (and a copy of the input file as `input.toml`) for a command whose input
 /// is not a DEM scenario: call [`Traced::start`] before the work, [`Traced::write`] after it.
@@ -227,6 +228,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Design(args) => design::run(args),
         Command::Powder(args) => powder::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Validate(args) => validate::run(args),
     }
 }
 

@@ -7,9 +7,8 @@
 //!
 //! Stopping on request: a loop whose `pdamp_dem::time_loop::CancelToken` is cancelled (by the
 //! CLI's SIGINT/SIGTERM handler, a Python session) writes a checkpoint and returns
-//! [`Interrupted`]. The wall-clock cadence is [`CheckpointTimer`] (of the engine's time loop).
+//! [`Interrupted`]. The wall-clock cadence is the engine's (`pdamp_dem::time_loop`).
 
-pub use pdamp_dem::time_loop::CheckpointTimer;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

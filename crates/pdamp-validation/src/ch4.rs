@@ -1,0 +1,85 @@
+//! D Ch. 4, single impacts (level I): the closed forms of the impact models. The FE impact
+//! rows (contact times, restitution curves, energy splits) are simulations and follow as
+//! `Full` rows.
+
+use crate::{ComputeError, Target, closed_form, exact, rel, stated, worded};
+use pdamp_impact::hertz::HertzPair;
+use pdamp_impact::{Material, MaterialModel, Partner};
+
+const CH: &str = "D Ch. 4 — single impacts";
+
+/// The Hertz pair of a 30 mm S235 sphere and `partner` (D Sect. 4.2.1).
+fn hertz_30mm(partner: &Partner) -> HertzPair {
+    pdamp_impact::study::hertz_pair(&Material::s235(), partner, 0.015)
+}
+
+/// The Perzyna overstress factor β = 1 + (ε̇/ζ)^λ of `m` at the plastic strain rate `rate`
+/// (D Eq. 4.2), with ζ and λ of pdamp's built-in material.
+fn perzyna_beta(m: &Material, rate_1_s: f64) -> Result<f64, ComputeError> {
+    match &m.model {
+        MaterialModel::ViscoplasticJ2 {
+            perzyna_zeta_1_s: Some(z),
+            perzyna_lambda,
+            ..
+        } => Ok(1.0 + (rate_1_s / z).powf(*perzyna_lambda)),
+        _ => Err(ComputeError::new(format!(
+            "{} has no Perzyna rate dependence",
+            m.name
+        ))),
+    }
+}
+
+/// The Ch. 4 targets.
+pub fn targets() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch4.eq4_2.beta_s235",
+            CH,
+            "Perzyna overstress factor β of S235 at ε̇_pl = 1000 1/s",
+            worded(3.0, "about three", "1", "D Eq. 4.2, Tab. 4.1, L1684"),
+            crate::Tolerance::Range { lo: 2.5, hi: 3.5 },
+            || {
+                let b = perzyna_beta(&Material::s235(), 1000.0)?;
+                exact(b, "1 + (1000/ζ)^λ of Material::s235()")
+            },
+        ),
+        closed_form(
+            "ch4.eq4_2.beta_al6060",
+            CH,
+            "Perzyna β of Al 6060 at 1000 1/s (\"minor\" rate effect)",
+            worded(1.18, "minor (< 1.3)", "1", "D L1670, L1684"),
+            crate::Tolerance::Range { lo: 1.0, hi: 1.3 },
+            || {
+                let b = perzyna_beta(&Material::al6060(), 1000.0)?;
+                exact(b, "1 + (1000/ζ)^λ of Material::al6060()")
+            },
+        ),
+        closed_form(
+            "ch4.eq4_7.g_inf_saa",
+            CH,
+            "long-term shear modulus G∞ = E/(2(1+ν)) of SAA 9579 (E 54.97 MPa, ν 0.4477)",
+            stated(18.985e6, "Pa", "D Eq. 4.7, Tab. 4.2, L1709–1743"),
+            rel(1e-4),
+            || {
+                exact(
+                    Material::saa9579().shear_modulus(),
+                    "Material::saa9579().shear_modulus()",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.te_steel_steel",
+            CH,
+            "Hertz contact time, 30 mm steel sphere on a steel wall at 1 m/s",
+            worded(100e-6, "≈ 100 µs", "s", "D Eq. 4.8, L1777, L1859"),
+            rel(0.05),
+            || {
+                let p = hertz_30mm(&Partner::Wall(Material::s235()));
+                exact(
+                    p.contact_time(1.0),
+                    "hertz_pair(s235, Wall(s235), 0.015).contact_time(1.0)",
+                )
+            },
+        ),
+    ]
+}

@@ -1,0 +1,243 @@
+//! D Ch. 6, medium-excitation horizontal dampers: the bouncing collect-and-collide limit
+//! (D Eq. 6.6–6.11), Tab. 6.2 and the layered design of Sect. 6.2.
+
+use crate::{Target, abs, closed_form, exact, rel, stated, worded};
+use pdamp_structure::design::bed_mass_for_damping;
+use pdamp_structure::formulas::{
+    HorizontalDamper, RollingDamper, clearance_m, rolling_loss_factor, rolling_optimal_stroke_m,
+};
+use std::f64::consts::{PI, TAU};
+
+const CH: &str = "D Ch. 6 — rolling, fluidization and bouncing";
+
+/// η̄ of a bouncing bed of clearance `h` (no rolling layer) at amplitude `x`, driven at 50 Hz
+/// (A ≫ g).
+fn bouncing_eta(h: f64, x: f64) -> f64 {
+    HorizontalDamper {
+        rolling: RollingDamper {
+            bed_mass_kg: 0.1,
+            clearance_m: 0.0,
+            smoothing_log_width: None,
+        },
+        bouncing_clearance_m: h,
+        bouncing_mass_ratio: 1.0,
+    }
+    .loss_factor_and_mass_ratio(x, TAU * 50.0)
+    .0
+}
+
+/// Bouncing clearance of `n` spheres in the 120 mm box (n_max 192 in the bouncing column).
+fn h_bou(n: f64) -> f64 {
+    clearance_m(0.12, n, 192.0)
+}
+
+/// The Ch. 6 targets.
+pub fn targets() -> Vec<Target> {
+    let mut t = Vec::new();
+    t.extend(bouncing_model());
+    t.extend(table_6_2());
+    t.extend(layered_design());
+    t
+}
+
+/// The bouncing limit and the scattered states (D Eq. 6.10, Fig. 6.4).
+fn bouncing_model() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch6.eq6_10.eta_bou_max",
+            CH,
+            "maximal bouncing loss factor 4/π (just above X_opt = h/π)",
+            worded(1.27, "4/π ≈ 1.27", "1", "D Eq. 6.10, L2645–2693"),
+            abs(0.005),
+            || {
+                let h = 0.0925;
+                exact(
+                    bouncing_eta(h, (1.0 + 1e-6) * h / PI),
+                    "HorizontalDamper{h_bou: 0.0925} at 1.000001 h/π, 50 Hz",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.fig6_4.eta_bou_scattered",
+            CH,
+            "scattered bouncing just below X_opt: 2/π",
+            worded(0.64, "≈ 0.64", "1", "D L2695–2700"),
+            abs(0.005),
+            || {
+                let h = 0.0925;
+                exact(
+                    bouncing_eta(h, (1.0 - 1e-6) * h / PI),
+                    "HorizontalDamper{h_bou: 0.0925} at 0.999999 h/π, 50 Hz",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.fig6_4.eta_rol_scattered",
+            CH,
+            "scattered rolling at X_opt",
+            worded(0.40, "≈ 0.40", "1", "D L2695–2700"),
+            abs(0.01),
+            || {
+                let r = RollingDamper {
+                    bed_mass_kg: 0.1,
+                    clearance_m: 0.06,
+                    smoothing_log_width: None,
+                };
+                let x = rolling_optimal_stroke_m(0.06);
+                exact(
+                    r.loss_factor_and_mass_ratio(x).0,
+                    "RollingDamper{h: 0.06} at rolling_optimal_stroke_m(0.06)",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.fig6_4.bouncing_over_rolling",
+            CH,
+            "bouncing maximum over rolling maximum",
+            worded(1.4, "1.4 ×", "1", "D L2697"),
+            abs(0.05),
+            || {
+                let h = 0.0925;
+                let r = bouncing_eta(h, (1.0 + 1e-6) * h / PI) / rolling_loss_factor(PI);
+                exact(r, "η̄_bou^max / rolling_loss_factor(π)")
+            },
+        ),
+    ]
+}
+
+/// D Tab. 6.2: clearances and optimal strokes of the four beds.
+fn table_6_2() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch6.tab6_2.h_rol_24",
+            CH,
+            "Tab. 6.2 rolling clearance, 24 spheres",
+            stated(0.060, "m", "D Tab. 6.2, L2724–2732"),
+            abs(1e-9),
+            || exact(clearance_m(0.12, 24.0, 48.0), "clearance_m(0.12, 24, 48)"),
+        ),
+        closed_form(
+            "ch6.tab6_2.x_rol_24",
+            CH,
+            "Tab. 6.2 optimal rolling stroke, 24 spheres",
+            stated(0.024, "m", "D Tab. 6.2"),
+            abs(0.5e-3),
+            || {
+                exact(
+                    rolling_optimal_stroke_m(clearance_m(0.12, 24.0, 48.0)),
+                    "rolling_optimal_stroke_m(clearance_m(0.12, 24, 48))",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.tab6_2.x_rol_44",
+            CH,
+            "Tab. 6.2 optimal rolling stroke, 44 spheres",
+            stated(0.004, "m", "D Tab. 6.2"),
+            abs(0.5e-3),
+            || {
+                exact(
+                    rolling_optimal_stroke_m(clearance_m(0.12, 44.0, 48.0)),
+                    "rolling_optimal_stroke_m(clearance_m(0.12, 44, 48))",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.tab6_2.h_bou_24",
+            CH,
+            "h_bou, 24 spheres",
+            stated(0.105, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-9),
+            || exact(h_bou(24.0), "clearance_m(0.12, 24, 192)"),
+        ),
+        closed_form(
+            "ch6.tab6_2.h_bou_44",
+            CH,
+            "h_bou, 44 spheres",
+            stated(0.0925, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-9),
+            || exact(h_bou(44.0), "clearance_m(0.12, 44, 192)"),
+        ),
+        closed_form(
+            "ch6.tab6_2.h_bou_48",
+            CH,
+            "h_bou, 48 spheres",
+            stated(0.090, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-9),
+            || exact(h_bou(48.0), "clearance_m(0.12, 48, 192)"),
+        ),
+        closed_form(
+            "ch6.tab6_2.h_bou_96",
+            CH,
+            "h_bou, 96 spheres",
+            stated(0.060, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-9),
+            || exact(h_bou(96.0), "clearance_m(0.12, 96, 192)"),
+        ),
+        closed_form(
+            "ch6.tab6_2.x_bou_24",
+            CH,
+            "X_bou^opt = h_bou/π, 24 spheres (D rounds to mm)",
+            stated(0.034, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-3),
+            || exact(h_bou(24.0) / PI, "clearance_m(0.12, 24, 192)/π"),
+        ),
+        closed_form(
+            "ch6.tab6_2.x_bou_44",
+            CH,
+            "X_bou^opt, 44 spheres",
+            stated(0.029, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-3),
+            || exact(h_bou(44.0) / PI, "clearance_m(0.12, 44, 192)/π"),
+        ),
+        closed_form(
+            "ch6.tab6_2.x_bou_48",
+            CH,
+            "X_bou^opt, 48 spheres",
+            stated(0.029, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-3),
+            || exact(h_bou(48.0) / PI, "clearance_m(0.12, 48, 192)/π"),
+        ),
+        closed_form(
+            "ch6.tab6_2.x_bou_96",
+            CH,
+            "X_bou^opt, 96 spheres",
+            stated(0.019, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
+            abs(1e-3),
+            || exact(h_bou(96.0) / PI, "clearance_m(0.12, 96, 192)/π"),
+        ),
+    ]
+}
+
+/// The layered design of D Sect. 6.2.
+fn layered_design() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch6.sec6_2.f0",
+            CH,
+            "eigenfrequency of the Sect. 6.2 beam (M 1.108 kg, K 484 N/m)",
+            stated(3.33, "Hz", "D L2759"),
+            abs(0.005),
+            || {
+                let s = pdamp_structure::modal::ModalStructure::single_mode(1.108, 484.0, 0.0);
+                exact(
+                    s.modes[0].frequency_hz,
+                    "ModalStructure::single_mode(1.108, 484, 0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch6.sec6_2.bed_zeta044",
+            CH,
+            "bed mass for ζ_d = 0.044 on M = 1.108 kg (D: 196 g)",
+            stated(0.196, "kg", "D L2769"),
+            rel(0.01),
+            || {
+                exact(
+                    bed_mass_for_damping(1.108, 0.044, 0.5),
+                    "bed_mass_for_damping(1.108, 0.044, 0.5)",
+                )
+            },
+        ),
+    ]
+}

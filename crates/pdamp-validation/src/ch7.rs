@@ -1,0 +1,119 @@
+//! D Ch. 7, vertical dampers: the vertical collect-and-collide model (D Eq. 7.1–7.19) and the
+//! structure of Sect. 7.2.
+
+use crate::{Target, abs, closed_form, exact, rel, stated, worded};
+use pdamp_structure::formulas::{VerticalDamper, clearance_m};
+use pdamp_structure::modal::ModalStructure;
+use std::f64::consts::{PI, TAU};
+
+const CH: &str = "D Ch. 7 — vertical dampers";
+
+/// The 32-sphere vertical bed of Sect. 7.2 (h = 100 mm).
+const BED: VerticalDamper = VerticalDamper {
+    bed_mass_kg: 0.131,
+    clearance_m: 0.1,
+};
+
+/// The Ch. 7 targets.
+pub fn targets() -> Vec<Target> {
+    let mut known = closed_form(
+        "ch7.sec7_2_1.f0_stated_mass",
+        CH,
+        "eigenfrequency of the Ch. 7 beam from D's stated M = 1.139 kg, K = 1848 N/m",
+        stated(5.56, "Hz", "D L3001"),
+        abs(0.01),
+        || {
+            let s = ModalStructure::single_mode(1.139, 1848.0, 0.55);
+            exact(
+                s.modes[0].frequency_hz,
+                "ModalStructure::single_mode(1.139, 1848, 0.55)",
+            )
+        },
+    );
+    known.known_cause = Some(
+        "D's stated M and K are inconsistent with its 5.56 Hz: √(K/M)/2π = 6.41 Hz; M = 1.514 kg \
+         reproduces 5.56 Hz and is what examples/structure_ch7_beam.toml uses",
+    );
+    vec![
+        closed_form(
+            "ch7.eq7_4.h_32",
+            CH,
+            "clearance of 32 of 192 spheres",
+            stated(0.100, "m", "D Eq. 7.4, L3008"),
+            abs(1e-9),
+            || exact(clearance_m(0.12, 32.0, 192.0), "clearance_m(0.12, 32, 192)"),
+        ),
+        closed_form(
+            "ch7.eq7_4.h_64",
+            CH,
+            "clearance of 64 of 192 spheres",
+            stated(0.080, "m", "D L3038"),
+            abs(1e-9),
+            || exact(clearance_m(0.12, 64.0, 192.0), "clearance_m(0.12, 64, 192)"),
+        ),
+        closed_form(
+            "ch7.masses.m_32",
+            CH,
+            "bed mass of 32 steel spheres r = 5 mm",
+            stated(0.131, "kg", "D L3008"),
+            rel(0.02),
+            || {
+                exact(
+                    32.0 * pdamp_impact::hertz::sphere_mass(0.005, 7900.0),
+                    "32·sphere_mass(0.005, 7900)",
+                )
+            },
+        ),
+        closed_form(
+            "ch7.eq7_18.eta_max",
+            CH,
+            "maximal vertical loss factor for A ≫ g at X = h/π",
+            worded(1.27, "4/π ≈ 1.27", "1", "D Eq. 7.16–7.18, L2939"),
+            abs(0.01),
+            || {
+                let s = BED.state(0.1 / PI, TAU * 200.0);
+                exact(
+                    s.effective_loss_factor,
+                    "VerticalDamper{0.131 kg, h 0.1}.state(h/π, 2π·200)",
+                )
+            },
+        ),
+        closed_form(
+            "ch7.eq7_5.eta_solid",
+            CH,
+            "solid-like loss factor (A < g)",
+            stated(0.001, "1", "D Eq. 7.5, L2875–2879"),
+            abs(1e-12),
+            || {
+                let s = BED.state(0.005, TAU * 5.0);
+                exact(s.effective_loss_factor, "VerticalDamper.state(0.005, 2π·5)")
+            },
+        ),
+        closed_form(
+            "ch7.eq7_19.mbar_solid",
+            CH,
+            "effective mass ratio of a solid-like bed",
+            stated(0.75, "1", "D Eq. 7.19, L2980"),
+            abs(1e-12),
+            || {
+                let s = BED.state(0.005, TAU * 5.0);
+                exact(s.effective_mass_ratio, "VerticalDamper.state(0.005, 2π·5)")
+            },
+        ),
+        known,
+        closed_form(
+            "ch7.sec7_2_2.zeta_undamped",
+            CH,
+            "structural damping ratio of the Ch. 7 beam (D = 0.55 kg/s, M 1.514 kg)",
+            worded(0.005, "≈ 0.005", "1", "D L3012"),
+            abs(0.0005),
+            || {
+                let s = ModalStructure::single_mode(1.514, 1848.0, 0.55);
+                exact(
+                    s.modes[0].damping_ratio,
+                    "ModalStructure::single_mode(1.514, 1848, 0.55)",
+                )
+            },
+        ),
+    ]
+}

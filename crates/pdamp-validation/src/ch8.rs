@@ -1,0 +1,214 @@
+//! D Ch. 8, high-excitation dampers: the bouncing optimum of the cube and cylinder designs
+//! (D Eq. 8.1/8.2) and the coated-wall design table (D Tab. 8.4, Eq. 8.5–8.12).
+
+use crate::{Target, abs, closed_form, exact, rel, stated};
+use pdamp_structure::design::{CoatedWallDesign, CoatedWallInput, coated_wall_design};
+use pdamp_structure::formulas::clearance_m;
+use std::f64::consts::PI;
+
+const CH: &str = "D Ch. 8 — high-excitation dampers";
+
+/// The coated-wall design at `f_hz` with D's baseline particles (r 1.25 mm steel, 20 per
+/// line, ν_w = 0.5).
+fn coated(f_hz: f64) -> CoatedWallDesign {
+    coated_wall_design(&CoatedWallInput {
+        design_frequency_hz: f_hz,
+        particle_radius_m: 1.25e-3,
+        particle_density_kg_m3: 7900.0,
+        particle_youngs_modulus_pa: 208e9,
+        particle_poisson_ratio: 0.3,
+        wall_poisson_ratio: 0.5,
+        particles_per_line: 20.0,
+    })
+}
+
+const TAB84: &str = "D Tab. 8.4, L3457–3465";
+
+/// The Ch. 8 targets.
+pub fn targets() -> Vec<Target> {
+    let mut t = Vec::new();
+    t.extend(bouncing_designs());
+    t.extend(table_8_4());
+    t
+}
+
+/// Bouncing optima and bed masses of the cube and cylinder designs (D Eq. 8.1/8.2).
+fn bouncing_designs() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch8.eq8_1.xopt_cube_r2p5",
+            CH,
+            "X_opt = h/π of 520 of 573 spheres r = 2.5 mm in the 40 mm cube",
+            stated(1.2e-3, "m", "D Eq. 8.1, L3206"),
+            abs(0.05e-3),
+            || {
+                exact(
+                    clearance_m(0.04, 520.0, 573.0) / PI,
+                    "clearance_m(0.04, 520, 573)/π",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.eq8_1.xopt_cube_r5",
+            CH,
+            "X_opt of 58 of 65 spheres r = 5 mm in the cube",
+            stated(1.4e-3, "m", "D L3221, L3252"),
+            abs(0.05e-3),
+            || {
+                exact(
+                    clearance_m(0.04, 58.0, 65.0) / PI,
+                    "clearance_m(0.04, 58, 65)/π",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.masses.baseline",
+            CH,
+            "bed mass of the baseline: 4500 spheres r = 1.25 mm",
+            stated(0.291, "kg", "D L3115"),
+            rel(0.02),
+            || {
+                exact(
+                    4500.0 * pdamp_impact::hertz::sphere_mass(1.25e-3, 7900.0),
+                    "4500·sphere_mass(1.25e-3, 7900)",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.masses.cube_r5",
+            CH,
+            "bed mass of 40 spheres r = 5 mm",
+            stated(0.166, "kg", "D L3330"),
+            rel(0.02),
+            || {
+                exact(
+                    40.0 * pdamp_impact::hertz::sphere_mass(5e-3, 7900.0),
+                    "40·sphere_mass(5e-3, 7900)",
+                )
+            },
+        ),
+    ]
+}
+
+/// D Tab. 8.4: the coated-wall design (Eq. 8.5–8.12).
+fn table_8_4() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch8.tab8_4.h_50hz",
+            CH,
+            "coated-wall clearance h at f_d = 50 Hz",
+            stated(4.7e-3, "m", TAB84),
+            abs(0.1e-3),
+            || {
+                exact(
+                    coated(50.0).clearance_m,
+                    "coated_wall_design(50 Hz).clearance_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.h_60hz",
+            CH,
+            "coated-wall clearance h at 60 Hz",
+            stated(3.3e-3, "m", TAB84),
+            abs(0.1e-3),
+            || {
+                exact(
+                    coated(60.0).clearance_m,
+                    "coated_wall_design(60 Hz).clearance_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.h_80hz",
+            CH,
+            "coated-wall clearance h at 80 Hz",
+            stated(1.9e-3, "m", TAB84),
+            abs(0.1e-3),
+            || {
+                exact(
+                    coated(80.0).clearance_m,
+                    "coated_wall_design(80 Hz).clearance_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.xopt_50hz",
+            CH,
+            "coated-wall optimal stroke at 50 Hz",
+            stated(1.5e-3, "m", TAB84),
+            abs(0.07e-3),
+            || {
+                exact(
+                    coated(50.0).optimal_stroke_m,
+                    "coated_wall_design(50 Hz).optimal_stroke_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.xopt_60hz",
+            CH,
+            "coated-wall optimal stroke at 60 Hz",
+            stated(1.1e-3, "m", TAB84),
+            abs(0.07e-3),
+            || {
+                exact(
+                    coated(60.0).optimal_stroke_m,
+                    "coated_wall_design(60 Hz).optimal_stroke_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.xopt_80hz",
+            CH,
+            "coated-wall optimal stroke at 80 Hz",
+            stated(0.6e-3, "m", TAB84),
+            abs(0.07e-3),
+            || {
+                exact(
+                    coated(80.0).optimal_stroke_m,
+                    "coated_wall_design(80 Hz).optimal_stroke_m",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.ew_50hz",
+            CH,
+            "coating modulus E_w (Eq. 8.11) at 50 Hz",
+            stated(0.25e6, "Pa", TAB84),
+            rel(0.05),
+            || {
+                exact(
+                    coated(50.0).wall_modulus_pa,
+                    "coated_wall_design(50 Hz).wall_modulus_pa",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.ew_60hz",
+            CH,
+            "coating modulus E_w at 60 Hz",
+            stated(0.44e6, "Pa", TAB84),
+            rel(0.05),
+            || {
+                exact(
+                    coated(60.0).wall_modulus_pa,
+                    "coated_wall_design(60 Hz).wall_modulus_pa",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.tab8_4.ew_80hz",
+            CH,
+            "coating modulus E_w at 80 Hz",
+            stated(1.0e6, "Pa", TAB84),
+            rel(0.05),
+            || {
+                exact(
+                    coated(80.0).wall_modulus_pa,
+                    "coated_wall_design(80 Hz).wall_modulus_pa",
+                )
+            },
+        ),
+    ]
+}
