@@ -1,5 +1,6 @@
 //! `pdamp validate`: pdamp against the numbers of its references, as `validation.md` and
-//! `validation.csv` (the table of `pdamp_validation`; docs/validation.md is its output).
+//! `validation.csv` (the table of `pdamp_validation`; docs/validation.md is its output); the
+//! runs behind the rows are kept in `OUT/runs/`.
 
 use anyhow::Result;
 use clap::Args;
@@ -15,12 +16,15 @@ pub(crate) struct ValidateArgs {
     /// Every registered row, simulations included.
     #[arg(long)]
     full: bool,
-    /// Output directory (validation.md, validation.csv, provenance.json).
+    /// Output directory (validation.md, validation.csv, provenance.json, runs/).
     #[arg(long)]
     out: PathBuf,
     /// Replace the results of an earlier run in OUT.
     #[arg(long)]
     overwrite: bool,
+    /// The repository's examples folder (default: the one pdamp was built from).
+    #[arg(long)]
+    examples: Option<PathBuf>,
 }
 
 /// Runs `pdamp validate`: writes the table and prints its counts as JSON.
@@ -32,11 +36,15 @@ pub(crate) fn run(a: ValidateArgs) -> Result<()> {
         false,
         a.overwrite,
         None,
-        &["validation.md", "validation.csv", "provenance.json"],
+        &["validation.md", "validation.csv", "provenance.json", "runs"],
         &[],
     )?;
     let start = std::time::Instant::now();
-    let rows = pdamp_validation::run(tier);
+    let mut ctx = pdamp_validation::Context::in_repository(&a.out.join("runs"));
+    if let Some(e) = &a.examples {
+        ctx.examples_dir = e.clone();
+    }
+    let rows = pdamp_validation::run(tier, &ctx);
     let command = if a.full {
         "pdamp validate --full"
     } else {

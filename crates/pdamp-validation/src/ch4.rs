@@ -38,7 +38,7 @@ pub fn targets() -> Vec<Target> {
             "Perzyna overstress factor β of S235 at ε̇_pl = 1000 1/s",
             worded(3.0, "about three", "1", "D Eq. 4.2, Tab. 4.1, L1684"),
             crate::Tolerance::Range { lo: 2.5, hi: 3.5 },
-            || {
+            |_| {
                 let b = perzyna_beta(&Material::s235(), 1000.0)?;
                 exact(b, "1 + (1000/ζ)^λ of Material::s235()")
             },
@@ -49,7 +49,7 @@ pub fn targets() -> Vec<Target> {
             "Perzyna β of Al 6060 at 1000 1/s (\"minor\" rate effect)",
             worded(1.18, "minor (< 1.3)", "1", "D L1670, L1684"),
             crate::Tolerance::Range { lo: 1.0, hi: 1.3 },
-            || {
+            |_| {
                 let b = perzyna_beta(&Material::al6060(), 1000.0)?;
                 exact(b, "1 + (1000/ζ)^λ of Material::al6060()")
             },
@@ -60,7 +60,7 @@ pub fn targets() -> Vec<Target> {
             "long-term shear modulus G∞ = E/(2(1+ν)) of SAA 9579 (E 54.97 MPa, ν 0.4477)",
             stated(18.985e6, "Pa", "D Eq. 4.7, Tab. 4.2, L1709–1743"),
             rel(1e-4),
-            || {
+            |_| {
                 exact(
                     Material::saa9579().shear_modulus(),
                     "Material::saa9579().shear_modulus()",
@@ -73,7 +73,7 @@ pub fn targets() -> Vec<Target> {
             "Hertz contact time, 30 mm steel sphere on a steel wall at 1 m/s",
             worded(100e-6, "≈ 100 µs", "s", "D Eq. 4.8, L1777, L1859"),
             rel(0.05),
-            || {
+            |_| {
                 let p = hertz_30mm(&Partner::Wall(Material::s235()));
                 exact(
                     p.contact_time(1.0),

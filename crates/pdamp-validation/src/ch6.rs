@@ -49,7 +49,7 @@ fn bouncing_model() -> Vec<Target> {
             "maximal bouncing loss factor 4/π (just above X_opt = h/π)",
             worded(1.27, "4/π ≈ 1.27", "1", "D Eq. 6.10, L2645–2693"),
             abs(0.005),
-            || {
+            |_| {
                 let h = 0.0925;
                 exact(
                     bouncing_eta(h, (1.0 + 1e-6) * h / PI),
@@ -63,7 +63,7 @@ fn bouncing_model() -> Vec<Target> {
             "scattered bouncing just below X_opt: 2/π",
             worded(0.64, "≈ 0.64", "1", "D L2695–2700"),
             abs(0.005),
-            || {
+            |_| {
                 let h = 0.0925;
                 exact(
                     bouncing_eta(h, (1.0 - 1e-6) * h / PI),
@@ -77,7 +77,7 @@ fn bouncing_model() -> Vec<Target> {
             "scattered rolling at X_opt",
             worded(0.40, "≈ 0.40", "1", "D L2695–2700"),
             abs(0.01),
-            || {
+            |_| {
                 let r = RollingDamper {
                     bed_mass_kg: 0.1,
                     clearance_m: 0.06,
@@ -96,7 +96,7 @@ fn bouncing_model() -> Vec<Target> {
             "bouncing maximum over rolling maximum",
             worded(1.4, "1.4 ×", "1", "D L2697"),
             abs(0.05),
-            || {
+            |_| {
                 let h = 0.0925;
                 let r = bouncing_eta(h, (1.0 + 1e-6) * h / PI) / rolling_loss_factor(PI);
                 exact(r, "η̄_bou^max / rolling_loss_factor(π)")
@@ -114,7 +114,7 @@ fn table_6_2() -> Vec<Target> {
             "Tab. 6.2 rolling clearance, 24 spheres",
             stated(0.060, "m", "D Tab. 6.2, L2724–2732"),
             abs(1e-9),
-            || exact(clearance_m(0.12, 24.0, 48.0), "clearance_m(0.12, 24, 48)"),
+            |_| exact(clearance_m(0.12, 24.0, 48.0), "clearance_m(0.12, 24, 48)"),
         ),
         closed_form(
             "ch6.tab6_2.x_rol_24",
@@ -122,7 +122,7 @@ fn table_6_2() -> Vec<Target> {
             "Tab. 6.2 optimal rolling stroke, 24 spheres",
             stated(0.024, "m", "D Tab. 6.2"),
             abs(0.5e-3),
-            || {
+            |_| {
                 exact(
                     rolling_optimal_stroke_m(clearance_m(0.12, 24.0, 48.0)),
                     "rolling_optimal_stroke_m(clearance_m(0.12, 24, 48))",
@@ -135,7 +135,7 @@ fn table_6_2() -> Vec<Target> {
             "Tab. 6.2 optimal rolling stroke, 44 spheres",
             stated(0.004, "m", "D Tab. 6.2"),
             abs(0.5e-3),
-            || {
+            |_| {
                 exact(
                     rolling_optimal_stroke_m(clearance_m(0.12, 44.0, 48.0)),
                     "rolling_optimal_stroke_m(clearance_m(0.12, 44, 48))",
@@ -148,7 +148,7 @@ fn table_6_2() -> Vec<Target> {
             "h_bou, 24 spheres",
             stated(0.105, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-9),
-            || exact(h_bou(24.0), "clearance_m(0.12, 24, 192)"),
+            |_| exact(h_bou(24.0), "clearance_m(0.12, 24, 192)"),
         ),
         closed_form(
             "ch6.tab6_2.h_bou_44",
@@ -156,7 +156,7 @@ fn table_6_2() -> Vec<Target> {
             "h_bou, 44 spheres",
             stated(0.0925, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-9),
-            || exact(h_bou(44.0), "clearance_m(0.12, 44, 192)"),
+            |_| exact(h_bou(44.0), "clearance_m(0.12, 44, 192)"),
         ),
         closed_form(
             "ch6.tab6_2.h_bou_48",
@@ -164,7 +164,7 @@ fn table_6_2() -> Vec<Target> {
             "h_bou, 48 spheres",
             stated(0.090, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-9),
-            || exact(h_bou(48.0), "clearance_m(0.12, 48, 192)"),
+            |_| exact(h_bou(48.0), "clearance_m(0.12, 48, 192)"),
         ),
         closed_form(
             "ch6.tab6_2.h_bou_96",
@@ -172,7 +172,7 @@ fn table_6_2() -> Vec<Target> {
             "h_bou, 96 spheres",
             stated(0.060, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-9),
-            || exact(h_bou(96.0), "clearance_m(0.12, 96, 192)"),
+            |_| exact(h_bou(96.0), "clearance_m(0.12, 96, 192)"),
         ),
         closed_form(
             "ch6.tab6_2.x_bou_24",
@@ -180,7 +180,7 @@ fn table_6_2() -> Vec<Target> {
             "X_bou^opt = h_bou/π, 24 spheres (D rounds to mm)",
             stated(0.034, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-3),
-            || exact(h_bou(24.0) / PI, "clearance_m(0.12, 24, 192)/π"),
+            |_| exact(h_bou(24.0) / PI, "clearance_m(0.12, 24, 192)/π"),
         ),
         closed_form(
             "ch6.tab6_2.x_bou_44",
@@ -188,7 +188,7 @@ fn table_6_2() -> Vec<Target> {
             "X_bou^opt, 44 spheres",
             stated(0.029, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-3),
-            || exact(h_bou(44.0) / PI, "clearance_m(0.12, 44, 192)/π"),
+            |_| exact(h_bou(44.0) / PI, "clearance_m(0.12, 44, 192)/π"),
         ),
         closed_form(
             "ch6.tab6_2.x_bou_48",
@@ -196,7 +196,7 @@ fn table_6_2() -> Vec<Target> {
             "X_bou^opt, 48 spheres",
             stated(0.029, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-3),
-            || exact(h_bou(48.0) / PI, "clearance_m(0.12, 48, 192)/π"),
+            |_| exact(h_bou(48.0) / PI, "clearance_m(0.12, 48, 192)/π"),
         ),
         closed_form(
             "ch6.tab6_2.x_bou_96",
@@ -204,7 +204,7 @@ fn table_6_2() -> Vec<Target> {
             "X_bou^opt, 96 spheres",
             stated(0.019, "m", "D Tab. 6.2, Eq. 6.1, 6.11"),
             abs(1e-3),
-            || exact(h_bou(96.0) / PI, "clearance_m(0.12, 96, 192)/π"),
+            |_| exact(h_bou(96.0) / PI, "clearance_m(0.12, 96, 192)/π"),
         ),
     ]
 }
@@ -218,7 +218,7 @@ fn layered_design() -> Vec<Target> {
             "eigenfrequency of the Sect. 6.2 beam (M 1.108 kg, K 484 N/m)",
             stated(3.33, "Hz", "D L2759"),
             abs(0.005),
-            || {
+            |_| {
                 let s = pdamp_structure::modal::ModalStructure::single_mode(1.108, 484.0, 0.0);
                 exact(
                     s.modes[0].frequency_hz,
@@ -232,7 +232,7 @@ fn layered_design() -> Vec<Target> {
             "bed mass for ζ_d = 0.044 on M = 1.108 kg (D: 196 g)",
             stated(0.196, "kg", "D L2769"),
             rel(0.01),
-            || {
+            |_| {
                 exact(
                     bed_mass_for_damping(1.108, 0.044, 0.5),
                     "bed_mass_for_damping(1.108, 0.044, 0.5)",

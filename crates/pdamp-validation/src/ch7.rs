@@ -22,7 +22,7 @@ pub fn targets() -> Vec<Target> {
         "eigenfrequency of the Ch. 7 beam from D's stated M = 1.139 kg, K = 1848 N/m",
         stated(5.56, "Hz", "D L3001"),
         abs(0.01),
-        || {
+        |_| {
             let s = ModalStructure::single_mode(1.139, 1848.0, 0.55);
             exact(
                 s.modes[0].frequency_hz,
@@ -41,7 +41,7 @@ pub fn targets() -> Vec<Target> {
             "clearance of 32 of 192 spheres",
             stated(0.100, "m", "D Eq. 7.4, L3008"),
             abs(1e-9),
-            || exact(clearance_m(0.12, 32.0, 192.0), "clearance_m(0.12, 32, 192)"),
+            |_| exact(clearance_m(0.12, 32.0, 192.0), "clearance_m(0.12, 32, 192)"),
         ),
         closed_form(
             "ch7.eq7_4.h_64",
@@ -49,7 +49,7 @@ pub fn targets() -> Vec<Target> {
             "clearance of 64 of 192 spheres",
             stated(0.080, "m", "D L3038"),
             abs(1e-9),
-            || exact(clearance_m(0.12, 64.0, 192.0), "clearance_m(0.12, 64, 192)"),
+            |_| exact(clearance_m(0.12, 64.0, 192.0), "clearance_m(0.12, 64, 192)"),
         ),
         closed_form(
             "ch7.masses.m_32",
@@ -57,7 +57,7 @@ pub fn targets() -> Vec<Target> {
             "bed mass of 32 steel spheres r = 5 mm",
             stated(0.131, "kg", "D L3008"),
             rel(0.02),
-            || {
+            |_| {
                 exact(
                     32.0 * pdamp_impact::hertz::sphere_mass(0.005, 7900.0),
                     "32·sphere_mass(0.005, 7900)",
@@ -70,7 +70,7 @@ pub fn targets() -> Vec<Target> {
             "maximal vertical loss factor for A ≫ g at X = h/π",
             worded(1.27, "4/π ≈ 1.27", "1", "D Eq. 7.16–7.18, L2939"),
             abs(0.01),
-            || {
+            |_| {
                 let s = BED.state(0.1 / PI, TAU * 200.0);
                 exact(
                     s.effective_loss_factor,
@@ -84,7 +84,7 @@ pub fn targets() -> Vec<Target> {
             "solid-like loss factor (A < g)",
             stated(0.001, "1", "D Eq. 7.5, L2875–2879"),
             abs(1e-12),
-            || {
+            |_| {
                 let s = BED.state(0.005, TAU * 5.0);
                 exact(s.effective_loss_factor, "VerticalDamper.state(0.005, 2π·5)")
             },
@@ -95,7 +95,7 @@ pub fn targets() -> Vec<Target> {
             "effective mass ratio of a solid-like bed",
             stated(0.75, "1", "D Eq. 7.19, L2980"),
             abs(1e-12),
-            || {
+            |_| {
                 let s = BED.state(0.005, TAU * 5.0);
                 exact(s.effective_mass_ratio, "VerticalDamper.state(0.005, 2π·5)")
             },
@@ -107,7 +107,7 @@ pub fn targets() -> Vec<Target> {
             "structural damping ratio of the Ch. 7 beam (D = 0.55 kg/s, M 1.514 kg)",
             worded(0.005, "≈ 0.005", "1", "D L3012"),
             abs(0.0005),
-            || {
+            |_| {
                 let s = ModalStructure::single_mode(1.514, 1848.0, 0.55);
                 exact(
                     s.modes[0].damping_ratio,

@@ -1,7 +1,9 @@
 //! D Ch. 8, high-excitation dampers: the bouncing optimum of the cube and cylinder designs
 //! (D Eq. 8.1/8.2) and the coated-wall design table (D Tab. 8.4, Eq. 8.5–8.12).
 
-use crate::{Target, abs, closed_form, exact, rel, stated};
+use crate::{
+    ComputeError, Context, Measured, Target, abs, closed_form, exact, quick_run, rel, stated,
+};
 use pdamp_structure::design::{CoatedWallDesign, CoatedWallInput, coated_wall_design};
 use pdamp_structure::formulas::clearance_m;
 use std::f64::consts::PI;
@@ -29,6 +31,7 @@ pub fn targets() -> Vec<Target> {
     let mut t = Vec::new();
     t.extend(bouncing_designs());
     t.extend(table_8_4());
+    t.extend(table_8_7());
     t
 }
 
@@ -41,7 +44,7 @@ fn bouncing_designs() -> Vec<Target> {
             "X_opt = h/π of 520 of 573 spheres r = 2.5 mm in the 40 mm cube",
             stated(1.2e-3, "m", "D Eq. 8.1, L3206"),
             abs(0.05e-3),
-            || {
+            |_| {
                 exact(
                     clearance_m(0.04, 520.0, 573.0) / PI,
                     "clearance_m(0.04, 520, 573)/π",
@@ -54,7 +57,7 @@ fn bouncing_designs() -> Vec<Target> {
             "X_opt of 58 of 65 spheres r = 5 mm in the cube",
             stated(1.4e-3, "m", "D L3221, L3252"),
             abs(0.05e-3),
-            || {
+            |_| {
                 exact(
                     clearance_m(0.04, 58.0, 65.0) / PI,
                     "clearance_m(0.04, 58, 65)/π",
@@ -67,7 +70,7 @@ fn bouncing_designs() -> Vec<Target> {
             "bed mass of the baseline: 4500 spheres r = 1.25 mm",
             stated(0.291, "kg", "D L3115"),
             rel(0.02),
-            || {
+            |_| {
                 exact(
                     4500.0 * pdamp_impact::hertz::sphere_mass(1.25e-3, 7900.0),
                     "4500·sphere_mass(1.25e-3, 7900)",
@@ -80,7 +83,7 @@ fn bouncing_designs() -> Vec<Target> {
             "bed mass of 40 spheres r = 5 mm",
             stated(0.166, "kg", "D L3330"),
             rel(0.02),
-            || {
+            |_| {
                 exact(
                     40.0 * pdamp_impact::hertz::sphere_mass(5e-3, 7900.0),
                     "40·sphere_mass(5e-3, 7900)",
@@ -99,7 +102,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall clearance h at f_d = 50 Hz",
             stated(4.7e-3, "m", TAB84),
             abs(0.1e-3),
-            || {
+            |_| {
                 exact(
                     coated(50.0).clearance_m,
                     "coated_wall_design(50 Hz).clearance_m",
@@ -112,7 +115,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall clearance h at 60 Hz",
             stated(3.3e-3, "m", TAB84),
             abs(0.1e-3),
-            || {
+            |_| {
                 exact(
                     coated(60.0).clearance_m,
                     "coated_wall_design(60 Hz).clearance_m",
@@ -125,7 +128,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall clearance h at 80 Hz",
             stated(1.9e-3, "m", TAB84),
             abs(0.1e-3),
-            || {
+            |_| {
                 exact(
                     coated(80.0).clearance_m,
                     "coated_wall_design(80 Hz).clearance_m",
@@ -138,7 +141,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall optimal stroke at 50 Hz",
             stated(1.5e-3, "m", TAB84),
             abs(0.07e-3),
-            || {
+            |_| {
                 exact(
                     coated(50.0).optimal_stroke_m,
                     "coated_wall_design(50 Hz).optimal_stroke_m",
@@ -151,7 +154,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall optimal stroke at 60 Hz",
             stated(1.1e-3, "m", TAB84),
             abs(0.07e-3),
-            || {
+            |_| {
                 exact(
                     coated(60.0).optimal_stroke_m,
                     "coated_wall_design(60 Hz).optimal_stroke_m",
@@ -164,7 +167,7 @@ fn table_8_4() -> Vec<Target> {
             "coated-wall optimal stroke at 80 Hz",
             stated(0.6e-3, "m", TAB84),
             abs(0.07e-3),
-            || {
+            |_| {
                 exact(
                     coated(80.0).optimal_stroke_m,
                     "coated_wall_design(80 Hz).optimal_stroke_m",
@@ -177,7 +180,7 @@ fn table_8_4() -> Vec<Target> {
             "coating modulus E_w (Eq. 8.11) at 50 Hz",
             stated(0.25e6, "Pa", TAB84),
             rel(0.05),
-            || {
+            |_| {
                 exact(
                     coated(50.0).wall_modulus_pa,
                     "coated_wall_design(50 Hz).wall_modulus_pa",
@@ -190,7 +193,7 @@ fn table_8_4() -> Vec<Target> {
             "coating modulus E_w at 60 Hz",
             stated(0.44e6, "Pa", TAB84),
             rel(0.05),
-            || {
+            |_| {
                 exact(
                     coated(60.0).wall_modulus_pa,
                     "coated_wall_design(60 Hz).wall_modulus_pa",
@@ -203,12 +206,131 @@ fn table_8_4() -> Vec<Target> {
             "coating modulus E_w at 80 Hz",
             stated(1.0e6, "Pa", TAB84),
             rel(0.05),
-            || {
+            |_| {
                 exact(
                     coated(80.0).wall_modulus_pa,
                     "coated_wall_design(80 Hz).wall_modulus_pa",
                 )
             },
+        ),
+    ]
+}
+
+/// The first four flexible eigenfrequencies (Hz) of beam No. 2 of D Sect. 8.2.1
+/// (`examples/structure_ch8_beam2.toml`: Tab. 8.6's row 2, 90 Timoshenko elements); with
+/// `swapped` the section of row 1 (1138 mm², 166 000 mm⁴), as if the table's rows were swapped.
+fn beam2_modes(ctx: &Context, swapped: bool) -> Result<Vec<f64>, ComputeError> {
+    let path = ctx.example("structure_ch8_beam2.toml");
+    let mut file = pdamp_structure::scenario::load_structure(&path).map_err(ComputeError::new)?;
+    if swapped {
+        let beam =
+            file.structure.beam.as_mut().ok_or_else(|| {
+                ComputeError::new("structure_ch8_beam2.toml has no [structure.beam]")
+            })?;
+        beam.area_m2 = Some(1138e-6);
+        beam.second_moment_m4 = Some(166_000e-12);
+    }
+    let base = path.parent().unwrap_or(std::path::Path::new("."));
+    let built = file.structure.build(base).map_err(ComputeError::new)?;
+    Ok(built.modal.modes.iter().map(|m| m.frequency_hz).collect())
+}
+
+/// Flexible mode `k` (0-based) of [`beam2_modes`].
+fn beam2_mode(ctx: &Context, k: usize, swapped: bool) -> Result<Measured, ComputeError> {
+    let f = beam2_modes(ctx, swapped)?;
+    let f = *f
+        .get(k)
+        .ok_or_else(|| ComputeError::new(format!("only {} modes", f.len())))?;
+    let how = if swapped {
+        "structure_ch8_beam2.toml with Tab. 8.6 row 1's section: modes"
+    } else {
+        "pdamp structure modes examples/structure_ch8_beam2.toml"
+    };
+    Ok(Measured::exact(f, how))
+}
+
+const TAB87: &str = "D Tab. 8.7, L3562–3570";
+const SWAPPED: Option<&str> = Some(
+    "Tab. 8.6's rows appear swapped (the text gives beam 2 6.6 kg and twice the height, the \
+     table the smaller section): with row 1's section the same model reproduces all four modes \
+     (rows *_swapped_rows)",
+);
+
+/// D Tab. 8.7: the eigenfrequencies of beam No. 2 (numeric column), with Tab. 8.6 as printed
+/// and with its rows swapped.
+fn table_8_7() -> Vec<Target> {
+    vec![
+        quick_run(
+            "ch8.tab8_7.mode1",
+            CH,
+            "beam 2, flexible mode 1 (Tab. 8.6 as printed)",
+            stated(51.8, "Hz", TAB87),
+            rel(0.03),
+            SWAPPED,
+            |c| beam2_mode(c, 0, false),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode2",
+            CH,
+            "beam 2, flexible mode 2 (Tab. 8.6 as printed)",
+            stated(155.0, "Hz", TAB87),
+            rel(0.03),
+            SWAPPED,
+            |c| beam2_mode(c, 1, false),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode3",
+            CH,
+            "beam 2, flexible mode 3 (Tab. 8.6 as printed)",
+            stated(316.0, "Hz", TAB87),
+            rel(0.03),
+            SWAPPED,
+            |c| beam2_mode(c, 2, false),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode4",
+            CH,
+            "beam 2, flexible mode 4 (Tab. 8.6 as printed)",
+            stated(534.0, "Hz", TAB87),
+            rel(0.03),
+            SWAPPED,
+            |c| beam2_mode(c, 3, false),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode1_swapped_rows",
+            CH,
+            "beam 2, mode 1, Tab. 8.6 rows swapped",
+            stated(51.8, "Hz", TAB87),
+            rel(0.03),
+            None,
+            |c| beam2_mode(c, 0, true),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode2_swapped_rows",
+            CH,
+            "beam 2, mode 2, Tab. 8.6 rows swapped",
+            stated(155.0, "Hz", TAB87),
+            rel(0.03),
+            None,
+            |c| beam2_mode(c, 1, true),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode3_swapped_rows",
+            CH,
+            "beam 2, mode 3, Tab. 8.6 rows swapped",
+            stated(316.0, "Hz", TAB87),
+            rel(0.03),
+            None,
+            |c| beam2_mode(c, 2, true),
+        ),
+        quick_run(
+            "ch8.tab8_7.mode4_swapped_rows",
+            CH,
+            "beam 2, mode 4, Tab. 8.6 rows swapped",
+            stated(534.0, "Hz", TAB87),
+            rel(0.03),
+            None,
+            |c| beam2_mode(c, 3, true),
         ),
     ]
 }

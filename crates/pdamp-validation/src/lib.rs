@@ -23,7 +23,7 @@ pub mod report;
 pub mod target;
 
 pub use target::{
-    Category, ComputeError, Measured, Reference, Row, Status, Target, Tier, Tolerance,
+    Category, ComputeError, Context, Measured, Reference, Row, Status, Target, Tier, Tolerance,
 };
 
 /// Every target, by chapter.
@@ -37,13 +37,13 @@ pub fn targets() -> Vec<Target> {
     t
 }
 
-/// Evaluates the targets of `tier` (a `Full` run also runs the `Quick` rows; a `Quick` run
-/// lists the `Full` rows as not run) in parallel, in the order of [`targets`].
-pub fn run(tier: Tier) -> Vec<Row> {
+/// Evaluates the targets of `tier` in `ctx` (a `Full` run also runs the `Quick` rows; a
+/// `Quick` run lists the `Full` rows as not run) in parallel, in the order of [`targets`].
+pub fn run(tier: Tier, ctx: &Context) -> Vec<Row> {
     use rayon::prelude::*;
     targets()
         .par_iter()
-        .map(|t| t.evaluate(tier == Tier::Full || t.tier == Tier::Quick))
+        .map(|t| t.evaluate(ctx, tier == Tier::Full || t.tier == Tier::Quick))
         .collect()
 }
 
@@ -79,7 +79,7 @@ pub(crate) fn closed_form(
     quantity: &'static str,
     reference: Reference,
     tolerance: Tolerance,
-    compute: fn() -> Result<Measured, ComputeError>,
+    compute: fn(&Context) -> Result<Measured, ComputeError>,
 ) -> Target {
     Target {
         id,
@@ -91,6 +91,25 @@ pub(crate) fn closed_form(
         tier: Tier::Quick,
         known_cause: None,
         compute,
+    }
+}
+
+/// A target computed by a run of pdamp taking under a second (a structure's modes, a
+/// steady-state sweep with formula dampers): `Quick`, with the measured cause where pdamp is
+/// known to differ.
+pub(crate) fn quick_run(
+    id: &'static str,
+    chapter: &'static str,
+    quantity: &'static str,
+    reference: Reference,
+    tolerance: Tolerance,
+    known_cause: Option<&'static str>,
+    compute: fn(&Context) -> Result<Measured, ComputeError>,
+) -> Target {
+    Target {
+        category: Category::Structure,
+        known_cause,
+        ..closed_form(id, chapter, quantity, reference, tolerance, compute)
     }
 }
 

@@ -133,6 +133,30 @@ impl ComputeError {
     }
 }
 
+/// Where a computation finds its inputs and puts its runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Context {
+    /// The repository's `examples/` folder (structure, coupling and scenario files).
+    pub examples_dir: std::path::PathBuf,
+    /// A folder for the outputs of the runs (one subfolder per target).
+    pub work_dir: std::path::PathBuf,
+}
+
+impl Context {
+    /// The examples of the repository pdamp was built from, runs under `work_dir`.
+    pub fn in_repository(work_dir: &std::path::Path) -> Self {
+        Self {
+            examples_dir: std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples"),
+            work_dir: work_dir.to_path_buf(),
+        }
+    }
+
+    /// The example file `name`.
+    pub fn example(&self, name: &str) -> std::path::PathBuf {
+        self.examples_dir.join(name)
+    }
+}
+
 /// One row of the validation table.
 #[derive(Debug, Clone, Copy)]
 pub struct Target {
@@ -155,7 +179,7 @@ pub struct Target {
     /// reproduced.
     pub known_cause: Option<&'static str>,
     /// pdamp's computation.
-    pub compute: fn() -> Result<Measured, ComputeError>,
+    pub compute: fn(&Context) -> Result<Measured, ComputeError>,
 }
 
 /// The verdict on one row.
@@ -201,8 +225,8 @@ pub struct Row {
 }
 
 impl Target {
-    /// Computes the target (unless `run` is false) and judges it.
-    pub fn evaluate(&self, run: bool) -> Row {
+    /// Computes the target in `ctx` (unless `run` is false) and judges it.
+    pub fn evaluate(&self, ctx: &Context, run: bool) -> Row {
         let mut row = Row {
             id: self.id,
             chapter: self.chapter,
@@ -219,7 +243,7 @@ impl Target {
         if !run {
             return row;
         }
-        match (self.compute)() {
+        match (self.compute)(ctx) {
             Err(e) => {
                 row.status = Status::Error;
                 row.note = Some(e.message);
@@ -304,18 +328,19 @@ mod tests {
             category: Category::ClosedForm,
             tier: Tier::Quick,
             known_cause: Some("because"),
-            compute: || Ok(Measured::exact(2.0, "2")),
+            compute: |_| Ok(Measured::exact(2.0, "2")),
         };
-        let r = t.evaluate(true);
+        let ctx = Context::in_repository(&std::env::temp_dir());
+        let r = t.evaluate(&ctx, true);
         assert_eq!(r.status, Status::NotReproduced);
         assert_eq!(r.note.as_deref(), Some("because"));
         assert_eq!(r.deviation, Some(1.0));
-        assert_eq!(t.evaluate(false).status, Status::NotRun);
+        assert_eq!(t.evaluate(&ctx, false).status, Status::NotRun);
         let e = Target {
-            compute: || Err(ComputeError::new("no")),
+            compute: |_| Err(ComputeError::new("no")),
             ..t
         };
-        let r = e.evaluate(true);
+        let r = e.evaluate(&ctx, true);
         assert_eq!((r.status, r.note.as_deref()), (Status::Error, Some("no")));
     }
 }
