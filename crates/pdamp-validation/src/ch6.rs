@@ -37,6 +37,21 @@ pub fn targets() -> Vec<Target> {
     t.extend(bouncing_model());
     t.extend(table_6_2());
     t.extend(layered_design());
+    t.push(crate::quick_run(
+        "ch6.fig6_6.zeta_achieved",
+        CH,
+        "layered design on the Sect. 6.2 beam: mean ζ over 10–45 mm (design ζ_d)",
+        stated(0.044, "1", "D L2769, Fig. 6.6"),
+        rel(0.15),
+        None,
+        |c| {
+            let d = crate::decay::free_decay(c, "couple_ch6_free_layers.toml")?;
+            Ok(crate::Measured::exact(
+                crate::decay::mean_damping_in(&d, 0.010..0.045)?,
+                "pdamp couple examples/couple_ch6_free_layers.toml: mean ζ at 10–45 mm",
+            ))
+        },
+    ));
     t
 }
 

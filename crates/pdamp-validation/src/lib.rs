@@ -19,6 +19,7 @@ pub mod ch5;
 pub mod ch6;
 pub mod ch7;
 pub mod ch8;
+pub mod decay;
 pub mod report;
 pub mod target;
 

@@ -138,7 +138,8 @@ impl ComputeError {
 pub struct Context {
     /// The repository's `examples/` folder (structure, coupling and scenario files).
     pub examples_dir: std::path::PathBuf,
-    /// A folder for the outputs of the runs (one subfolder per target).
+    /// A folder for the outputs of the runs ([`Target::evaluate`] gives each target a
+    /// subfolder named by its id).
     pub work_dir: std::path::PathBuf,
 }
 
@@ -243,7 +244,12 @@ impl Target {
         if !run {
             return row;
         }
-        match (self.compute)(ctx) {
+        // Every target runs in a folder of its own (targets run in parallel).
+        let ctx = Context {
+            work_dir: ctx.work_dir.join(self.id),
+            ..ctx.clone()
+        };
+        match (self.compute)(&ctx) {
             Err(e) => {
                 row.status = Status::Error;
                 row.note = Some(e.message);

@@ -1,0 +1,85 @@
+//! Free decays of the coupling examples (`pdamp couple`, analytical dampers) and the measures the
+//! references quote from them: ζ per cycle against the mean cycle amplitude, ζ over an amplitude
+//! band, the amplitude at a time.
+
+use crate::{ComputeError, Context};
+
+/// One cycle of a decay (`damping.csv`): mean amplitude (m), damping ratio, time (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cycle {
+    /// Mean amplitude of the cycle, m.
+    pub amplitude_m: f64,
+    /// Damping ratio of the cycle.
+    pub damping_ratio: f64,
+    /// Time of the cycle, s.
+    pub time_s: f64,
+}
+
+/// The cycles of the free decay of the coupling example `file`, run by `pdamp couple` into
+/// `ctx.work_dir`.
+pub fn free_decay(ctx: &Context, file: &str) -> Result<Vec<Cycle>, ComputeError> {
+    let out = ctx.work_dir.join(file.trim_end_matches(".toml"));
+    let _ = std::fs::remove_dir_all(&out);
+    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
+    pdamp_structure::report::run_couple(&ctx.example(file), &out, options, &mut |_| {})
+        .map_err(ComputeError::new)?;
+    let (header, rows) =
+        pdamp_io::csv::read_csv_f64(out.join("damping.csv")).map_err(ComputeError::new)?;
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|h| h == n)
+            .ok_or_else(|| ComputeError::new(format!("damping.csv has no column {n}")))
+    };
+    let (a, z, t) = (
+        col("mean_amplitude_m")?,
+        col("damping_ratio")?,
+        col("time_s")?,
+    );
+    Ok(rows
+        .iter()
+        .map(|r| Cycle {
+            amplitude_m: r[a],
+            damping_ratio: r[z],
+            time_s: r[t],
+        })
+        .collect())
+}
+
+/// Mean ζ of the cycles whose amplitude lies in `band` (m).
+pub fn mean_damping_in(cycles: &[Cycle], band: std::ops::Range<f64>) -> Result<f64, ComputeError> {
+    let z: Vec<f64> = cycles
+        .iter()
+        .filter(|c| band.contains(&c.amplitude_m))
+        .map(|c| c.damping_ratio)
+        .collect();
+    if z.is_empty() {
+        return Err(ComputeError::new(format!("no cycle between {band:?} m")));
+    }
+    Ok(z.iter().sum::<f64>() / z.len() as f64)
+}
+
+/// Largest ζ of the decay.
+pub fn max_damping(cycles: &[Cycle]) -> f64 {
+    cycles.iter().map(|c| c.damping_ratio).fold(0.0, f64::max)
+}
+
+/// The amplitude at time `t` (linear between the cycles around it), m.
+pub fn amplitude_at(cycles: &[Cycle], t: f64) -> Result<f64, ComputeError> {
+    let k = cycles
+        .iter()
+        .position(|c| c.time_s >= t)
+        .filter(|&k| k > 0)
+        .ok_or_else(|| ComputeError::new(format!("the decay does not span t = {t} s")))?;
+    let (c0, c1) = (cycles[k - 1], cycles[k]);
+    Ok(c0.amplitude_m
+        + (c1.amplitude_m - c0.amplitude_m) * (t - c0.time_s) / (c1.time_s - c0.time_s))
+}
+
+/// ζ of the first cycle.
+pub fn first_damping(cycles: &[Cycle]) -> Result<f64, ComputeError> {
+    cycles
+        .first()
+        .map(|c| c.damping_ratio)
+        .ok_or_else(|| ComputeError::new("the decay has no cycle"))
+}
