@@ -607,8 +607,59 @@ const OPTIMUM: &str = "couple_ch5_free_optimum.toml";
 /// the brute-force optimum (36, 36, 40) on the beam, approach 3). D's numbers are measurements:
 /// ±30 % where D gives no tighter statement.
 fn free_decays() -> Vec<Target> {
-    use crate::decay::{amplitude_at, first_damping, free_decay, max_damping, mean_damping_in};
+    use crate::decay::{
+        amplitude_at, amplitude_of_max_damping, first_damping, free_decay, max_damping,
+        mean_damping_in,
+    };
     vec![
+        quick_run(
+            "ch5.fig5_13.zeta_max",
+            CH,
+            "36 spheres from X_0 = 63 mm, rolling formulas: largest ζ per cycle (Eq. 3.52 ideal)",
+            stated(0.056, "1", "D L2311–2336, Fig. 5.13"),
+            rel(0.1),
+            None,
+            |c| {
+                let d = free_decay(c, "couple_ch5_free_formulas.toml")?;
+                Ok(Measured::exact(
+                    max_damping(&d),
+                    "pdamp couple examples/couple_ch5_free_formulas.toml: largest ζ",
+                ))
+            },
+        ),
+        quick_run(
+            "ch5.fig5_13.amplitude_of_zeta_max",
+            CH,
+            "36 spheres: amplitude of the largest ζ (experiment 13 mm)",
+            stated(0.013, "m", "D L2311–2336, Fig. 5.13"),
+            abs(2e-3),
+            None,
+            |c| {
+                let d = free_decay(c, "couple_ch5_free_formulas.toml")?;
+                Ok(Measured::exact(
+                    amplitude_of_max_damping(&d)?,
+                    "couple_ch5_free_formulas: amplitude of the cycle with the largest ζ",
+                ))
+            },
+        ),
+        quick_run(
+            "ch5.fig5_19.flexor_amplitude_5s",
+            CH,
+            "Flexor with (24, 28, 28, 28, 28): amplitude after 5 s (measured below 11 mm)",
+            worded(0.011, "< 11 mm", "m", "D L2441, Fig. 5.19"),
+            crate::Tolerance::Range {
+                lo: 0.0,
+                hi: 0.011 * 1.3,
+            },
+            None,
+            |c| {
+                let d = free_decay(c, "couple_ch5_flexor_formulas.toml")?;
+                Ok(Measured::exact(
+                    amplitude_at(&d, 5.0)?,
+                    "pdamp couple examples/couple_ch5_flexor_formulas.toml: amplitude at 5 s",
+                ))
+            },
+        ),
         quick_run(
             "ch5.fig5_15.zeta_first_cycle",
             CH,

@@ -7,6 +7,7 @@ use pdamp_structure::modal::ModalStructure;
 use std::f64::consts::{PI, TAU};
 
 const CH: &str = "D Ch. 7 — vertical dampers";
+const VERTICAL32: &str = "couple_ch7_free_vertical32.toml";
 
 /// The 32-sphere vertical bed of Sect. 7.2 (h = 100 mm).
 const BED: VerticalDamper = VerticalDamper {
@@ -16,6 +17,13 @@ const BED: VerticalDamper = VerticalDamper {
 
 /// The Ch. 7 targets.
 pub fn targets() -> Vec<Target> {
+    let mut t = model_and_structure();
+    t.extend(free_decay_32());
+    t
+}
+
+/// The vertical model's limits and the structure of Sect. 7.2.
+fn model_and_structure() -> Vec<Target> {
     let mut known = closed_form(
         "ch7.sec7_2_1.f0_stated_mass",
         CH,
@@ -113,6 +121,62 @@ pub fn targets() -> Vec<Target> {
                     s.modes[0].damping_ratio,
                     "ModalStructure::single_mode(1.514, 1848, 0.55)",
                 )
+            },
+        ),
+    ]
+}
+
+/// The measured free decay of Fig. 7.6 (32 spheres, vertical formulas, approach 3).
+fn free_decay_32() -> Vec<Target> {
+    vec![
+        crate::quick_run(
+            "ch7.fig7_6.zeta_first_cycle",
+            CH,
+            "32 spheres from X_0 = 58 mm, vertical formulas: ζ of the first cycle (D: ≈ 0.035 at 53 mm, measured)",
+            worded(0.035, "≈ 0.035", "1", "D L3010, Fig. 7.6"),
+            rel(0.3),
+            None,
+            |c| {
+                let d = crate::decay::free_decay(c, VERTICAL32)?;
+                Ok(crate::Measured::exact(
+                    crate::decay::first_damping(&d)?,
+                    "pdamp couple examples/couple_ch7_free_vertical32.toml: cycle 1",
+                ))
+            },
+        ),
+        crate::quick_run(
+            "ch7.fig7_6.zeta_rises",
+            CH,
+            "32 spheres: ζ rises from the first cycle to X = 41 mm (D: 0.035 → 0.05, ratio 1.43)",
+            worded(1.43, "rises (ratio > 1)", "1", "D L3010, Fig. 7.6"),
+            crate::Tolerance::Range {
+                lo: 1.0,
+                hi: f64::INFINITY,
+            },
+            None,
+            |c| {
+                let d = crate::decay::free_decay(c, VERTICAL32)?;
+                let r = crate::decay::damping_at_amplitude(&d, 0.041)?
+                    / crate::decay::first_damping(&d)?;
+                Ok(crate::Measured::exact(
+                    r,
+                    "couple_ch7_free_vertical32: ζ(41 mm)/ζ(cycle 1)",
+                ))
+            },
+        ),
+        crate::quick_run(
+            "ch7.fig7_6.zeta_41mm",
+            CH,
+            "32 spheres: ζ rising to 0.05 at X = 41 mm (experiment)",
+            stated(0.05, "1", "D L3010, Fig. 7.6"),
+            rel(0.3),
+            None,
+            |c| {
+                let d = crate::decay::free_decay(c, VERTICAL32)?;
+                Ok(crate::Measured::exact(
+                    crate::decay::damping_at_amplitude(&d, 0.041)?,
+                    "couple_ch7_free_vertical32: ζ at 41 mm",
+                ))
             },
         ),
     ]

@@ -83,3 +83,24 @@ pub fn first_damping(cycles: &[Cycle]) -> Result<f64, ComputeError> {
         .map(|c| c.damping_ratio)
         .ok_or_else(|| ComputeError::new("the decay has no cycle"))
 }
+
+/// ζ at amplitude `x` (m), linear between the two cycles around it (the cycles' amplitudes
+/// fall with time).
+pub fn damping_at_amplitude(cycles: &[Cycle], x: f64) -> Result<f64, ComputeError> {
+    let k = cycles
+        .windows(2)
+        .position(|w| (w[1].amplitude_m..=w[0].amplitude_m).contains(&x))
+        .ok_or_else(|| ComputeError::new(format!("the decay does not pass {x} m")))?;
+    let (c0, c1) = (cycles[k], cycles[k + 1]);
+    let s = (x - c0.amplitude_m) / (c1.amplitude_m - c0.amplitude_m);
+    Ok(c0.damping_ratio + s * (c1.damping_ratio - c0.damping_ratio))
+}
+
+/// Amplitude (m) of the cycle with the largest ζ.
+pub fn amplitude_of_max_damping(cycles: &[Cycle]) -> Result<f64, ComputeError> {
+    cycles
+        .iter()
+        .max_by(|a, b| a.damping_ratio.total_cmp(&b.damping_ratio))
+        .map(|c| c.amplitude_m)
+        .ok_or_else(|| ComputeError::new("the decay has no cycle"))
+}

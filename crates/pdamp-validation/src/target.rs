@@ -177,11 +177,14 @@ pub struct Target {
     pub tier: Tier,
     /// Why pdamp differs, where the difference is known and measured (a reference
     /// inconsistency, a model the reference does not state); printed beside a row that is not
-    /// reproduced.
+    /// reproduced (`None`: [`OPEN`]).
     pub known_cause: Option<&'static str>,
     /// pdamp's computation.
     pub compute: fn(&Context) -> Result<Measured, ComputeError>,
 }
+
+/// The note of a row that is not reproduced and whose cause is not known yet.
+pub const OPEN: &str = "cause not measured yet (open in the validation campaign)";
 
 /// The verdict on one row.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -262,7 +265,7 @@ impl Target {
                 row.status = if judge(self.tolerance, r, &m) {
                     Status::Reproduced
                 } else {
-                    row.note = self.known_cause.map(str::to_string);
+                    row.note = Some(self.known_cause.unwrap_or(OPEN).to_string());
                     Status::NotReproduced
                 };
                 row.measured = Some(m);

@@ -12,6 +12,14 @@ fn run(name: &str) -> Vec<Row> {
     rows
 }
 
+/// Rows that pdamp does not reproduce and whose cause is not measured yet (issue 25). A row
+/// leaves this list when it is reproduced or its cause is recorded; a new disagreement fails.
+const OPEN: [&str; 3] = [
+    "ch5.fig5_19.flexor_amplitude_5s",
+    "ch7.fig7_6.zeta_first_cycle",
+    "ch7.fig7_6.zeta_rises",
+];
+
 #[test]
 fn quick_rows_reproduce_the_references_or_name_their_cause() {
     let rows = run("verdicts");
@@ -22,6 +30,7 @@ fn quick_rows_reproduce_the_references_or_name_their_cause() {
         match r.status {
             Status::Reproduced => {}
             Status::NotReproduced if t.known_cause.is_some() => {}
+            Status::NotReproduced if OPEN.contains(&r.id) => {}
             _ => failures.push(format!(
                 "{} ({}): {:?} {:?} vs {} ({:?})",
                 r.id,
@@ -34,6 +43,15 @@ fn quick_rows_reproduce_the_references_or_name_their_cause() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    for id in OPEN {
+        let r = rows.iter().find(|r| r.id == id).unwrap();
+        assert_eq!(
+            r.status,
+            Status::NotReproduced,
+            "{id} is reproduced now: take it off the open list"
+        );
+        assert_eq!(r.note.as_deref(), Some(pdamp_validation::target::OPEN));
+    }
     // The one known inconsistency of D (Ch. 7's stated beam mass) stays visible.
     let ch7 = rows
         .iter()
