@@ -19,6 +19,7 @@ const BED: VerticalDamper = VerticalDamper {
 pub fn targets() -> Vec<Target> {
     let mut t = model_and_structure();
     t.extend(free_decay_32());
+    t.extend(layer_study());
     t
 }
 
@@ -178,6 +179,80 @@ fn free_decay_32() -> Vec<Target> {
                     "couple_ch7_free_vertical32: ζ at 41 mm",
                 ))
             },
+        ),
+    ]
+}
+
+/// The brute-force study of D Sect. 7.2.3 (`examples/study_ch7_vertical.toml`: particles in
+/// steps of 16, stroke at t = 0.8 s; D quotes 0.75 s), run by `pdamp structure optimize-layers`.
+fn study(ctx: &crate::Context) -> Result<serde_json::Value, crate::ComputeError> {
+    let out = ctx.work_dir.join("study_ch7_vertical");
+    let _ = std::fs::remove_dir_all(&out);
+    pdamp_structure::study::run_layer_study_file(&ctx.example("study_ch7_vertical.toml"), &out)
+        .map_err(crate::ComputeError::new)
+}
+
+/// The stroke (m) of the design with `particles` in the study's ten best (`0`: no damper).
+fn stroke_of(s: &serde_json::Value, particles: u64) -> Result<f64, crate::ComputeError> {
+    let entry = if particles == 0 {
+        Some(&s["no_particles"])
+    } else {
+        s["top_10"].as_array().and_then(|top| {
+            top.iter()
+                .find(|v| v["particles"] == serde_json::json!([particles]))
+        })
+    };
+    entry.and_then(|v| v["stroke_m"].as_f64()).ok_or_else(|| {
+        crate::ComputeError::new(format!("{particles} particles not among the ten best"))
+    })
+}
+
+const STUDY: &str = "pdamp structure optimize-layers examples/study_ch7_vertical.toml";
+
+/// D Sect. 7.2.3 and Fig. 7.7: the optimum particle number and the strokes after 0.75 s.
+fn layer_study() -> Vec<Target> {
+    vec![
+        crate::quick_run(
+            "ch7.sec7_2_3.optimum_particles",
+            CH,
+            "brute-force optimum particle number (steps of 16, smallest stroke)",
+            stated(64.0, "1", "D L3038"),
+            abs(0.5),
+            None,
+            |c| {
+                let s = study(c)?;
+                let n = s["best"]["particles"][0]
+                    .as_f64()
+                    .ok_or_else(|| crate::ComputeError::new("no best design"))?;
+                Ok(crate::Measured::exact(n, STUDY))
+            },
+        ),
+        crate::quick_run(
+            "ch7.fig7_7.stroke_undamped",
+            CH,
+            "stroke without particles after 0.75 s (pdamp: 0.8 s)",
+            stated(0.051, "m", "D L3042"),
+            abs(2e-3),
+            None,
+            |c| Ok(crate::Measured::exact(stroke_of(&study(c)?, 0)?, STUDY)),
+        ),
+        crate::quick_run(
+            "ch7.fig7_7.stroke_64",
+            CH,
+            "stroke with 64 particles after 0.75 s (measured; pdamp: 0.8 s)",
+            worded(0.010, "≈ 10 mm", "m", "D L3042"),
+            rel(0.3),
+            None,
+            |c| Ok(crate::Measured::exact(stroke_of(&study(c)?, 64)?, STUDY)),
+        ),
+        crate::quick_run(
+            "ch7.fig7_7.stroke_32",
+            CH,
+            "stroke with 32 particles after 0.75 s (measured; pdamp: 0.8 s)",
+            stated(0.019, "m", "D L3042"),
+            rel(0.3),
+            None,
+            |c| Ok(crate::Measured::exact(stroke_of(&study(c)?, 32)?, STUDY)),
         ),
     ]
 }
