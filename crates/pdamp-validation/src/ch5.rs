@@ -597,6 +597,15 @@ fn table_5_2() -> Vec<Target> {
             ),
             |c| couple_damping_ratio(c, "couple_ch5_forced_u2mm.toml"),
         ),
+        quick_run(
+            "ch5.fig5_25.zeta_u_opt",
+            CH,
+            "steady-state ζ at U_opt = 1.34 mm, rolling formulas with the jump at X_opt smoothed",
+            stated(0.048, "1", "D L2522, Fig. 5.25 (simulation)"),
+            rel(0.15),
+            None,
+            |c| couple_damping_ratio(c, "couple_ch5_forced_uopt.toml"),
+        ),
     ]
 }
 
