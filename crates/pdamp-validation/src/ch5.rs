@@ -558,11 +558,7 @@ fn bed_masses() -> Vec<Target> {
 /// ζ of the steady-state FRF (D Eq. 3.47) of a coupling file of the examples, run by
 /// `pdamp couple` into the work folder.
 fn couple_damping_ratio(ctx: &Context, file: &str) -> Result<Measured, ComputeError> {
-    let out = ctx.work_dir.join(file.trim_end_matches(".toml"));
-    let _ = std::fs::remove_dir_all(&out);
-    let options = pdamp_scenario::run::RunOptions::new(0.0, false);
-    let v = pdamp_structure::report::run_couple(&ctx.example(file), &out, options, &mut |_| {})
-        .map_err(ComputeError::new)?;
+    let (v, _) = crate::decay::run_couple_example(ctx, file)?;
     let z = v["damping_ratio_eq_3_47"]
         .as_f64()
         .ok_or_else(|| ComputeError::new("no damping_ratio_eq_3_47 in the summary"))?;

@@ -1,5 +1,5 @@
-//! Free decays of the coupling examples (`pdamp couple`, analytical dampers) and the measures the
-//! references quote from them: ζ per cycle against the mean cycle amplitude, ζ over an amplitude
+//! Runs of the coupling examples (`pdamp couple`, analytical dampers), their free decays and the
+//! measures the references quote from them: ζ per cycle against the mean cycle amplitude, ζ over an amplitude
 //! band, the amplitude at a time.
 
 use crate::{ComputeError, Context};
@@ -15,14 +15,24 @@ pub struct Cycle {
     pub time_s: f64,
 }
 
-/// The cycles of the free decay of the coupling example `file`, run by `pdamp couple` into
-/// `ctx.work_dir`.
-pub fn free_decay(ctx: &Context, file: &str) -> Result<Vec<Cycle>, ComputeError> {
+/// Runs the coupling example `file` by `pdamp couple` into a fresh folder of `ctx.work_dir`;
+/// returns its summary and the folder.
+pub fn run_couple_example(
+    ctx: &Context,
+    file: &str,
+) -> Result<(serde_json::Value, std::path::PathBuf), ComputeError> {
     let out = ctx.work_dir.join(file.trim_end_matches(".toml"));
     let _ = std::fs::remove_dir_all(&out);
     let options = pdamp_scenario::run::RunOptions::new(0.0, false);
-    pdamp_structure::report::run_couple(&ctx.example(file), &out, options, &mut |_| {})
-        .map_err(ComputeError::new)?;
+    let summary =
+        pdamp_structure::report::run_couple(&ctx.example(file), &out, options, &mut |_| {})
+            .map_err(ComputeError::new)?;
+    Ok((summary, out))
+}
+
+/// The cycles of the free decay of the coupling example `file` ([`run_couple_example`]).
+pub fn free_decay(ctx: &Context, file: &str) -> Result<Vec<Cycle>, ComputeError> {
+    let (_, out) = run_couple_example(ctx, file)?;
     let (header, rows) =
         pdamp_io::csv::read_csv_f64(out.join("damping.csv")).map_err(ComputeError::new)?;
     let col = |n: &str| {
