@@ -6,9 +6,8 @@
 //!   best design must have D's total mass within 5 % and D's design must be within 15 % of the
 //!   best stroke and among the ten best of 455.
 //! - D Sect. 7.2.3 (`examples/study_ch7_vertical.toml`): one vertical bed in steps of 16, stroke
-//!   at 0.8 s. D's optimum 64 particles; here 64 must be within 20 % of the best stroke, the
-//!   best within 48…128 (flat optimum, see docs/structure.md), and every filled design better
-//!   than the empty container's 51 mm (D: 51 mm undamped at 0.75 s).
+//!   at 0.8 s. D's optimum 64 particles is not reproduced (96); the test asserts D's undamped
+//!   51 mm and the measured cause, a flat valley from 64 to 128 spheres.
 
 use std::path::Path;
 
@@ -48,26 +47,46 @@ fn ch5_layer_optimum_matches_dissertation() {
     assert!(ds <= 1.15 * best_stroke);
 }
 
+/// D Sect. 7.2.3 is not reproduced (optimum 96, D 64; `pdamp validate` row
+/// ch7.sec7_2_3.optimum_particles). What is asserted is D's undamped stroke and the measured
+/// cause: the objective is flat — every filling from 64 to 128 spheres reaches the solid-like
+/// floor g (M + m̄)/K ≈ 9–11 mm by 0.8 s and their strokes lie within 20 % of each other — so the
+/// brute-force optimum is decided inside that valley. The best stroke is within 30 % of the
+/// measured 10 mm (D L3042, 64 particles).
 #[test]
-fn ch7_vertical_optimum_matches_dissertation() {
+fn ch7_vertical_study_reaches_the_floor_from_64_particles() {
     let s = run("study_ch7_vertical.toml");
-    let best = &s["best"];
-    let n_best = best["particles"][0].as_u64().unwrap();
-    let best_stroke = best["stroke_m"].as_f64().unwrap();
     let top: Vec<&serde_json::Value> = s["top_10"].as_array().unwrap().iter().collect();
-    let d = top
-        .iter()
-        .find(|v| v["particles"] == serde_json::json!([64]))
-        .expect("64 among the ten best");
-    let ds = d["stroke_m"].as_f64().unwrap();
+    let stroke = |n: u64| {
+        top.iter()
+            .find(|v| v["particles"] == serde_json::json!([n]))
+            .and_then(|v| v["stroke_m"].as_f64())
+            .unwrap_or_else(|| panic!("{n} particles among the ten best"))
+    };
+    let valley: Vec<f64> = (4..=8).map(|k| stroke(16 * k)).collect();
+    let best = s["best"]["stroke_m"].as_f64().unwrap();
     let empty = s["no_particles"]["stroke_m"].as_f64().unwrap();
     println!(
-        "best {n_best} particles: {:.1} mm; 64 particles {:.1} mm; empty {:.1} mm",
-        best_stroke * 1e3,
-        ds * 1e3,
+        "best {:?} {:.1} mm; 64..128: {:?} mm; 32: {:.1} mm; empty {:.1} mm",
+        s["best"]["particles"],
+        best * 1e3,
+        valley
+            .iter()
+            .map(|x| (x * 1e4).round() / 10.0)
+            .collect::<Vec<_>>(),
+        stroke(32) * 1e3,
         empty * 1e3
     );
-    assert!((48..=128).contains(&n_best));
-    assert!(ds <= 1.2 * best_stroke);
-    assert!((empty - 0.051).abs() < 0.002, "{empty}");
+    assert!((empty - 0.051).abs() < 0.002, "undamped {empty} (D 51 mm)");
+    let hi = valley.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        hi <= 1.2 * best,
+        "64–128 spheres not within 20 % of the best: {valley:?}"
+    );
+    assert!(
+        (best / 0.010 - 1.0).abs() < 0.3,
+        "best stroke {best} (D ≈ 10 mm)"
+    );
+    // 32 spheres decay slower than 64 (D: 19 against 10 mm)
+    assert!(stroke(32) > 1.5 * stroke(64));
 }

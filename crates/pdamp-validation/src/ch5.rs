@@ -38,6 +38,15 @@ fn bed_mass(n: f64) -> f64 {
     n * pdamp_impact::hertz::sphere_mass(0.005, 7900.0)
 }
 
+/// Why the Flexor decay from D Eq. 5.19's start misses the measured 5 s amplitude (measured,
+/// 2026-12-07).
+const FLEXOR_START: &str = "the 5 s amplitude is decided by the start: the same damper from the \
+    unscaled 78 mm is at 11.9 mm after 5 s (row ch5.fig5_19.flexor_amplitude_5s_from_78mm), and \
+    pdamp's brute force over the five layers finds D's 24/28-sphere layers only from 78 mm (best \
+    [20, 20, 20, 24, 24]; from 104 mm [8, 12, 12, 12, 16], D's design rank 1059 of 3003): D's \
+    optimisation and formula curve appear to start from 78 mm; the experiment's undamped 1.09 Hz \
+    (model 0.99 Hz) takes the 78 mm decay to 8.7 mm";
+
 /// The Ch. 5 targets.
 pub fn targets() -> Vec<Target> {
     let mut t = Vec::new();
@@ -656,12 +665,30 @@ fn free_decays() -> Vec<Target> {
                 lo: 0.0,
                 hi: 0.011 * 1.3,
             },
-            None,
+            Some(FLEXOR_START),
             |c| {
                 let d = free_decay(c, "couple_ch5_flexor_formulas.toml")?;
                 Ok(Measured::exact(
                     amplitude_at(&d, 5.0)?,
                     "pdamp couple examples/couple_ch5_flexor_formulas.toml: amplitude at 5 s",
+                ))
+            },
+        ),
+        quick_run(
+            "ch5.fig5_19.flexor_amplitude_5s_from_78mm",
+            CH,
+            "Flexor with (24, 28, 28, 28, 28) from the unscaled X_0 = 78 mm: amplitude after 5 s (measured below 11 mm)",
+            worded(0.011, "< 11 mm", "m", "D L2441, Fig. 5.19"),
+            crate::Tolerance::Range {
+                lo: 0.0,
+                hi: 0.011 * 1.3,
+            },
+            None,
+            |c| {
+                let d = free_decay(c, "couple_ch5_flexor_formulas_x78.toml")?;
+                Ok(Measured::exact(
+                    amplitude_at(&d, 5.0)?,
+                    "pdamp couple examples/couple_ch5_flexor_formulas_x78.toml: amplitude at 5 s",
                 ))
             },
         ),

@@ -133,7 +133,7 @@ fn free_decay_32() -> Vec<Target> {
         crate::quick_run(
             "ch7.fig7_6.zeta_first_cycle",
             CH,
-            "32 spheres from X_0 = 58 mm, vertical formulas: ζ of the first cycle (D: ≈ 0.035 at 53 mm, measured)",
+            "32 spheres from X_0 = 58 mm, vertical formulas: ζ of the first cycle between negative peaks (D: ≈ 0.035 at 53 mm, measured)",
             worded(0.035, "≈ 0.035", "1", "D L3010, Fig. 7.6"),
             rel(0.3),
             None,
@@ -148,7 +148,7 @@ fn free_decay_32() -> Vec<Target> {
         crate::quick_run(
             "ch7.fig7_6.zeta_rises",
             CH,
-            "32 spheres: ζ rises from the first cycle to X = 41 mm (D: 0.035 → 0.05, ratio 1.43)",
+            "32 spheres: ζ rises from the first cycle to X = 41 mm, negative peaks (D: 0.035 → 0.05, ratio 1.43)",
             worded(1.43, "rises (ratio > 1)", "1", "D L3010, Fig. 7.6"),
             crate::Tolerance::Range {
                 lo: 1.0,
@@ -180,6 +180,51 @@ fn free_decay_32() -> Vec<Target> {
                 ))
             },
         ),
+        crate::quick_run(
+            "ch7.fig7_6.solid_like_time",
+            CH,
+            "32 spheres: time from which the particles hardly damp (their share of ζ, ζ − ζ_structure, below the structure's own 0.0052)",
+            stated(1.66, "s", "D L3012, Fig. 7.6"),
+            abs(0.2),
+            None,
+            |c| {
+                let d = crate::decay::free_decay(c, VERTICAL32)?;
+                let z_s = ModalStructure::single_mode(1.514, 1848.0, 0.55).modes[0].damping_ratio;
+                Ok(crate::Measured::exact(
+                    crate::decay::time_damping_falls_below(&d, 2.0 * z_s)?,
+                    "couple_ch7_free_vertical32: first time ζ per cycle < 2·0.0052",
+                ))
+            },
+        ),
+        closed_form(
+            "ch7.sec7_2_2.x_min",
+            CH,
+            "smallest amplitude X_min = g/ω_bed² (32 spheres as static mass)",
+            stated(0.0088, "m", "D L3012"),
+            abs(2e-4),
+            |_| {
+                let g = pdamp_dem::math::STANDARD_GRAVITY_M_S2;
+                exact(
+                    g * (1.514 + 0.131) / 1848.0,
+                    "g (M + m_bed)/K, M 1.514 kg, K 1848 N/m",
+                )
+            },
+        ),
+        closed_form(
+            "ch7.sec7_2_2.undamped_2s",
+            CH,
+            "amplitude of the structure without particles after 2 s from X_0 = 58 mm",
+            worded(0.040, "about 40 mm", "m", "D L3012"),
+            abs(1e-3),
+            |_| {
+                let m = ModalStructure::single_mode(1.514, 1848.0, 0.55).modes[0];
+                let w = TAU * m.frequency_hz;
+                exact(
+                    0.058 * (-m.damping_ratio * w * 2.0).exp(),
+                    "0.058·exp(−ζ ω_0 · 2 s), single_mode(1.514, 1848, 0.55)",
+                )
+            },
+        ),
     ]
 }
 
@@ -209,6 +254,20 @@ fn stroke_of(s: &serde_json::Value, particles: u64) -> Result<f64, crate::Comput
 
 const STUDY: &str = "pdamp structure optimize-layers examples/study_ch7_vertical.toml";
 
+/// Why the vertical brute force does not give D's 64 (measured, 2026-12-07).
+const FLAT_VALLEY: &str = "the objective is flat: 64, 80, 96, 112 and 128 spheres give 13.8, 12.4, \
+    11.8, 12.0 and 12.3 mm at 0.8 s (all within 17 %), every one close to the solid-like floor \
+    g(M + m̄)/K ≈ 9–11 mm; the optimum moves inside that valley with the evaluation time (0.75 s: \
+    112) and the structure data (D's printed M = 1.139 kg: 112; M 1.139 kg with K = 1390 N/m, \
+    which give D's 5.56 Hz: 128), so D's 64 is one point of a valley the model does not resolve";
+
+/// Why the model's strokes lie above the measured ones (measured, 2026-12-07).
+const SLOW_SINGLE: &str = "after the switch from double to single collect-and-collide (X just \
+    below X_opt = 32 mm) the vertical formulas give η̄ = 0.38–0.58 (at 5.4 Hz the bed lands \
+    after the container has turned down, Ωt_imp > 2π, Eq. 7.6–7.9 as printed) and ζ per cycle \
+    0.020–0.027, where the experiment's 34 → 19 mm in two cycles needs ζ ≈ 0.046; the double \
+    collect-and-collide cycles before match (ζ 0.043 and 0.049 against 0.035 and 0.05)";
+
 /// D Sect. 7.2.3 and Fig. 7.7: the optimum particle number and the strokes after 0.75 s.
 fn layer_study() -> Vec<Target> {
     vec![
@@ -218,7 +277,7 @@ fn layer_study() -> Vec<Target> {
             "brute-force optimum particle number (steps of 16, smallest stroke)",
             stated(64.0, "1", "D L3038"),
             abs(0.5),
-            None,
+            Some(FLAT_VALLEY),
             |c| {
                 let s = study(c)?;
                 let n = s["best"]["particles"][0]
@@ -242,7 +301,7 @@ fn layer_study() -> Vec<Target> {
             "stroke with 64 particles after 0.75 s (measured; pdamp: 0.8 s)",
             worded(0.010, "≈ 10 mm", "m", "D L3042"),
             rel(0.3),
-            None,
+            Some(SLOW_SINGLE),
             |c| Ok(crate::Measured::exact(stroke_of(&study(c)?, 64)?, STUDY)),
         ),
         crate::quick_run(
@@ -251,7 +310,7 @@ fn layer_study() -> Vec<Target> {
             "stroke with 32 particles after 0.75 s (measured; pdamp: 0.8 s)",
             stated(0.019, "m", "D L3042"),
             rel(0.3),
-            None,
+            Some(SLOW_SINGLE),
             |c| Ok(crate::Measured::exact(stroke_of(&study(c)?, 32)?, STUDY)),
         ),
     ]

@@ -114,3 +114,15 @@ pub fn amplitude_of_max_damping(cycles: &[Cycle]) -> Result<f64, ComputeError> {
         .map(|c| c.amplitude_m)
         .ok_or_else(|| ComputeError::new("the decay has no cycle"))
 }
+
+/// The time (s) at which ζ per cycle first falls below `z`, linear between the two cycles
+/// around the crossing.
+pub fn time_damping_falls_below(cycles: &[Cycle], z: f64) -> Result<f64, ComputeError> {
+    let k = cycles
+        .windows(2)
+        .position(|w| w[0].damping_ratio >= z && w[1].damping_ratio < z)
+        .ok_or_else(|| ComputeError::new(format!("ζ per cycle never falls below {z}")))?;
+    let (c0, c1) = (cycles[k], cycles[k + 1]);
+    let s = (z - c0.damping_ratio) / (c1.damping_ratio - c0.damping_ratio);
+    Ok(c0.time_s + s * (c1.time_s - c0.time_s))
+}

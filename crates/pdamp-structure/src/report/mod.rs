@@ -444,7 +444,7 @@ impl CoupledRun<'_> {
 
 fn free_outputs(
     structure: &ModalStructure,
-    _scn: &CoupleScenario,
+    scn: &CoupleScenario,
     spec: &FreeVibrationSpec,
     hist: &TimeHistory,
     out: &Path,
@@ -459,7 +459,8 @@ fn free_outputs(
     )
     .map_err(io)?;
     let f_k = structure.modes[spec.mode].frequency_hz;
-    let peaks = free::decay_peaks(hist, 0.5 / f_k)?;
+    let which = scn.analysis.decay_peaks();
+    let peaks = free::signed_decay_peaks(hist, 0.5 / f_k, which)?;
     let cyc = free::damping_per_cycle(&peaks);
     let drows: Vec<[f64; 4]> = cyc
         .iter()
@@ -510,7 +511,7 @@ fn free_outputs(
         &urows,
     )
     .map_err(io)?;
-    // Plots: decay with envelope (positive peaks) and the bare structure's envelope.
+    // Plots: decay with the envelope of the evaluated peaks and the bare structure's envelope.
     let z = structure.modes[spec.mode].damping_ratio;
     let w = TAU * f_k;
     // With D Eq. 5.19 the run starts from the scaled displacement: the output point's first
@@ -519,10 +520,14 @@ fn free_outputs(
         (true, Some(x)) if spec.output_point == spec.initial_point => x.abs(),
         _ => spec.initial_displacement_m.abs(),
     };
+    let (label, sign) = match which {
+        free::DecayPeaks::Positive => ("envelope (positive peaks)", 1.0),
+        free::DecayPeaks::Negative => ("envelope (negative peaks)", -1.0),
+    };
     let env: Vec<f64> = hist
         .time_s
         .iter()
-        .map(|t| x0 * (-z * w * t).exp())
+        .map(|t| sign * x0 * (-z * w * t).exp())
         .collect();
     let mut p = LinePlot::new(Axis::linear("time (s)"), Axis::linear("displacement (m)"));
     p.series.push(Series::new(
@@ -532,9 +537,9 @@ fn free_outputs(
     ));
     p.series.push(
         Series::new(
-            "envelope (positive peaks)",
+            label,
             peaks.iter().map(|p| p.0).collect(),
-            peaks.iter().map(|p| p.1).collect(),
+            peaks.iter().map(|p| sign * p.1).collect(),
         )
         .with_marker(Marker::Circle),
     );
@@ -559,6 +564,7 @@ fn free_outputs(
     let max_z = cyc.iter().map(|c| c.damping_ratio).fold(f64::NAN, f64::max);
     Ok(json!({
         "analysis": "free",
+        "decay_peaks": which,
         "cycles": cyc.len(),
         "initial_amplitude_m": x0,
         "final_peak_amplitude_m": peaks.last().map(|p| p.1),

@@ -549,6 +549,10 @@ pub enum AnalysisSpec {
         /// Update rule for approaches 2/3.
         #[serde(default)]
         update: UpdateRule,
+        /// Peaks between which ζ per cycle is evaluated (`damping.csv`): `positive` (default,
+        /// D Sect. 5.1.2) or `negative` (D Sect. 7.2, vertical dampers released downwards).
+        #[serde(default)]
+        decay_peaks: crate::free::DecayPeaks,
         /// Store every n-th step.
         #[serde(default = "one_usize")]
         sample_every: usize,
@@ -620,6 +624,14 @@ pub enum AnalysisSpec {
 }
 
 impl AnalysisSpec {
+    /// The peaks a free decay's ζ per cycle is taken between (positive for the other kinds).
+    pub fn decay_peaks(&self) -> crate::free::DecayPeaks {
+        match self {
+            AnalysisSpec::Free { decay_peaks, .. } => *decay_peaks,
+            _ => crate::free::DecayPeaks::Positive,
+        }
+    }
+
     /// The free-vibration settings of a `kind = "free"` analysis (`None` for the others);
     /// `mode` becomes 0-based.
     pub fn free_vibration_spec(&self) -> Option<crate::free::FreeVibrationSpec> {
@@ -635,6 +647,7 @@ impl AnalysisSpec {
                 output_point,
                 update,
                 sample_every,
+                ..
             } => Some(crate::free::FreeVibrationSpec {
                 duration_s: *duration_s,
                 time_step_s: *time_step_s,
