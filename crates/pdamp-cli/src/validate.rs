@@ -50,7 +50,16 @@ pub(crate) fn run(a: ValidateArgs) -> Result<()> {
     } else {
         "pdamp validate --quick"
     };
-    report::write(&a.out, &rows, tier, command)?;
+    // A full run's rows take minutes: its wall time goes into the table (the quick table stays
+    // the same from run to run, docs/validation.md is compared with it).
+    let run_line = a.full.then(|| {
+        format!(
+            "Wall time of this run: {:.0} s with {} threads.\n",
+            start.elapsed().as_secs_f64(),
+            rayon::current_num_threads()
+        )
+    });
+    report::write_with(&a.out, &rows, tier, command, run_line.as_deref())?;
     traced.write(&a.out)?;
     dir.set_status(pdamp_io::output_dir::RunStatus::Finished);
     dir.close()?;

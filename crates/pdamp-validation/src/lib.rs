@@ -20,6 +20,7 @@ pub mod ch6;
 pub mod ch7;
 pub mod ch8;
 pub mod decay;
+pub mod dem_point;
 pub mod report;
 pub mod target;
 
@@ -109,6 +110,24 @@ pub(crate) fn quick_run(
 ) -> Target {
     Target {
         category: Category::Structure,
+        known_cause,
+        ..closed_form(id, chapter, quantity, reference, tolerance, compute)
+    }
+}
+
+/// A target computed by DEM runs of one damper (ensembles of dropped beds, minutes): `Full`.
+pub(crate) fn dem_run(
+    id: &'static str,
+    chapter: &'static str,
+    quantity: &'static str,
+    reference: Reference,
+    tolerance: Tolerance,
+    known_cause: Option<&'static str>,
+    compute: fn(&Context) -> Result<Measured, ComputeError>,
+) -> Target {
+    Target {
+        category: Category::Damper,
+        tier: Tier::Full,
         known_cause,
         ..closed_form(id, chapter, quantity, reference, tolerance, compute)
     }

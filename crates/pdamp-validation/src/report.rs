@@ -168,6 +168,10 @@ pub fn markdown(rows: &[Row], tier: Tier, command: &str) -> String {
             let note = match &r.note {
                 Some(n) if how.is_empty() => n.clone(),
                 Some(n) => format!("{how}; {n}"),
+                None if r.status == Status::NotRun => {
+                    "a simulation row: run by `pdamp validate --full` (docs/validation-full.md)"
+                        .to_string()
+                }
                 None => how,
             };
             let _ = writeln!(
@@ -191,10 +195,24 @@ pub fn markdown(rows: &[Row], tier: Tier, command: &str) -> String {
 
 /// Writes `dir/validation.md` and `dir/validation.csv` atomically.
 pub fn write(dir: &Path, rows: &[Row], tier: Tier, command: &str) -> std::io::Result<()> {
+    write_with(dir, rows, tier, command, None)
+}
+
+/// [`write`] with a line about the run (its wall time and threads, for a `Full` run whose
+/// rows take minutes) under the summary of `validation.md`.
+pub fn write_with(
+    dir: &Path,
+    rows: &[Row],
+    tier: Tier,
+    command: &str,
+    run_line: Option<&str>,
+) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     pdamp_io::atomic::write_atomic(dir.join("validation.csv"), csv(rows).as_bytes())?;
-    pdamp_io::atomic::write_atomic(
-        dir.join("validation.md"),
-        markdown(rows, tier, command).as_bytes(),
-    )
+    let mut md = markdown(rows, tier, command);
+    if let Some(line) = run_line {
+        let at = md.find("\n## ").unwrap_or(md.len());
+        md.insert_str(at, &format!("{line}\n"));
+    }
+    pdamp_io::atomic::write_atomic(dir.join("validation.md"), md.as_bytes())
 }
