@@ -437,3 +437,47 @@ pub fn damping_per_cycle(peaks: &[(f64, f64)]) -> Vec<CycleDamping> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A linear decay x = x0 e^{−ζωt} cos(ω_d t) released at rest (to first order in ζ) from
+    /// −58 mm: the negative peaks start with the release point and give ζ per cycle exactly
+    /// (D Eq. 3.40, 3.41); the positive peaks give the same ζ one half cycle later.
+    #[test]
+    fn decay_peaks_of_either_sign_start_at_the_release_and_give_zeta() {
+        let (zeta, f, x0) = (0.04_f64, 5.0_f64, -0.058_f64);
+        let w = std::f64::consts::TAU * f;
+        let wd = w * (1.0 - zeta * zeta).sqrt();
+        let dt = 1e-5;
+        let n = (2.0 / dt) as usize;
+        let mut hist = TimeHistory::default();
+        for i in 0..n {
+            let t = i as f64 * dt;
+            let e = (-zeta * w * t).exp();
+            // x and ẋ of the damped free response from (x0, 0)
+            let x = x0 * e * ((wd * t).cos() + zeta * w / wd * (wd * t).sin());
+            let v = -x0 * e * w * w / wd * (wd * t).sin();
+            hist.time_s.push(t);
+            hist.displacement_m.push(x);
+            hist.velocity_m_s.push(v);
+        }
+        assert_eq!(hist.velocity_m_s[0], 0.0);
+        let neg = signed_decay_peaks(&hist, 0.5 / f, DecayPeaks::Negative).unwrap();
+        assert_eq!(neg[0], (0.0, 0.058));
+        assert!((neg[1].0 - 1.0 / (f * (1.0 - zeta * zeta).sqrt())).abs() < 2e-4);
+        let pos = signed_decay_peaks(&hist, 0.5 / f, DecayPeaks::Positive).unwrap();
+        assert!(
+            pos[0].0 > 0.09 && pos[0].0 < 0.11,
+            "first positive peak half a period in"
+        );
+        for peaks in [neg, pos] {
+            let cycles = damping_per_cycle(&peaks);
+            assert!(cycles.len() >= 8);
+            for c in cycles {
+                assert!((c.damping_ratio / zeta - 1.0).abs() < 1e-3, "{c:?}");
+            }
+        }
+    }
+}
