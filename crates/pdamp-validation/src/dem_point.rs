@@ -121,3 +121,132 @@ pub fn peak_along_amplitudes(
         ),
     })
 }
+
+/// One point of an ensemble field: the means over the packings and the 95 % half-width of η̄.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldPoint {
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Intensity Γ = A/g.
+    pub intensity: f64,
+    /// Mean η̄.
+    pub loss_factor: f64,
+    /// 95 % confidence half-width of the mean η̄.
+    pub loss_factor_ci95_half_width: f64,
+    /// Mean m̄_bed/m_bed.
+    pub mass_ratio: f64,
+    /// Packings.
+    pub packings: usize,
+}
+
+type FieldCell = std::sync::Arc<std::sync::OnceLock<Result<Vec<FieldPoint>, ComputeError>>>;
+
+/// Fields already run in this process, by example and grid: rows that quote points of the same
+/// field (D Tab. 8.3 and 8.5 on the same beds) run it once, whichever row asks first.
+static FIELDS: std::sync::Mutex<Vec<(String, FieldCell)>> = std::sync::Mutex::new(Vec::new());
+
+/// The ensemble field of the damper example `file` over `frequencies_hz` × `intensities` with
+/// the packings of its `[damper]`, as `pdamp fields` computes it (every packing's bed made
+/// once and driven at every point), run once per process into `runs/fields/` beside the
+/// targets' folders.
+pub fn ensemble_field(
+    ctx: &Context,
+    file: &str,
+    frequencies_hz: &[f64],
+    intensities: &[f64],
+) -> Result<Vec<FieldPoint>, ComputeError> {
+    let key = format!(
+        "{}|{file}|{frequencies_hz:?}|{intensities:?}",
+        ctx.examples_dir.display()
+    );
+    let cell = {
+        let mut all = FIELDS.lock().unwrap_or_else(|e| e.into_inner());
+        match all.iter().find(|(k, _)| *k == key) {
+            Some((_, c)) => c.clone(),
+            None => {
+                let c = FieldCell::default();
+                all.push((key, c.clone()));
+                c
+            }
+        }
+    };
+    cell.get_or_init(|| run_field(ctx, file, frequencies_hz, intensities))
+        .clone()
+}
+
+fn run_field(
+    ctx: &Context,
+    file: &str,
+    frequencies_hz: &[f64],
+    intensities: &[f64],
+) -> Result<Vec<FieldPoint>, ComputeError> {
+    use pdamp_scenario::schema::{AxisSpec, FieldsSpec};
+    let path = ctx.example(file);
+    let (mut sc, _) =
+        pdamp_scenario::schema::Scenario::load_and_build(&path).map_err(ComputeError::new)?;
+    sc.fields = Some(FieldsSpec {
+        frequencies_hz: AxisSpec::List(frequencies_hz.to_vec()),
+        amplitudes_m: None,
+        accelerations_m_s2: None,
+        intensities: Some(AxisSpec::List(intensities.to_vec())),
+    });
+    sc.validate().map_err(ComputeError::new)?;
+    let runs = ctx.work_dir.parent().unwrap_or(&ctx.work_dir);
+    let out = runs.join("fields").join(format!(
+        "{}_{}",
+        file.trim_end_matches(".toml"),
+        frequencies_hz.len() * intensities.len()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    let base = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let outcome = pdamp_design::report::run_fields_scenario(&sc, &base, &out, |_| {}, |_, _| {})
+        .map_err(ComputeError::new)?;
+    let packings = sc.damper.as_ref().map_or(1, |d| d.packings);
+    let half = if packings > 1 {
+        let (header, rows) =
+            pdamp_io::csv::read_csv_f64(out.join("fields.csv")).map_err(ComputeError::new)?;
+        let c = header
+            .iter()
+            .position(|h| h == "effective_loss_factor_ci95_half_width")
+            .ok_or_else(|| ComputeError::new("fields.csv without the ensemble columns"))?;
+        rows.iter().map(|r| r[c]).collect()
+    } else {
+        vec![0.0; outcome.points.len()]
+    };
+    Ok(outcome
+        .points
+        .iter()
+        .zip(half)
+        .map(|(p, h)| FieldPoint {
+            frequency_hz: p.frequency_hz,
+            intensity: p.intensity,
+            loss_factor: p.effective_loss_factor,
+            loss_factor_ci95_half_width: h,
+            mass_ratio: p.effective_mass_ratio,
+            packings,
+        })
+        .collect())
+}
+
+/// η̄ of the field point at (`f_hz`, `intensity`) as a [`Measured`] with its confidence
+/// interval.
+pub fn field_point(
+    points: &[FieldPoint],
+    f_hz: f64,
+    intensity: f64,
+    how: &str,
+) -> Result<Measured, ComputeError> {
+    let p = points
+        .iter()
+        .find(|p| (p.frequency_hz - f_hz).abs() < 1e-9 && (p.intensity - intensity).abs() < 1e-6)
+        .ok_or_else(|| ComputeError::new(format!("no point at {f_hz} Hz, Γ = {intensity}")))?;
+    Ok(Measured {
+        value: p.loss_factor,
+        ci95: Some((
+            p.loss_factor - p.loss_factor_ci95_half_width,
+            p.loss_factor + p.loss_factor_ci95_half_width,
+        )),
+        runs: p.packings,
+        how: format!("{how}; m̄/m_bed {:.2}", p.mass_ratio),
+    })
+}
