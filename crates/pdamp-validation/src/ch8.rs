@@ -521,9 +521,11 @@ fn baseline_dem() -> Vec<Target> {
 }
 
 /// Why the baseline's DEM η̄ stays low (measured, 2026-12-07).
-const BASELINE_CAUSE: &str = "the collect-and-collide optimum of pdamp's baseline lies near X = 2 mm, \
-    not at D's 1 mm: along 100 Hz one bed gives η̄ 0.06/0.035/0.56/1.33/0.85 at X = 0.5/1.0/1.5/2.0/ \
-    3.0 mm (Γ 20/40/60/80/120), i.e. an effective clearance of ≈ 6 mm where the bed as filled has \
-    3.06 mm; more cycles change nothing (40 evaluated cycles: 0.060 ± 0.003 and 0.057 ± 0.094 at \
-    Γ 20/40 on the same three beds); after the 90° turn the bed slumps and spans the whole length \
-    with the free volume as a 5 mm void along the top (bed_statistics.json: axial clearance 0)";
+const BASELINE_CAUSE: &str = "pdamp's collect-and-collide optimum of the baseline lies near \
+    X = 2 mm, not at D's 1 mm: along 100 Hz one bed gives η̄ 0.06/0.035/0.56/1.33/0.85 at X = \
+    0.5/1.0/1.5/2.0/3.0 mm (Γ 20/40/60/80/120), an effective clearance of ≈ 6 mm where the bed as \
+    filled leaves 2.7–3.1 mm. Measured and ruled out (one to three beds each): more cycles (40 \
+    evaluated: 0.060 ± 0.003 and 0.057 ± 0.094 at Γ 20/40), the slump after the 90° turn (a bed \
+    kept as filled, with its axial gap: 0.061/0.059/0.74 at Γ 20/40/60), softening (D's moduli \
+    0.063/0.066), a constant ε = 0.5 instead of the ε(v) tables (0.17 at Γ 40); still open: why \
+    the bed needs twice the stroke (bed dilation in flight, D's integrator and contact law)";
