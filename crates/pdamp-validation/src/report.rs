@@ -198,7 +198,7 @@ pub fn write(dir: &Path, rows: &[Row], tier: Tier, command: &str) -> std::io::Re
     write_with(dir, rows, tier, command, None)
 }
 
-/// [`write`] with a line about the run (its wall time and threads, for a `Full` run whose
+/// [`write()`] with a line about the run (its wall time and threads, for a `Full` run whose
 /// rows take minutes) under the summary of `validation.md`.
 pub fn write_with(
     dir: &Path,
