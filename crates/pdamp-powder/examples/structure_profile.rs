@@ -43,7 +43,7 @@ fn main() {
         t0.elapsed().as_secs_f64() / 20.0 * 1e3
     );
     {
-        use pdamp_powder::fe::sparse::Cholesky;
+        use pdamp_fem::Cholesky;
         let t0 = Instant::now();
         let c = Cholesky::new(&s.k0).unwrap();
         println!(
@@ -57,7 +57,7 @@ fn main() {
             c.solve_in_place(&mut b);
         }
         println!("solve {:.3} ms", t0.elapsed().as_secs_f64() / 20.0 * 1e3);
-        let mut c = pdamp_powder::fe::sparse::SingleCholesky::new(&s.k0).unwrap();
+        let mut c = pdamp_fem::SingleCholesky::new(&s.k0).unwrap();
         let t0 = Instant::now();
         for _ in 0..20 {
             c.solve_in_place(&mut b);

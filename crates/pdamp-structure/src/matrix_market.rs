@@ -636,38 +636,34 @@ pub fn check_structural_pair(
             }
         }
     }
-    let ms = crate::sparse::SparseSym::from_triplets(n, &m.entries, false)?;
-    let perm = crate::sparse::rcm_order(&ms);
-    let not_pd = || MatrixMarketError::PairMatrix {
-        matrix: "mass",
-        file: m_file.to_string(),
-        message: "the mass matrix is not positive definite (its LDLᵀ factorization has a \
-                  non-positive pivot): a dof without mass or a wrong sign; give every dof mass \
-                  or remove it from the export"
-            .to_string(),
+    let sparse = |a: &CooMatrix| {
+        crate::sparse::SymmetricCsr::from_triplets(n, &a.entries, false)
+            .map_err(crate::sparse::SparseError::from)
     };
-    let fac = crate::sparse::SkylineLdlt::factor(&ms, &perm).map_err(|_| not_pd())?;
-    if fac.negative_pivots() > 0 {
-        return Err(not_pd());
+    let ms = sparse(m)?;
+    if !pdamp_fem::is_positive_definite(&ms) {
+        return Err(MatrixMarketError::PairMatrix {
+            matrix: "mass",
+            file: m_file.to_string(),
+            message: "the mass matrix is not positive definite (its Cholesky factorization has \
+                      a non-positive pivot): a dof without mass or a wrong sign; give every dof \
+                      mass or remove it from the export"
+                .to_string(),
+        });
     }
     let ratio = kd.iter().zip(&md).map(|(a, b)| a / b).fold(0.0, f64::max);
     if ratio > 0.0 && ratio.is_finite() {
+        // K + σM is positive definite exactly when every eigenvalue of (K, M) exceeds −σ
         let sigma = 1e-8 * ratio;
-        let ks = crate::sparse::SparseSym::from_triplets(n, &k.entries, false)?;
-        let shifted = ks.shifted(-sigma, &ms);
-        let perm = crate::sparse::rcm_order(&shifted);
-        let negative = match crate::sparse::SkylineLdlt::factor(&shifted, &perm) {
-            Ok(f) => f.negative_pivots(),
-            Err(_) => 0, // singular at the shift: an eigenvalue at −σ exactly, not decided here
-        };
-        if negative > 0 {
+        if !pdamp_fem::is_positive_definite(&sparse(k)?.shifted(-sigma, &ms)) {
             return Err(MatrixMarketError::PairMatrix {
                 matrix: "stiffness",
                 file: k_file.to_string(),
                 message: format!(
-                    "the stiffness matrix is not positive semi-definite: {negative} eigenvalue(s) \
-                     of (K, M) lie below −{sigma:e} (1/s²); check the sign of the export and that \
-                     K holds no stress-stiffening or follower terms"
+                    "the stiffness matrix is not positive semi-definite: an eigenvalue of \
+                     (K, M) lies below −{sigma:e} (1/s²) (the Cholesky factorization of \
+                     K + {sigma:e}·M has a non-positive pivot); check the sign of the export and \
+                     that K holds no stress-stiffening or follower terms"
                 ),
             });
         }

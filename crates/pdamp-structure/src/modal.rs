@@ -3,7 +3,8 @@
 //! The generalized eigenproblem $(K - \omega_k^2 M)\phi^{(k)} = 0$ is solved densely: with the
 //! Cholesky factor $M = L L^T$ it becomes the standard symmetric problem
 //! $L^{-1} K L^{-T} y = \omega^2 y$, $\phi = L^{-T} y$, which gives mass-normalised shapes
-//! ($\Phi^T M \Phi = E$, $\Phi^T K \Phi = \Omega$). Dense is adequate up to a few thousand dof.
+//! ($\Phi^T M \Phi = E$, $\Phi^T K \Phi = \Omega$), by faer's dense self-adjoint eigensolver
+//! ([`pdamp_fem::dense_lowest_modes`]). Dense is adequate up to a few thousand dof.
 
 use crate::StructureError;
 use nalgebra::DMatrix;
@@ -31,72 +32,19 @@ pub fn lowest_modes(
     n_modes: usize,
     min_frequency_hz: f64,
 ) -> Result<ModalBasis, StructureError> {
-    let n = stiffness.nrows();
-    if stiffness.ncols() != n || mass.nrows() != n || mass.ncols() != n {
-        return Err(StructureError::numerical(format!(
-            "K is {}×{}, M is {}×{}: both must be square and equal",
-            stiffness.nrows(),
-            stiffness.ncols(),
-            mass.nrows(),
-            mass.ncols()
-        )));
-    }
-    if n == 0 {
-        return Err(StructureError::numerical("empty model (no active dof)"));
-    }
     if stiffness.iter().chain(mass.iter()).any(|v| !v.is_finite()) {
         return Err(StructureError::numerical("K or M has non-finite entries"));
     }
-    let chol = nalgebra::Cholesky::new(mass.clone()).ok_or_else(|| {
-        StructureError::numerical(
-            "the mass matrix is not positive definite (a dof has stiffness but no mass: add \
-             rotary inertia or a point mass, or fix the dof)",
-        )
-    })?;
-    let l = chol.l();
-    // A = L⁻¹ K L⁻ᵀ
-    let x = l
-        .solve_lower_triangular(stiffness)
-        .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
-    let a = l
-        .solve_lower_triangular(&x.transpose())
-        .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
-    let a = (&a + a.transpose()) * 0.5;
-    let eig = nalgebra::SymmetricEigen::new(a);
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    let lt = l.transpose();
-    let mut omegas = Vec::new();
-    let mut cols = Vec::new();
-    for &i in &order {
-        let w = eig.eigenvalues[i].max(0.0).sqrt();
-        if w / TAU < min_frequency_hz {
-            continue;
-        }
-        if omegas.len() == n_modes {
-            break;
-        }
-        let y = eig.eigenvectors.column(i).into_owned();
-        let mut phi = lt
-            .solve_upper_triangular(&y)
-            .ok_or_else(|| StructureError::numerical("singular Cholesky factor"))?;
-        // Sign convention: the largest component positive.
-        let imax = phi.iamax();
-        if phi[imax] < 0.0 {
-            phi = -phi;
-        }
-        omegas.push(w);
-        cols.push(phi);
-    }
-    if cols.is_empty() {
-        return Err(StructureError::numerical(format!(
-            "no mode above {min_frequency_hz} Hz"
-        )));
-    }
-    Ok(ModalBasis {
-        omega_rad_s: omegas,
-        shapes: DMatrix::from_columns(&cols),
-    })
+    let faer_of =
+        |a: &DMatrix<f64>| faer::Mat::<f64>::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)]);
+    let modes = pdamp_fem::dense_lowest_modes(
+        faer_of(stiffness).as_ref(),
+        faer_of(mass).as_ref(),
+        n_modes,
+        min_frequency_hz,
+    )
+    .map_err(|e| StructureError::numerical(e.to_string()))?;
+    Ok(crate::sparse::basis_of(modes))
 }
 
 /// One mode of the reduced structure.

@@ -2,8 +2,8 @@
 
 use super::{BeamSpec, LoadSpec};
 use crate::couple::Interface;
-use crate::fe::sparse::SolverError;
 use crate::fe::{self, Aabb, HexMesh, LoadRamp, Structure, SurfaceLoad};
+use pdamp_fem::EigenError;
 
 /// Builds the structure of the scenario: mesh, clamp (z = 0), pressure on x = 0, gravity.
 pub fn build_structure(beam: &BeamSpec, load: &LoadSpec, gravity: [f64; 3]) -> (Structure, usize) {
@@ -42,7 +42,7 @@ pub fn cavity_interface(s: &Structure, cavity: &Aabb) -> Interface {
 }
 
 /// First bending frequencies \[Hz\] of the empty beam (no powder), `count` lowest modes.
-pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, SolverError> {
+pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, EigenError> {
     let (s, _) = build_structure(
         beam,
         &LoadSpec {
@@ -52,7 +52,7 @@ pub fn empty_beam_modes(beam: &BeamSpec, count: usize) -> Result<Vec<f64>, Solve
         },
         [0.0; 3],
     );
-    fe::modes::lowest_modes(&s, count, 300).map(|(f, _)| f)
+    fe::modes::lowest_modes(&s, count).map(|(f, _)| f)
 }
 
 /// First bending frequency of the empty beam from piecewise Timoshenko theory (solid bottom,

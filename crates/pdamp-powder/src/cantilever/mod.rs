@@ -33,13 +33,13 @@ use crate::couple::{CoupleError, CoupledEnergy, CouplingSettings};
 use crate::damping::TableOneRatios;
 use crate::error::ParameterError;
 use crate::fe::gen_alpha::DynamicsError;
-use crate::fe::sparse::SolverError;
 use crate::fe::{Aabb, BoxMeshDivisions, HexMesh, MassKind, Rayleigh, SvkMaterial};
 use crate::health::HealthError;
 use crate::law::PowderLaw;
 use crate::prep::{PrepError, PrepReport, PrepSettings};
 use crate::psd::LogNormal;
 use crate::vtk::SnapshotError;
+use pdamp_fem::EigenError;
 
 fn d_len() -> f64 {
     0.132
@@ -325,7 +325,7 @@ pub enum CantileverError {
     Health(#[from] Box<HealthError>),
     /// The modal analysis failed.
     #[error(transparent)]
-    Solver(#[from] SolverError),
+    Modes(#[from] EigenError),
     /// A ParaView frame could not be written.
     #[error(transparent)]
     Snapshot(#[from] SnapshotError),

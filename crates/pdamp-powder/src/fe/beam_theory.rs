@@ -105,57 +105,10 @@ pub fn timoshenko_f1(
         .map(|q| k[(q / nf + 2) * n + q % nf + 2])
         .collect();
     let mf: Vec<f64> = (0..nf).map(|q| m[(q + 2) * n + q + 2]).collect();
-    // dense Cholesky of K, inverse iteration on K⁻¹M
-    let mut l = kf.clone();
-    for j in 0..nf {
-        let mut d = l[j * nf + j];
-        for p in 0..j {
-            d -= l[j * nf + p] * l[j * nf + p];
-        }
-        let d = d.sqrt();
-        l[j * nf + j] = d;
-        for i in j + 1..nf {
-            let mut v = l[i * nf + j];
-            for p in 0..j {
-                v -= l[i * nf + p] * l[j * nf + p];
-            }
-            l[i * nf + j] = v / d;
-        }
-    }
-    let solve = |b: &mut [f64]| {
-        for i in 0..nf {
-            let mut v = b[i];
-            for p in 0..i {
-                v -= l[i * nf + p] * b[p];
-            }
-            b[i] = v / l[i * nf + i];
-        }
-        for i in (0..nf).rev() {
-            let mut v = b[i];
-            for p in i + 1..nf {
-                v -= l[p * nf + i] * b[p];
-            }
-            b[i] = v / l[i * nf + i];
-        }
-    };
-    let mut x: Vec<f64> = (0..nf)
-        .map(|i| if i % 2 == 0 { (i + 1) as f64 } else { 0.0 })
-        .collect();
-    let mut lam = 0.0;
-    for _ in 0..200 {
-        let mut y: Vec<f64> = x.iter().zip(&mf).map(|(a, b)| a * b).collect();
-        solve(&mut y);
-        let num: f64 = y.iter().zip(&mf).zip(&x).map(|((a, m), b)| a * m * b).sum();
-        let den: f64 = y.iter().zip(&mf).map(|(a, m)| a * m * a).sum();
-        let new = num / den; // Rayleigh quotient estimate of 1/ω² ... inverted below
-        let nrm = den.sqrt();
-        x = y.iter().map(|a| a / nrm).collect();
-        if (new - lam).abs() <= 1e-14 * new.abs() {
-            lam = new;
-            break;
-        }
-        lam = new;
-    }
-    // lam ≈ (xᵀ M y)/(yᵀ M y) with y = K⁻¹ M x → ω² for the converged vector
-    lam.sqrt() / (2.0 * std::f64::consts::PI)
+    // the lowest mode of the clamped pencil by faer's dense eigensolver
+    let kd = faer::Mat::<f64>::from_fn(nf, nf, |i, j| kf[i * nf + j]);
+    let md = faer::Mat::<f64>::from_fn(nf, nf, |i, j| if i == j { mf[i] } else { 0.0 });
+    let modes = pdamp_fem::dense_lowest_modes(kd.as_ref(), md.as_ref(), 1, 0.0)
+        .expect("a clamped beam with positive lumped masses has a lowest mode");
+    modes.omega_rad_s[0] / (2.0 * std::f64::consts::PI)
 }

@@ -17,8 +17,8 @@
 //! refactorizes with the current tangent in every iteration (quadratic convergence, for large
 //! deformations).
 
-use super::sparse::{Cholesky, CsrMatrix, SingleCholesky, SolverError};
 use super::structure::Structure;
+use pdamp_fem::{Cholesky, FactorError, SingleCholesky, SymmetricCsr};
 
 /// The factor of the effective tangent: single precision for modified Newton (the residual
 /// that decides convergence is double precision, see [`SingleCholesky`]; measured on the
@@ -47,7 +47,7 @@ impl TangentFactor {
         }
     }
 
-    fn refactor(&mut self, a: &CsrMatrix) -> Result<(), SolverError> {
+    fn refactor(&mut self, a: &SymmetricCsr) -> Result<(), FactorError> {
         match self {
             Self::Double(c) => c.refactor(a),
             Self::Single(_) => {
@@ -107,7 +107,7 @@ pub struct Rayleigh {
 pub enum DynamicsError {
     /// Factorization failure.
     #[error(transparent)]
-    Solver(#[from] SolverError),
+    Solver(#[from] FactorError),
     /// Newton did not converge.
     #[error(
         "Newton did not converge at t = {t_s} s after {iterations} iterations (residual {residual:e})"
@@ -139,7 +139,7 @@ pub enum DynamicsError {
     /// The double-precision factor a checkpoint state asks for failed
     /// ([`Dynamics::restore_state`]).
     #[error("structure state: {0}")]
-    StateFactor(#[source] SolverError),
+    StateFactor(#[source] FactorError),
 }
 
 /// Newton settings.
@@ -199,7 +199,7 @@ pub struct Dynamics {
     /// Settings.
     pub newton: NewtonSettings,
     rayleigh: Rayleigh,
-    keff: CsrMatrix,
+    keff: SymmetricCsr,
     factor: TangentFactor,
     // free-dof work vectors
     r: Vec<f64>,
@@ -353,7 +353,7 @@ impl Dynamics {
     /// Recomputes the factor of the reference effective matrix in double precision and keeps
     /// it for the rest of the run (done automatically when the single-precision factor stops
     /// converging; callable for a run that wants it from the start).
-    pub fn use_double_factor(&mut self) -> Result<(), SolverError> {
+    pub fn use_double_factor(&mut self) -> Result<(), FactorError> {
         if matches!(self.factor, TangentFactor::Single(_)) {
             self.factor = TangentFactor::Double(Cholesky::new(&self.keff)?);
         }
@@ -508,8 +508,8 @@ fn effective_matrix(
     p: &GenAlpha,
     dt: f64,
     ray: &Rayleigh,
-    k: &CsrMatrix,
-) -> CsrMatrix {
+    k: &SymmetricCsr,
+) -> SymmetricCsr {
     let cm = (1.0 - p.alpha_m) / (p.beta * dt * dt);
     let cc = (1.0 - p.alpha_f) * p.gamma / (p.beta * dt);
     let ck = 1.0 - p.alpha_f;

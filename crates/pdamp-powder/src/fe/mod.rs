@@ -8,7 +8,6 @@ pub mod hex8;
 pub mod mesh;
 pub mod modes;
 pub mod quad;
-pub mod sparse;
 pub mod structure;
 pub mod svk;
 

@@ -5,8 +5,8 @@
 //! Constrained dofs are eliminated; matrices live on the free dofs.
 
 use super::mesh::{Face, HexMesh};
-use super::sparse::CsrMatrix;
 use super::svk::{self, GaussPoint, SvkMaterial};
+use pdamp_fem::SymmetricCsr;
 
 /// Time history of a load factor.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -68,13 +68,13 @@ pub struct Structure {
     /// Free index → global dof.
     pub free_dofs: Vec<usize>,
     /// Mass matrix on the free dofs (pattern equal to the stiffness pattern).
-    pub mass: CsrMatrix,
+    pub mass: SymmetricCsr,
     /// The mass matrix per free node (`mass` = `mass_nodal` ⊗ I₃, both kinds): the products
     /// with the mass matrix use it ([`Structure::mass_mul`]), a third of the entries of `mass`,
     /// whose pattern is the stiffness pattern so that effective matrices can be combined.
-    pub mass_nodal: CsrMatrix,
+    pub mass_nodal: SymmetricCsr,
     /// Tangent stiffness at the reference configuration (free dofs).
-    pub k0: CsrMatrix,
+    pub k0: SymmetricCsr,
     /// Surface loads.
     pub loads: Vec<SurfaceLoad>,
     /// Constant body-force vector (gravity) on all dofs \[N\].
@@ -171,8 +171,8 @@ impl Structure {
             }
         }
         let nfree = free_dofs.len();
-        let mass = CsrMatrix::from_triplets(nfree, tm);
-        let mass_nodal = CsrMatrix::from_triplets(nfree / 3, tn);
+        let mass = SymmetricCsr::assemble(nfree, tm);
+        let mass_nodal = SymmetricCsr::assemble(nfree / 3, tn);
         let mut s = Structure {
             mesh,
             material,
@@ -181,7 +181,7 @@ impl Structure {
             free_dofs,
             mass,
             mass_nodal,
-            k0: CsrMatrix::default(),
+            k0: SymmetricCsr::default(),
             loads: Vec::new(),
             body_force,
             elem_free,
@@ -240,7 +240,7 @@ impl Structure {
     }
 
     /// Tangent stiffness at displacement `d` (all dofs) on the free dofs.
-    pub fn tangent(&self, d: &[f64]) -> CsrMatrix {
+    pub fn tangent(&self, d: &[f64]) -> SymmetricCsr {
         let (lam, mu) = self.material.lame();
         let mut t = Vec::with_capacity(self.mesh.elements.len() * 576);
         for (e, el) in self.mesh.elements.iter().enumerate() {
@@ -261,7 +261,7 @@ impl Structure {
                 }
             }
         }
-        CsrMatrix::from_triplets(self.free_dofs.len(), t)
+        SymmetricCsr::assemble(self.free_dofs.len(), t)
     }
 
     /// Internal forces (all dofs) and strain energy \[J\] at `d`.

@@ -7,8 +7,9 @@ pub mod beam;
 pub mod hex8;
 pub mod plate;
 
-use crate::sparse::{SparseError, SparseSym};
+use crate::sparse::SymmetricCsr;
 use nalgebra::{DMatrix, Vector3};
+use pdamp_fem::SparseError;
 use serde::{Deserialize, Serialize};
 
 pub use beam::BeamSection;
@@ -220,9 +221,9 @@ pub struct Assembled {
 #[derive(Debug, Clone)]
 pub struct AssembledSparse {
     /// Stiffness matrix K, N/m.
-    pub stiffness: SparseSym,
+    pub stiffness: SymmetricCsr,
     /// Mass matrix M, kg.
-    pub mass: SparseSym,
+    pub mass: SymmetricCsr,
     /// (node, dof) of each row.
     pub dofs: Vec<(usize, Dof)>,
 }
@@ -586,7 +587,7 @@ impl FeModel {
                 .filter_map(|&(i, j, v)| Some((map[i]?, map[j]?, v)))
                 .filter(|e| e.2 != 0.0)
                 .collect();
-            SparseSym::from_triplets(rows.len(), &v, false)
+            SymmetricCsr::from_triplets(rows.len(), &v, false)
         };
         Ok(AssembledSparse {
             stiffness: sel(&k)?,

@@ -185,8 +185,10 @@ impl StructureSpec {
         let rows = self.dof_map_rows(&map, &dp)?;
         let n = k.nrows;
         let (basis, solver) = if self.wants_sparse(n) {
-            let ks = crate::sparse::SparseSym::from_triplets(n, &k.entries, false)?;
-            let ms = crate::sparse::SparseSym::from_triplets(n, &m.entries, false)?;
+            let ks = crate::sparse::SymmetricCsr::from_triplets(n, &k.entries, false)
+                .map_err(crate::sparse::SparseError::from)?;
+            let ms = crate::sparse::SymmetricCsr::from_triplets(n, &m.entries, false)
+                .map_err(crate::sparse::SparseError::from)?;
             let basis =
                 crate::sparse::lowest_modes_sparse(&ks, &ms, self.n_modes, self.min_frequency_hz)?;
             (basis, "sparse")
