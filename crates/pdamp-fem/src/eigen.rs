@@ -219,11 +219,14 @@ pub fn lowest_modes(
 
 /// Mode-shape columns as a matrix, each with its largest component positive.
 fn columns(n: usize, cols: Vec<Vec<f64>>) -> Mat<f64> {
-    Mat::from_fn(n, cols.len(), |i, j| {
-        let c = &cols[j];
-        let imax = (0..n).fold(0, |b, k| if c[k].abs() > c[b].abs() { k } else { b });
-        if c[imax] < 0.0 { -c[i] } else { c[i] }
-    })
+    let signs: Vec<f64> = cols
+        .iter()
+        .map(|c| {
+            let imax = (0..n).fold(0, |b, k| if c[k].abs() > c[b].abs() { k } else { b });
+            if c[imax] < 0.0 { -1.0 } else { 1.0 }
+        })
+        .collect();
+    Mat::from_fn(n, cols.len(), |i, j| signs[j] * cols[j][i])
 }
 
 /// The `p` dominant eigenpairs of the shift-inverted operator (faer Krylov–Schur) as
