@@ -31,7 +31,7 @@ pub mod cantilever;
 pub mod couple;
 pub mod damping;
 pub mod error;
-pub mod fe;
+pub use pdamp_fem::solid as fe;
 pub mod fuzz;
 pub mod health;
 pub mod law;

@@ -1,8 +1,8 @@
 //! Wall time of the sparse modal reduction (`pdamp_structure::sparse::lowest_modes_sparse`) on
 //! clamped hex8 bars and a free–free plate-like block of growing size, with the first and last
 //! frequency: `cargo run --release -p pdamp-structure --example sparse_modes_bench`.
-//! The same source ran against the previous solver (skyline LDLᵀ + subspace iteration) for
-//! the comparison in docs/structure.md.
+//! The same source ran against the previous solver (skyline LDLᵀ + subspace iteration, commit
+//! 5a65de8) for the comparison in docs/structure.md.
 
 use pdamp_structure::fe::{Dof, FeModel, SolidMaterial};
 use pdamp_structure::sparse;

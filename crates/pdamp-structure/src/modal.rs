@@ -20,6 +20,16 @@ pub struct ModalBasis {
     pub shapes: DMatrix<f64>,
 }
 
+impl From<pdamp_fem::Modes> for ModalBasis {
+    fn from(modes: pdamp_fem::Modes) -> Self {
+        let s = &modes.shapes;
+        ModalBasis {
+            shapes: DMatrix::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)]),
+            omega_rad_s: modes.omega_rad_s,
+        }
+    }
+}
+
 /// Solves $(K - \omega^2 M)\phi = 0$ [D Eq. 3.20] for the lowest `n_modes` modes with
 /// frequency ≥ `min_frequency_hz` (use a small positive value to drop rigid-body modes).
 ///
@@ -44,7 +54,7 @@ pub fn lowest_modes(
         min_frequency_hz,
     )
     .map_err(|e| StructureError::numerical(e.to_string()))?;
-    Ok(crate::sparse::basis_of(modes))
+    Ok(ModalBasis::from(modes))
 }
 
 /// One mode of the reduced structure.

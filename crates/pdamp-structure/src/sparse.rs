@@ -25,15 +25,6 @@ pub enum SparseError {
 /// `solver = "auto"` uses the sparse solver above this many active dof.
 pub const AUTO_SPARSE_ABOVE_DOF: usize = 1500;
 
-/// The modes of `pdamp-fem` as a [`ModalBasis`].
-pub(crate) fn basis_of(modes: pdamp_fem::Modes) -> ModalBasis {
-    let s = &modes.shapes;
-    ModalBasis {
-        shapes: DMatrix::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)]),
-        omega_rad_s: modes.omega_rad_s,
-    }
-}
-
 /// Lowest `n_modes` modes with f ≥ `min_frequency_hz` of sparse K, M (module documentation).
 /// Rigid-body modes below the threshold are computed and dropped.
 ///
@@ -46,7 +37,7 @@ pub fn lowest_modes_sparse(
     n_modes: usize,
     min_frequency_hz: f64,
 ) -> Result<ModalBasis, SparseError> {
-    Ok(basis_of(pdamp_fem::lowest_modes(
+    Ok(ModalBasis::from(pdamp_fem::lowest_modes(
         stiffness,
         mass,
         n_modes,

@@ -45,7 +45,7 @@ pub struct StructureSpec {
     pub min_frequency_hz: f64,
     /// Eigen solver of FE and Matrix Market models: `auto` (dense up to
     /// [`crate::sparse::AUTO_SPARSE_ABOVE_DOF`] active dof, sparse above), `dense` or `sparse`
-    /// (shift-invert subspace iteration, [`crate::sparse`]).
+    /// (faer Krylov–Schur on the shift-inverted pencil, [`crate::sparse`]).
     #[serde(default)]
     pub solver: EigenSolver,
     /// Single mode in damper coordinates [D Eq. 3.27/3.36].
@@ -77,7 +77,7 @@ pub enum EigenSolver {
     Auto,
     /// Dense Cholesky + symmetric eigen solver ([`crate::modal::lowest_modes`]).
     Dense,
-    /// Sparse shift-invert subspace iteration ([`crate::sparse::lowest_modes_sparse`]).
+    /// Sparse shift-invert Krylov–Schur ([`crate::sparse::lowest_modes_sparse`]).
     Sparse,
 }
 

@@ -17,7 +17,7 @@
 //! number are skipped; a (node, dof) given for two rows is refused with both lines. Every reader
 //! returns an error on malformed input and never panics.
 
-use crate::fe::Dof;
+use crate::linear::Dof;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -636,12 +636,9 @@ pub fn check_structural_pair(
             }
         }
     }
-    let sparse = |a: &CooMatrix| {
-        crate::sparse::SymmetricCsr::from_triplets(n, &a.entries, false)
-            .map_err(crate::sparse::SparseError::from)
-    };
+    let sparse = |a: &CooMatrix| crate::sparse::SymmetricCsr::from_triplets(n, &a.entries, false);
     let ms = sparse(m)?;
-    if !pdamp_fem::is_positive_definite(&ms) {
+    if !crate::factor::is_positive_definite(&ms) {
         return Err(MatrixMarketError::PairMatrix {
             matrix: "mass",
             file: m_file.to_string(),
@@ -655,7 +652,7 @@ pub fn check_structural_pair(
     if ratio > 0.0 && ratio.is_finite() {
         // K + σM is positive definite exactly when every eigenvalue of (K, M) exceeds −σ
         let sigma = 1e-8 * ratio;
-        if !pdamp_fem::is_positive_definite(&sparse(k)?.shifted(-sigma, &ms)) {
+        if !crate::factor::is_positive_definite(&sparse(k)?.shifted(-sigma, &ms)) {
             return Err(MatrixMarketError::PairMatrix {
                 matrix: "stiffness",
                 file: k_file.to_string(),

@@ -1,9 +1,9 @@
 //! Lowest eigenpairs of $\mathbf K_0\boldsymbol\phi = \omega^2\mathbf M\boldsymbol\phi$ of the
 //! structure (free dofs), by `pdamp-fem`'s sparse eigensolver (faer sparse Cholesky of the
-//! shifted pencil, faer Krylov–Schur, Rayleigh–Ritz refinement; [`pdamp_fem::eigen`]).
+//! shifted pencil, faer Krylov–Schur, Rayleigh–Ritz refinement; [`crate::eigen`]).
 
 use super::structure::Structure;
-use pdamp_fem::EigenError;
+use crate::EigenError;
 
 /// Eigenfrequencies \[Hz\] (ascending) and mass-normalised mode shapes (all dofs, zero on the
 /// constrained ones) of the `count` lowest modes.
@@ -12,7 +12,7 @@ use pdamp_fem::EigenError;
 /// The eigensolver's: a structure that is not constrained (singular K₀ is allowed only
 /// through the shift; a dof without mass is not), or no convergence.
 pub fn lowest_modes(s: &Structure, count: usize) -> Result<(Vec<f64>, Vec<Vec<f64>>), EigenError> {
-    let modes = pdamp_fem::lowest_modes(&s.k0, &s.mass, count, 0.0)?;
+    let modes = crate::lowest_modes(&s.k0, &s.mass, count, 0.0)?;
     let f = modes
         .omega_rad_s
         .iter()

@@ -18,7 +18,7 @@
 //! deformations).
 
 use super::structure::Structure;
-use pdamp_fem::{Cholesky, FactorError, SingleCholesky, SymmetricCsr};
+use crate::{Cholesky, FactorError, SingleCholesky, SymmetricCsr};
 
 /// The factor of the effective tangent: single precision for modified Newton (the residual
 /// that decides convergence is double precision, see [`SingleCholesky`]; measured on the

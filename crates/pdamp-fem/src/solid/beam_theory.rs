@@ -108,7 +108,7 @@ pub fn timoshenko_f1(
     // the lowest mode of the clamped pencil by faer's dense eigensolver
     let kd = faer::Mat::<f64>::from_fn(nf, nf, |i, j| kf[i * nf + j]);
     let md = faer::Mat::<f64>::from_fn(nf, nf, |i, j| if i == j { mf[i] } else { 0.0 });
-    let modes = pdamp_fem::dense_lowest_modes(kd.as_ref(), md.as_ref(), 1, 0.0)
+    let modes = crate::dense_lowest_modes(kd.as_ref(), md.as_ref(), 1, 0.0)
         .expect("a clamped beam with positive lumped masses has a lowest mode");
     modes.omega_rad_s[0] / (2.0 * std::f64::consts::PI)
 }

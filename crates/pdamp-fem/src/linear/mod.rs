@@ -7,9 +7,9 @@ pub mod beam;
 pub mod hex8;
 pub mod plate;
 
+use crate::sparse::SparseError;
 use crate::sparse::SymmetricCsr;
 use nalgebra::{DMatrix, Vector3};
-use pdamp_fem::SparseError;
 use serde::{Deserialize, Serialize};
 
 pub use beam::BeamSection;

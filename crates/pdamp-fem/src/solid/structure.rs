@@ -6,7 +6,7 @@
 
 use super::mesh::{Face, HexMesh};
 use super::svk::{self, GaussPoint, SvkMaterial};
-use pdamp_fem::SymmetricCsr;
+use crate::SymmetricCsr;
 
 /// Time history of a load factor.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
