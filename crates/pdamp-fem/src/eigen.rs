@@ -399,7 +399,7 @@ fn refine(
 /// residuals ‖Su − λu‖/‖S‖ of 8e-4 on the symmetrised pencil of a 648-dof hex8 cantilever
 /// (faer 0.24.4; the eigenvalues alone were right, QR gives 1e-15), so the recursion threshold
 /// is set beyond every size: QR throughout, O(n³) like the LAPACK `dsyev` path.
-fn symmetric_evd(s: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
+pub fn symmetric_evd(s: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     use faer::linalg::evd::{
         ComputeEigenvectors, SelfAdjointEvdParams, self_adjoint_evd, self_adjoint_evd_scratch,
     };

@@ -14,6 +14,7 @@
 //! - [`factor`] — faer's sparse Cholesky $LL^T$ (AMD ordering, symbolic analysis reused by
 //!   numeric refactorizations), in double precision and, for modified Newton iterations, in
 //!   single precision; the positive-definiteness checks of imported matrices;
+//! - [`dense`] — small dense systems of the structural level (inverse, least squares);
 //! - [`eigen`] — the lowest modes of $K\phi = \omega^2 M\phi$ [D Eq. 3.20]: faer's Krylov–Schur
 //!   (Lanczos) eigensolver on the shift-inverted, symmetrised pencil with a Rayleigh–Ritz
 //!   refinement for sparse models, faer's dense self-adjoint eigensolver for small ones.
@@ -23,6 +24,7 @@
 //! matrices, the ACM corner matrix).
 #![forbid(unsafe_code)]
 
+pub mod dense;
 pub mod eigen;
 pub mod factor;
 pub mod linear;

@@ -471,7 +471,7 @@ pub fn rfp_single_mode(points: &[FrfPoint]) -> Option<ModalFit> {
             b[2 * i + r] = row.4;
         }
     }
-    let sol = a.svd(true, true).solve(&b, 1e-14).ok()?;
+    let sol = pdamp_fem::dense::least_squares(&a, &b, 1e-14)?;
     if sol[0] <= 0.0 {
         return None;
     }

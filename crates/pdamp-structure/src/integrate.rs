@@ -317,7 +317,7 @@ impl ModalIntegrator {
         }
         let (g, b, h) = (0.5, 0.25, self.dt_s);
         let s = &m + &c * (g * h) + DMatrix::from_diagonal(&self.base_k) * (b * h * h);
-        self.s_inv = match s.try_inverse() {
+        self.s_inv = match pdamp_fem::dense::inverse(&s) {
             Some(s) => {
                 self.ledger.singular = false;
                 s
@@ -342,10 +342,7 @@ impl ModalIntegrator {
     /// or a change of the attachments).
     pub fn make_consistent(&mut self, p: &DVector<f64>) {
         let rhs = p - &self.c * &self.v - self.base_k.component_mul(&self.q);
-        self.a = self
-            .m
-            .clone()
-            .try_inverse()
+        self.a = pdamp_fem::dense::inverse(&self.m)
             .map(|mi| mi * rhs)
             .unwrap_or_else(|| DVector::from_element(self.len(), f64::NAN));
         self.ledger.p_last = Some(p.clone());

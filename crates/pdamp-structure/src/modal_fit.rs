@@ -110,11 +110,8 @@ pub fn rfp_fit(
     for (j, nj) in norms.iter().enumerate() {
         m.column_mut(j).scale_mut(1.0 / nj);
     }
-    let sol = m
-        .clone()
-        .svd(true, true)
-        .solve(&rhs, 1e-13)
-        .map_err(|e| StructureError::numerical(format!("rfp_fit: residue fit failed: {e}")))?;
+    let sol = pdamp_fem::dense::least_squares(&m, &rhs, 1e-13)
+        .ok_or_else(|| StructureError::numerical("rfp_fit: residue fit failed (SVD)"))?;
     let fitted = &m * &sol;
     let relative_error = (&fitted - &rhs).norm() / rhs.norm().max(1e-300);
     let modes = poles
@@ -227,9 +224,8 @@ fn fit_denominator(
         for (j, nj) in norms.iter().enumerate() {
             m.column_mut(j).scale_mut(1.0 / nj);
         }
-        let sol = m.svd(true, true).solve(&rhs, 1e-13).map_err(|e| {
-            StructureError::numerical(format!("rfp_fit: least squares failed: {e}"))
-        })?;
+        let sol = pdamp_fem::dense::least_squares(&m, &rhs, 1e-13)
+            .ok_or_else(|| StructureError::numerical("rfp_fit: least squares failed (SVD)"))?;
         for j in 0..na {
             a_coef[j] = sol[nb + 1 + j] / norms[nb + 1 + j];
         }
