@@ -41,6 +41,14 @@ fn rolling_path_integral_pi() -> f64 {
     *S_PI.get_or_init(|| rolling_path_integral(PI))
 }
 
+/// Least container acceleration amplitude at which a bed collected at the lower wall of a
+/// container tilted by `tilt_rad` about the axis normal to gravity and excitation can leave
+/// it: $A\cos\alpha > g\sin\alpha$, i.e. $A > g\tan\alpha$ [D L2229–2233: 0.51 m/s² for
+/// α = 3°]. D's design condition asks for $A\cos\alpha \gg g\sin\alpha$ at the operating point.
+pub fn tilt_lift_off_acceleration_m_s2(tilt_rad: f64) -> f64 {
+    STANDARD_GRAVITY_M_S2 * tilt_rad.tan()
+}
+
 /// Optimal stroke of the rolling collect-and-collide mode, $X^{opt}_{rol} = 7h/S(\pi)
 /// \approx 0.4075\,h$ [D Eq. 5.13, exact form of Eq. 5.8 with Ωt_imp = π].
 pub fn rolling_optimal_stroke_m(clearance_m: f64) -> f64 {

@@ -81,5 +81,150 @@ pub fn targets() -> Vec<Target> {
                 )
             },
         ),
+        closed_form(
+            "ch4.eq4_7.g0_saa",
+            CH,
+            "instantaneous shear modulus G₀ = G∞/(1 − Σg_i) of SAA 9579 (Prony series of Tab. 4.2)",
+            stated(
+                8.58e9,
+                "Pa",
+                "notes N45 L48–50, derived from D Eq. 4.7 and Tab. 4.2, L1709–1743",
+            ),
+            rel(2e-3),
+            |_| {
+                exact(
+                    Material::saa9579().instantaneous_shear_modulus(),
+                    "Material::saa9579().instantaneous_shear_modulus()",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.fmax_steel_steel",
+            CH,
+            "Hertz peak force, 30 mm steel sphere on a steel wall at 1 m/s",
+            stated(
+                3909.0,
+                "N",
+                "notes N45 L103–107, derived from D Eq. 4.8, L1777",
+            ),
+            rel(0.01),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Wall(Material::s235())).max_force(1.0),
+                    "hertz_pair(s235, Wall(s235), 0.015).max_force(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.te_steel_al",
+            CH,
+            "Hertz contact time, 30 mm steel sphere on an Al 6060 wall at 1 m/s",
+            stated(
+                137.1e-6,
+                "s",
+                "notes N45 L107, derived from D Eq. 4.8, L1777",
+            ),
+            rel(0.01),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Wall(Material::al6060())).contact_time(1.0),
+                    "hertz_pair(s235, Wall(al6060), 0.015).contact_time(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.fmax_steel_al",
+            CH,
+            "Hertz peak force, 30 mm steel sphere on an Al 6060 wall at 1 m/s",
+            stated(2960.0, "N", "notes N45 L107, derived from D Eq. 4.8, L1777"),
+            rel(0.01),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Wall(Material::al6060())).max_force(1.0),
+                    "hertz_pair(s235, Wall(al6060), 0.015).max_force(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.te_sphere_sphere",
+            CH,
+            "Hertz contact time, two 30 mm steel spheres at 1 m/s",
+            stated(
+                90.4e-6,
+                "s",
+                "notes N45 L107, derived from D Eq. 4.8, L1777",
+            ),
+            rel(0.01),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Sphere).contact_time(1.0),
+                    "hertz_pair(s235, Sphere, 0.015).contact_time(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.te_steel_saa",
+            CH,
+            "Hertz contact time (long-term modulus), 30 mm steel sphere on SAA 9579 at 1 m/s",
+            worded(
+                2.0e-3,
+                "≈ 2.0 ms",
+                "s",
+                "notes N45 L107, derived from D Eq. 4.8, L1777",
+            ),
+            rel(0.03),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Wall(Material::saa9579())).contact_time(1.0),
+                    "hertz_pair(s235, Wall(saa9579), 0.015).contact_time(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.fmax_steel_saa",
+            CH,
+            "Hertz peak force (long-term modulus), 30 mm steel sphere on SAA 9579 at 1 m/s",
+            stated(201.0, "N", "notes N45 L107, derived from D Eq. 4.8, L1777"),
+            rel(0.01),
+            |_| {
+                exact(
+                    hertz_30mm(&Partner::Wall(Material::saa9579())).max_force(1.0),
+                    "hertz_pair(s235, Wall(saa9579), 0.015).max_force(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.te_steel_pvc",
+            CH,
+            "Hertz contact time, 30 mm steel sphere on PVC (E 3 GPa, ν 0.38) at 1 m/s",
+            worded(
+                0.42e-3,
+                "≈ 0.42 ms",
+                "s",
+                "notes N45 L107, derived from D Eq. 4.8, L1777",
+            ),
+            rel(0.03),
+            |_| {
+                let pvc = Material::elastic("pvc", 3e9, 0.38, 1400.0);
+                exact(
+                    hertz_30mm(&Partner::Wall(pvc)).contact_time(1.0),
+                    "hertz_pair(s235, Wall(elastic pvc 3 GPa, 0.38), 0.015).contact_time(1.0)",
+                )
+            },
+        ),
+        closed_form(
+            "ch4.eq4_8.fmax_steel_pvc",
+            CH,
+            "Hertz peak force, 30 mm steel sphere on PVC (E 3 GPa, ν 0.38) at 1 m/s",
+            stated(964.0, "N", "notes N45 L107, derived from D Eq. 4.8, L1777"),
+            rel(0.01),
+            |_| {
+                let pvc = Material::elastic("pvc", 3e9, 0.38, 1400.0);
+                exact(
+                    hertz_30mm(&Partner::Wall(pvc)).max_force(1.0),
+                    "hertz_pair(s235, Wall(elastic pvc 3 GPa, 0.38), 0.015).max_force(1.0)",
+                )
+            },
+        ),
     ]
 }

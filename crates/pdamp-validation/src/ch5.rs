@@ -59,7 +59,101 @@ pub fn targets() -> Vec<Target> {
     t.extend(table_5_2());
     t.extend(free_decays());
     t.extend(flexor_decays());
+    t.extend(rolling_table_and_tilt());
     t
+}
+
+/// One row of the notes' derived η̄(X/h_rol) table (B.4.4) of the rolling formula.
+macro_rules! rolling_row {
+    ($id:literal, $ratio:literal, $eta:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!("η̄ of the rolling formula at X/h_rol = ", stringify!($ratio)),
+            stated(
+                $eta,
+                "1",
+                "notes N45 L263–277 (B.4.4), derived from D Eq. 5.3, 5.8, 5.10",
+            ),
+            abs(5e-4),
+            |_| {
+                exact(
+                    rolling_eta(0.03, $ratio * 0.03),
+                    concat!(
+                        "RollingDamper { h 0.03 }.loss_factor_and_mass_ratio(",
+                        stringify!($ratio),
+                        "·0.03)"
+                    ),
+                )
+            },
+        )
+    };
+}
+
+/// The notes' derived η̄(X/h_rol) table outside D's own statements (those are rows of
+/// `loss_factors`), and the tilt condition of Sect. 5.1.4.
+fn rolling_table_and_tilt() -> Vec<Target> {
+    use pdamp_structure::formulas::tilt_lift_off_acceleration_m_s2;
+    vec![
+        rolling_row!("ch5.b44.eta_0p2", 0.2, 0.2000),
+        rolling_row!("ch5.b44.eta_0p5", 0.5, 0.8814),
+        rolling_row!("ch5.b44.eta_0p6", 0.6, 0.8227),
+        rolling_row!("ch5.b44.eta_1", 1.0, 0.5906),
+        rolling_row!("ch5.b44.eta_2", 2.0, 0.3102),
+        rolling_row!("ch5.b44.eta_5", 5.0, 0.1119),
+        closed_form(
+            "ch5.sec5_1_4.tilt_threshold",
+            CH,
+            "least acceleration to leave the lower wall of a container tilted by 3° (A > g tan α)",
+            stated(0.51, "m/s²", "D L2229–2233"),
+            abs(0.005),
+            |_| {
+                exact(
+                    tilt_lift_off_acceleration_m_s2(3f64.to_radians()),
+                    "tilt_lift_off_acceleration_m_s2(3°)",
+                )
+            },
+        ),
+        closed_form(
+            "ch5.sec5_1_4.tilt_a_12mm",
+            CH,
+            "acceleration amplitude at X = 12 mm, 2 Hz (above the 3° threshold: rolling possible)",
+            stated(1.9, "m/s²", "D L2229–2233"),
+            abs(0.05),
+            |_| {
+                exact(
+                    0.012 * (std::f64::consts::TAU * 2.0).powi(2),
+                    "X·(2π·2 Hz)² with X = 12 mm",
+                )
+            },
+        ),
+        closed_form(
+            "ch5.sec5_1_4.tilt_a_4mm",
+            CH,
+            "acceleration amplitude at X = 4 mm, 2 Hz (barely above the 3° threshold)",
+            stated(0.63, "m/s²", "D L2229–2233"),
+            abs(0.005),
+            |_| {
+                exact(
+                    0.004 * (std::f64::consts::TAU * 2.0).powi(2),
+                    "X·(2π·2 Hz)² with X = 4 mm",
+                )
+            },
+        ),
+        closed_form(
+            "ch5.b9.mass_36_rho7800",
+            CH,
+            "bed mass of 36 spheres r = 5 mm with ρ = 7800 kg/m³ (D's 147 g; 149 g with 7900)",
+            stated(0.147, "kg", "D L2476"),
+            rel(0.01),
+            |_| {
+                exact(
+                    36.0 * pdamp_impact::hertz::sphere_mass(0.005, 7800.0),
+                    "36·sphere_mass(0.005, 7800)",
+                )
+            },
+        ),
+    ]
 }
 
 /// Clearances and optimal strokes (D Eq. 5.1, 5.13).

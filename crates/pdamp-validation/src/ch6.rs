@@ -37,6 +37,7 @@ pub fn targets() -> Vec<Target> {
     t.extend(bouncing_model());
     t.extend(table_6_2());
     t.extend(layered_design());
+    t.extend(bouncing_curve_and_layers());
     t.extend(dem_peaks_44());
     t.push(crate::quick_run(
         "ch6.fig6_6.zeta_achieved",
@@ -306,6 +307,150 @@ fn dem_peaks_44() -> Vec<Target> {
                     PACKINGS,
                 )
             },
+        ),
+    ]
+}
+
+/// One point of the notes' derived η̄(X/X_opt) curve of the bouncing limit (D Eq. 6.6/6.8).
+macro_rules! bouncing_row {
+    ($id:literal, $ratio:literal, $eta:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!("η̄ of the bouncing limit at X/X_opt = ", stringify!($ratio)),
+            stated($eta, "1", "notes N69 L126–127, derived from D Eq. 6.6, 6.8"),
+            abs(1.5e-3),
+            |_| {
+                exact(
+                    bouncing_eta(0.0925, $ratio * 0.0925 / PI),
+                    concat!(
+                        "HorizontalDamper { h_bou 0.0925 }, X = ",
+                        stringify!($ratio),
+                        "·h/π, 50 Hz"
+                    ),
+                )
+            },
+        )
+    };
+}
+
+/// A Tab. 6.2 rolling clearance (negative clearances clipped: no rolling layer).
+macro_rules! h_rol_row {
+    ($id:literal, $n:literal, $h:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!("Tab. 6.2 rolling clearance, ", stringify!($n), " spheres"),
+            stated($h, "m", "D Tab. 6.2, L2724–2732"),
+            abs(5e-4),
+            |_| {
+                exact(
+                    clearance_m(0.12, $n, 48.0).max(0.0),
+                    concat!("clearance_m(0.12, ", stringify!($n), ", 48), clipped at 0"),
+                )
+            },
+        )
+    };
+}
+
+/// A layer of the Sect. 6.2 design (the Ch. 5 guideline at X₀ = 63 mm): clearance or stroke.
+macro_rules! layer_row {
+    ($id:literal, $k:literal, $what:literal, $value:literal, $tol:literal, $stroke:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!("Sect. 6.2 layered container: ", $what),
+            stated($value, "m", "D L2763"),
+            abs($tol),
+            |_| {
+                let h = layer_clearances_m(0.063)[$k];
+                if $stroke {
+                    exact(
+                        rolling_optimal_stroke_m(h),
+                        "rolling_optimal_stroke_m(layer_clearances_m(0.063)[k])",
+                    )
+                } else {
+                    exact(h, "layer_clearances_m(0.063)[k]")
+                }
+            },
+        )
+    };
+}
+
+/// The notes' derived bouncing curve, Tab. 6.2's rolling clearances of 44/48/96 spheres and
+/// the Sect. 6.2 structure's start acceleration and layers.
+fn bouncing_curve_and_layers() -> Vec<Target> {
+    use pdamp_structure::design::layer_clearances_m;
+    vec![
+        bouncing_row!("ch6.eq6_8.eta_1p5", 1.5, 1.101),
+        bouncing_row!("ch6.eq6_8.eta_2", 2.0, 0.892),
+        bouncing_row!("ch6.eq6_8.eta_4", 4.0, 0.454),
+        bouncing_row!("ch6.eq6_8.eta_6", 6.0, 0.288),
+        bouncing_row!("ch6.eq6_8.eta_10", 10.0, 0.157),
+        h_rol_row!("ch6.tab6_2.h_rol_44", 44.0, 0.010),
+        h_rol_row!("ch6.tab6_2.h_rol_48", 48.0, 0.0),
+        h_rol_row!("ch6.tab6_2.h_rol_96", 96.0, 0.0),
+        closed_form(
+            "ch6.sec6_2.a0",
+            CH,
+            "start acceleration |A₀| = X₀ω₀² of the Sect. 6.2 beam at X₀ = 63 mm (> g: bouncing)",
+            worded(28.0, "≈ 28", "m/s²", "D L2759"),
+            abs(1.0),
+            |_| {
+                let s = pdamp_structure::modal::ModalStructure::single_mode(1.108, 484.0, 0.0);
+                exact(
+                    0.063 * s.modes[0].omega_rad_s().powi(2),
+                    "0.063·ω₀² of single_mode(1.108, 484, 0)",
+                )
+            },
+        ),
+        layer_row!(
+            "ch6.sec6_2.h_layer1",
+            0,
+            "clearance of layer 1",
+            0.080,
+            2e-3,
+            false
+        ),
+        layer_row!(
+            "ch6.sec6_2.h_layer2",
+            1,
+            "clearance of layer 2",
+            0.040,
+            2e-3,
+            false
+        ),
+        layer_row!(
+            "ch6.sec6_2.h_layer3",
+            2,
+            "clearance of layer 3",
+            0.025,
+            2e-3,
+            false
+        ),
+        layer_row!(
+            "ch6.sec6_2.xopt_layer1",
+            0,
+            "optimal stroke of layer 1",
+            0.032,
+            1e-3,
+            true
+        ),
+        layer_row!(
+            "ch6.sec6_2.xopt_layer2",
+            1,
+            "optimal stroke of layer 2",
+            0.016,
+            1e-3,
+            true
+        ),
+        layer_row!(
+            "ch6.sec6_2.xopt_layer3",
+            2,
+            "optimal stroke of layer 3",
+            0.010,
+            1e-3,
+            true
         ),
     ]
 }

@@ -20,7 +20,182 @@ pub fn targets() -> Vec<Target> {
     let mut t = model_and_structure();
     t.extend(free_decay_32());
     t.extend(layer_study());
+    t.extend(model_points());
     t
+}
+
+/// One point of the notes' own evaluation of the vertical model (h = 0.1 m).
+macro_rules! vertical_eta_row {
+    ($id:literal, $f:literal, $x:literal, $eta:literal, $mode:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!(
+                "η̄ of the vertical model, h = 0.1 m, f = ",
+                stringify!($f),
+                " Hz, X = ",
+                stringify!($x),
+                " m (",
+                $mode,
+                ")"
+            ),
+            stated(
+                $eta,
+                "1",
+                "notes N69 L321–333 (the notes' own evaluation of D Eq. 7.1–7.18, not D numbers)",
+            ),
+            abs(0.01),
+            |_| {
+                exact(
+                    BED.state($x, TAU * $f).effective_loss_factor,
+                    concat!(
+                        "VerticalDamper { h 0.1 }.state(",
+                        stringify!($x),
+                        ", 2π·",
+                        stringify!($f),
+                        ")"
+                    ),
+                )
+            },
+        )
+    };
+}
+
+/// m̄/m_bed of Eq. 7.19 at a point of the vertical model in the named mode.
+macro_rules! vertical_mbar_row {
+    ($id:literal, $f:literal, $x:literal, $mbar:literal, $mode:literal) => {
+        closed_form(
+            $id,
+            CH,
+            concat!(
+                "m̄/m_bed of Eq. 7.19, ",
+                $mode,
+                " (the model at f = ",
+                stringify!($f),
+                " Hz, X = ",
+                stringify!($x),
+                " m)"
+            ),
+            stated($mbar, "1", "D Eq. 7.19, L2980"),
+            abs(1e-9),
+            |_| {
+                exact(
+                    BED.state($x, TAU * $f).effective_mass_ratio,
+                    concat!(
+                        "VerticalDamper { h 0.1 }.state(",
+                        stringify!($x),
+                        ", 2π·",
+                        stringify!($f),
+                        ").effective_mass_ratio"
+                    ),
+                )
+            },
+        )
+    };
+}
+
+/// The zero-gravity optimum, the 64-sphere bed's mass, Eq. 7.19 in the three other modes and
+/// the notes' evaluation of the model.
+fn model_points() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch7.eq7_16.xopt",
+            CH,
+            "zero-gravity optimal stroke X_opt = h/π of the 32-sphere bed (h = 0.1 m)",
+            stated(0.032, "m", "D Eq. 7.16, L2929; 32 mm at L2970"),
+            abs(5e-4),
+            |_| {
+                exact(
+                    clearance_m(0.12, 32.0, 192.0) / PI,
+                    "clearance_m(0.12, 32, 192)/π",
+                )
+            },
+        ),
+        closed_form(
+            "ch7.masses.m_64",
+            CH,
+            "bed mass of 64 steel spheres r = 5 mm",
+            stated(0.265, "kg", "D L3033"),
+            rel(0.02),
+            |_| {
+                exact(
+                    64.0 * pdamp_impact::hertz::sphere_mass(0.005, 7900.0),
+                    "64·sphere_mass(0.005, 7900)",
+                )
+            },
+        ),
+        vertical_mbar_row!(
+            "ch7.eq7_19.mbar_single",
+            4.0,
+            0.040,
+            0.65,
+            "harmonic single collect-and-collide"
+        ),
+        vertical_mbar_row!(
+            "ch7.eq7_19.mbar_subharmonic",
+            8.0,
+            0.020,
+            0.2,
+            "subharmonic single collect-and-collide"
+        ),
+        vertical_mbar_row!("ch7.eq7_19.mbar_scattered", 10.0, 0.026, 0.1, "scattered"),
+        vertical_eta_row!(
+            "ch7.model.eta_20hz_32mm",
+            20.0,
+            0.032,
+            1.271,
+            "double, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_15hz_32mm",
+            15.0,
+            0.032,
+            1.266,
+            "double, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_10hz_32mm",
+            10.0,
+            0.032,
+            1.234,
+            "double, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_5hz_40mm",
+            5.0,
+            0.040,
+            1.036,
+            "double, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_4hz_40mm",
+            4.0,
+            0.040,
+            0.719,
+            "single, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_2hz_100mm",
+            2.0,
+            0.100,
+            0.328,
+            "single, harmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_8hz_20mm",
+            8.0,
+            0.020,
+            0.186,
+            "single, subharmonic"
+        ),
+        vertical_eta_row!(
+            "ch7.model.eta_10hz_200mm",
+            10.0,
+            0.200,
+            0.27,
+            "double, harmonic"
+        ),
+    ]
 }
 
 /// The vertical model's limits and the structure of Sect. 7.2.

@@ -3,6 +3,7 @@
 
 use crate::{
     ComputeError, Context, Measured, Target, abs, closed_form, exact, quick_run, rel, stated,
+    worded,
 };
 use pdamp_structure::design::{CoatedWallDesign, CoatedWallInput, coated_wall_design};
 use pdamp_structure::formulas::clearance_m;
@@ -34,7 +35,53 @@ pub fn targets() -> Vec<Target> {
     t.extend(table_8_7());
     t.extend(table_8_8());
     t.extend(baseline_dem());
+    t.extend(powder_design());
     t
+}
+
+/// The powder damper of Sect. 8.2.3 (its optimum stroke and the effective mass that D infers
+/// from the measured frequency drop, D Eq. 3.33) and the triple-star bed's mass.
+fn powder_design() -> Vec<Target> {
+    vec![
+        closed_form(
+            "ch8.sec8_2_3.xopt_powder",
+            CH,
+            "bouncing optimum X_opt = h/π of the powder damper (h = 1 mm)",
+            stated(0.32e-3, "m", "D L3594"),
+            abs(5e-6),
+            |_| exact(1e-3 / PI, "h/π with h = 1 mm (D Eq. 8.2)"),
+        ),
+        closed_form(
+            "ch8.masses.triple_star",
+            CH,
+            "bed mass of the triple star: ≈ 3400 steel spheres r = 1.25 mm",
+            worded(0.220, "≈ 220 g", "kg", "D L3317"),
+            rel(0.02),
+            |_| {
+                exact(
+                    3400.0 * pdamp_impact::hertz::sphere_mass(1.25e-3, 7900.0),
+                    "3400·sphere_mass(1.25e-3, 7900)",
+                )
+            },
+        ),
+        closed_form(
+            "ch8.sec8_2_3.frequency_drop",
+            CH,
+            "mode-1 frequency drop by m̄ = 0.85 m_bed with φ²m_bed = 0.1186 (ζ(η̄=1) = 0.053), \
+             D Eq. 3.33; D measured 4.6 %",
+            stated(0.046, "1", "D L3606–3617; φ²m_bed from notes N69 L687"),
+            abs(0.002),
+            |_| {
+                let s = pdamp_structure::modal::ModalStructure::single_mode(1.0, 1.0, 0.0);
+                let w =
+                    pdamp_structure::free::effective_omega(&s, 0, &[(vec![1.0], 0.85 * 0.1186)]);
+                exact(
+                    1.0 - w / s.modes[0].omega_rad_s(),
+                    "1 − effective_omega(single_mode(1, 1, 0), 0, [(φ = 1, 0.85·0.1186)])/ω",
+                )
+            },
+        ),
+    ]
 }
 
 /// Bouncing optima and bed masses of the cube and cylinder designs (D Eq. 8.1/8.2).

@@ -21,6 +21,7 @@ pub mod ch7;
 pub mod ch8;
 pub mod decay;
 pub mod dem_point;
+pub mod paper;
 pub mod report;
 pub mod target;
 
@@ -36,6 +37,7 @@ pub fn targets() -> Vec<Target> {
     t.extend(ch6::targets());
     t.extend(ch7::targets());
     t.extend(ch8::targets());
+    t.extend(paper::targets());
     t
 }
 
