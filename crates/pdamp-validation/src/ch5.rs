@@ -60,7 +60,101 @@ pub fn targets() -> Vec<Target> {
     t.extend(free_decays());
     t.extend(flexor_decays());
     t.extend(rolling_table_and_tilt());
+    t.extend(forced_and_free_statements());
     t
+}
+
+/// A number of the summary of a coupling example's run.
+fn couple_summary(ctx: &Context, file: &str, key: &str) -> Result<Measured, ComputeError> {
+    let (v, _) = crate::decay::run_couple_example(ctx, file)?;
+    let x = v[key]
+        .as_f64()
+        .ok_or_else(|| ComputeError::new(format!("no {key} in the summary of {file}")))?;
+    Ok(Measured::exact(
+        x,
+        format!("pdamp couple examples/{file}: summary.json {key}"),
+    ))
+}
+
+/// The stated outcomes of the forced runs of Sect. 5.2.2 and of the guideline and Flexor decays.
+fn forced_and_free_statements() -> Vec<Target> {
+    use crate::decay::{free_decay, mean_damping_in};
+    vec![
+        quick_run(
+            "ch5.sec5_2_2.f_resonance_u2",
+            CH,
+            "resonance frequency with the bed at U = 2 mm (rolling formulas)",
+            stated(1.73, "Hz", "D L2478"),
+            abs(0.02),
+            None,
+            |c| couple_summary(c, "couple_ch5_forced_u2mm.toml", "resonance_frequency_hz"),
+        ),
+        quick_run(
+            "ch5.sec5_2_2.f_resonance_u0p5",
+            CH,
+            "resonance frequency with the bed at U = 0.5 mm (rolling formulas; D: 1.73 Hz in both \
+             cases)",
+            stated(1.73, "Hz", "D L2478"),
+            abs(0.02),
+            Some(
+                "at U = 0.5 mm the bed stays below X_opt (scattered), where D Eq. 5.14 sets \
+                 m̄ = 0.3 m_bed: the resonance moves to 1.81 Hz; D's 1.73 Hz in both cases needs \
+                 m̄ = m_bed (Eq. 3.37, row ch5.eq3_37.f_with_bed)",
+            ),
+            |c| couple_summary(c, "couple_ch5_forced_u0p5mm.toml", "resonance_frequency_hz"),
+        ),
+        quick_run(
+            "ch5.sec5_2_2.x_u2",
+            CH,
+            "container amplitude at resonance, U = 2 mm (rolling formulas)",
+            worded(0.040, "≈ 40 mm", "m", "D L2498"),
+            rel(0.15),
+            Some(
+                "D's own formulas (Eq. 5.10, 5.14, 3.44) put the scattered-rolling resonance at \
+                 X ≈ 21 mm at U = 2 mm (as for row ch5.tab5_2.zeta_u2); D's ≈ 40 mm with η̄ ≈ 0.46 \
+                 does not follow from its stated model (notes N45 L416)",
+            ),
+            |c| couple_summary(c, "couple_ch5_forced_u2mm.toml", "peak_damper_amplitude_m"),
+        ),
+        quick_run(
+            "ch5.fig5_15.zeta_low",
+            CH,
+            "guideline: ζ of the cycles below 11 mm (5–11 mm)",
+            worded(0.02, "≈ 0.02", "1", "D Fig. 5.15, L2367"),
+            rel(0.3),
+            None,
+            |c| {
+                let d = free_decay(c, GUIDELINE)?;
+                Ok(Measured::exact(
+                    mean_damping_in(&d, 0.005..0.011)?,
+                    "couple_ch5_free_guideline: mean ζ of the cycles at 5–11 mm",
+                ))
+            },
+        ),
+        quick_run(
+            "ch5.fig5_20.flexor_zeta_below_40mm",
+            CH,
+            "Flexor (24, 28, 28, 28, 28) released at 78 mm: least ζ of the cycles at 11–40 mm",
+            worded(0.08, "ζ > 0.08 for X < 40 mm", "1", "D L2441, Fig. 5.20"),
+            crate::Tolerance::Range { lo: 0.08, hi: 1.0 },
+            None,
+            |c| {
+                let d = free_decay(c, "couple_ch5_flexor_formulas_x78.toml")?;
+                let z = d
+                    .iter()
+                    .filter(|c| (0.011..0.040).contains(&c.amplitude_m))
+                    .map(|c| c.damping_ratio)
+                    .fold(f64::INFINITY, f64::min);
+                if !z.is_finite() {
+                    return Err(ComputeError::new("no cycle at 11–40 mm"));
+                }
+                Ok(Measured::exact(
+                    z,
+                    "couple_ch5_flexor_formulas_x78: least ζ of the cycles at 11–40 mm",
+                ))
+            },
+        ),
+    ]
 }
 
 /// One row of the notes' derived η̄(X/h_rol) table (B.4.4) of the rolling formula.
