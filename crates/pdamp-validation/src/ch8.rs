@@ -36,7 +36,68 @@ pub fn targets() -> Vec<Target> {
     t.extend(table_8_8());
     t.extend(baseline_dem());
     t.extend(powder_design());
+    t.extend(powder_modes_2_to_4());
     t
+}
+
+/// ζ of mode `$k` (0-based) at the Fig. 3.7 equilibrium of the fields coupling.
+macro_rules! equilibrium_zeta_row {
+    ($id:literal, $k:literal, $what:literal, $zeta:literal, $text:literal, $tol:expr) => {
+        quick_run(
+            $id,
+            CH,
+            $what,
+            worded($zeta, $text, "1", "D L3617–3630, Fig. 8.25 (experiment)"),
+            $tol,
+            Some(NO_POWDER_FIELD),
+            |c| {
+                let e = fields_equilibrium(c, $k)?;
+                let z = e["equilibrium"]["damping_ratio"]
+                    .as_f64()
+                    .ok_or_else(|| ComputeError::new("no damping_ratio"))?;
+                Ok(Measured::exact(
+                    z,
+                    concat!(
+                        "couple_ch8_fields_steady: equilibrium damping_ratio of mode index ",
+                        stringify!($k)
+                    ),
+                ))
+            },
+        )
+    };
+}
+
+/// D's measured damping of modes 2–4 with the powder damper (Sect. 8.2.3).
+fn powder_modes_2_to_4() -> Vec<Target> {
+    vec![
+        equilibrium_zeta_row!(
+            "ch8.fig8_25.zeta_mode2",
+            1,
+            "damping ratio of mode 2 with the powder damper at 26 N (experiment: up to 0.018 for \
+             modes 2–3, ≈ 50 % of ζ(η̄ = 1))",
+            0.018,
+            "up to 0.018",
+            rel(0.35)
+        ),
+        equilibrium_zeta_row!(
+            "ch8.fig8_25.zeta_mode3",
+            2,
+            "damping ratio of mode 3 with the powder damper at 26 N (experiment: up to 0.018 for \
+             modes 2–3)",
+            0.018,
+            "up to 0.018",
+            rel(0.35)
+        ),
+        equilibrium_zeta_row!(
+            "ch8.fig8_25.zeta_mode4",
+            3,
+            "damping ratio of mode 4 with the powder damper at 26 N (experiment; D's prediction \
+             28 % higher)",
+            0.02,
+            "0.02",
+            rel(0.35)
+        ),
+    ]
 }
 
 /// The powder damper of Sect. 8.2.3 (its optimum stroke and the effective mass that D infers
