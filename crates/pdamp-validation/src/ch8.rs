@@ -70,6 +70,29 @@ macro_rules! equilibrium_zeta_row {
 /// D's measured damping of modes 2–4 with the powder damper (Sect. 8.2.3).
 fn powder_modes_2_to_4() -> Vec<Target> {
     vec![
+        quick_run(
+            "ch8.sec8_2_3.iterations",
+            CH,
+            "iterations of the Fig. 3.7 equilibrium of mode 1 (fields coupling, 26 N)",
+            worded(7.5, "5–10", "1", "D L1624, L3617"),
+            crate::Tolerance::Range { lo: 5.0, hi: 10.0 },
+            Some(
+                "pdamp relaxes by the mean of successive ζ where D averages Ẽ of successive \
+                 iterates: D's rule diverges when the first iterate (X set by structural damping \
+                 alone) is orders of magnitude too large, the mean of ζ reaches the same fixed \
+                 point in more steps (docs/structure.md, Fig. 3.7 iteration)",
+            ),
+            |c| {
+                let e = fields_equilibrium(c, 0)?;
+                let n = e["equilibrium"]["iterations"]
+                    .as_f64()
+                    .ok_or_else(|| ComputeError::new("no iterations"))?;
+                Ok(Measured::exact(
+                    n,
+                    "couple_ch8_fields_steady: mode 1 equilibrium iterations",
+                ))
+            },
+        ),
         equilibrium_zeta_row!(
             "ch8.fig8_25.zeta_mode2",
             1,
