@@ -25,11 +25,25 @@ pub(crate) struct ValidateArgs {
     /// The repository's examples folder (default: the one pdamp was built from).
     #[arg(long)]
     examples: Option<PathBuf>,
+    /// Only the rows whose id starts with one of these prefixes (comma separated, e.g.
+    /// `ch4.fe,ch8.tab8_3`); with --full their simulations run.
+    #[arg(long, value_delimiter = ',')]
+    only: Vec<String>,
 }
 
 /// Runs `pdamp validate`: writes the table and prints its counts as JSON.
 pub(crate) fn run(a: ValidateArgs) -> Result<()> {
     let tier = if a.full { Tier::Full } else { Tier::Quick };
+    // every --only prefix must select a row (a typo would silently write an empty table)
+    let ids: Vec<&str> = pdamp_validation::targets().iter().map(|t| t.id).collect();
+    for p in &a.only {
+        if !ids.iter().any(|id| id.starts_with(p.as_str())) {
+            anyhow::bail!(
+                "--only {p}: no row id starts with '{p}' (ids start with ch4. … ch8. or paper.; \
+                 docs/validation.md lists them)"
+            );
+        }
+    }
     let traced = crate::Traced::start(None, 0);
     let mut dir = crate::outputs::open_out(
         &a.out,
@@ -44,7 +58,10 @@ pub(crate) fn run(a: ValidateArgs) -> Result<()> {
     if let Some(e) = &a.examples {
         ctx.examples_dir = e.clone();
     }
-    let rows = pdamp_validation::run(tier, &ctx);
+    let keep = |t: &pdamp_validation::Target| {
+        a.only.is_empty() || a.only.iter().any(|p| t.id.starts_with(p.as_str()))
+    };
+    let rows = pdamp_validation::run_where(tier, &ctx, keep);
     let command = if a.full {
         "pdamp validate --full"
     } else {

@@ -45,3 +45,35 @@ fn validate_quick_writes_the_table_of_the_docs() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn validate_only_runs_the_named_rows_and_refuses_a_prefix_without_rows() {
+    let dir = std::env::temp_dir().join(format!("pdamp-validate-only-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.to_str().unwrap();
+    let o = pdamp(&["validate", "--only", "ch6.tab6_2,paper.tabA2", "--out", out]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let csv = std::fs::read_to_string(dir.join("validation.csv")).unwrap();
+    let ids: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(v["rows"].as_u64().unwrap() as usize, ids.len());
+    assert!(ids.len() >= 5, "{ids:?}");
+    assert!(
+        ids.iter()
+            .all(|id| id.starts_with("ch6.tab6_2") || id.starts_with("paper.tabA2")),
+        "{ids:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = pdamp(&["validate", "--only", "ch9", "--out", out]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--only ch9: no row id starts with 'ch9'"),
+        "{err}"
+    );
+    assert!(!dir.exists(), "nothing is written for a refused run");
+}

@@ -4,7 +4,8 @@
 
 use crate::{ComputeError, Target, closed_form, exact, rel, stated, worded};
 use pdamp_impact::hertz::HertzPair;
-use pdamp_impact::{Material, MaterialModel, Partner};
+use pdamp_impact::{FeOptions, ImpactResult, Material, MaterialModel, MeshDensity, Partner};
+use std::sync::OnceLock;
 
 const CH: &str = "D Ch. 4 — single impacts";
 
@@ -29,8 +30,127 @@ fn perzyna_beta(m: &Material, rate_1_s: f64) -> Result<f64, ComputeError> {
     }
 }
 
+/// One coarse-mesh FE impact of a 30 mm S235 sphere at 1 m/s on a wall of `wall` (D Sect.
+/// 4.2.2), computed once per process and shared by the rows that read it.
+fn fe_impact_1m_s(
+    wall: fn() -> Material,
+    cache: &'static OnceLock<ImpactResult>,
+) -> &'static ImpactResult {
+    cache.get_or_init(|| {
+        pdamp_impact::simulate_impact(
+            &Material::s235(),
+            &Partner::Wall(wall()),
+            0.015,
+            1.0,
+            &FeOptions::with_density(MeshDensity::Coarse),
+        )
+    })
+}
+
+static FE_STEEL: OnceLock<ImpactResult> = OnceLock::new();
+static FE_AL: OnceLock<ImpactResult> = OnceLock::new();
+
+fn fe_steel() -> &'static ImpactResult {
+    fe_impact_1m_s(Material::s235, &FE_STEEL)
+}
+
+fn fe_al() -> &'static ImpactResult {
+    fe_impact_1m_s(Material::al6060, &FE_AL)
+}
+
+/// The share of the plastic dissipation that happens in the wall.
+fn wall_share(r: &ImpactResult) -> f64 {
+    let e = &r.energy;
+    e.plastic_wall_j / (e.plastic_wall_j + e.plastic_sphere_j)
+}
+
+/// A row read from the coarse FE impact at 1 m/s (`Quick`: the two impacts take ≈ 10 s on 2
+/// cores together).
+macro_rules! fe_row {
+    ($id:literal, $what:literal, $reference:expr, $tol:expr, $impact:ident, $value:expr, $how:literal) => {
+        Target {
+            category: crate::Category::Impact,
+            ..closed_form($id, CH, $what, $reference, $tol, |_| {
+                let r = $impact();
+                if !r.completed {
+                    return Err(ComputeError::new("the impact did not separate in time"));
+                }
+                #[allow(clippy::redundant_closure_call)]
+                exact(($value)(r), $how)
+            })
+        }
+    };
+}
+
+/// The FE impacts of D Sect. 4.2.2 at 1 m/s (30 mm steel sphere, coarse mesh).
+fn fe_impacts() -> Vec<Target> {
+    vec![
+        fe_row!(
+            "ch4.fe.te_steel_steel",
+            "FE contact time, 30 mm steel sphere on a steel wall at 1 m/s (coarse mesh)",
+            stated(101e-6, "s", "D L1859"),
+            rel(0.03),
+            fe_steel,
+            |r: &ImpactResult| r.contact_time_s,
+            "simulate_impact(s235, Wall(s235), 0.015, 1 m/s, coarse).contact_time_s"
+        ),
+        fe_row!(
+            "ch4.fe.te_steel_al",
+            "FE contact time, 30 mm steel sphere on an Al 6060 wall at 1 m/s (coarse mesh)",
+            stated(133e-6, "s", "D L1859"),
+            rel(0.03),
+            fe_al,
+            |r: &ImpactResult| r.contact_time_s,
+            "simulate_impact(s235, Wall(al6060), 0.015, 1 m/s, coarse).contact_time_s"
+        ),
+        fe_row!(
+            "ch4.fig4_22.fmax_steel",
+            "peak contact force, steel sphere on steel at 1 m/s (measured; FE coarse mesh)",
+            stated(3027.0, "N", "D L1936 (experiment)"),
+            rel(0.15),
+            fe_steel,
+            |r: &ImpactResult| r.max_force_n,
+            "simulate_impact(s235, Wall(s235), 0.015, 1 m/s, coarse).max_force_n"
+        ),
+        fe_row!(
+            "ch4.fig4_22.fmax_al",
+            "peak contact force, steel sphere on Al 6060 at 1 m/s (measured; FE coarse mesh)",
+            stated(2180.0, "N", "D L1936 (experiment)"),
+            rel(0.15),
+            fe_al,
+            |r: &ImpactResult| r.max_force_n,
+            "simulate_impact(s235, Wall(al6060), 0.015, 1 m/s, coarse).max_force_n"
+        ),
+        fe_row!(
+            "ch4.fig4_9.split_steel",
+            "share of the plastic dissipation in the wall, steel on steel (D: about equal)",
+            worded(0.5, "≈ equal in sphere and wall", "1", "D L1820, Fig. 4.9"),
+            crate::abs(0.1),
+            fe_steel,
+            wall_share,
+            "plastic_wall_j/(plastic_wall_j + plastic_sphere_j), steel on steel, coarse"
+        ),
+        fe_row!(
+            "ch4.fig4_15.split_al",
+            "share of the plastic dissipation in the wall, steel on Al 6060 (D: ≈ 90 %)",
+            worded(0.9, "approximately 90 %", "1", "D L1861, Fig. 4.15"),
+            crate::abs(0.07),
+            fe_al,
+            wall_share,
+            "plastic_wall_j/(plastic_wall_j + plastic_sphere_j), steel on Al 6060, coarse"
+        ),
+    ]
+}
+
 /// The Ch. 4 targets.
 pub fn targets() -> Vec<Target> {
+    let mut t = closed_forms();
+    t.extend(fe_impacts());
+    t
+}
+
+/// The closed forms of the impact models.
+fn closed_forms() -> Vec<Target> {
     vec![
         closed_form(
             "ch4.eq4_2.beta_s235",

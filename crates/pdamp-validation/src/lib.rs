@@ -44,9 +44,15 @@ pub fn targets() -> Vec<Target> {
 /// Evaluates the targets of `tier` in `ctx` (a `Full` run also runs the `Quick` rows; a
 /// `Quick` run lists the `Full` rows as not run) in parallel, in the order of [`targets`].
 pub fn run(tier: Tier, ctx: &Context) -> Vec<Row> {
+    run_where(tier, ctx, |_| true)
+}
+
+/// [`run`] on the targets that `keep` selects (e.g. by id prefix: `pdamp validate --only`).
+pub fn run_where(tier: Tier, ctx: &Context, keep: impl Fn(&Target) -> bool + Sync) -> Vec<Row> {
     use rayon::prelude::*;
     targets()
-        .par_iter()
+        .into_par_iter()
+        .filter(|t| keep(t))
         .map(|t| t.evaluate(ctx, tier == Tier::Full || t.tier == Tier::Quick))
         .collect()
 }
