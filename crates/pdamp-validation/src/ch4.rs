@@ -145,6 +145,7 @@ fn fe_impacts() -> Vec<Target> {
 /// The Ch. 4 targets.
 pub fn targets() -> Vec<Target> {
     let mut t = closed_forms();
+    t.extend(hertz_partners());
     t.extend(fe_impacts());
     t
 }
@@ -235,6 +236,13 @@ fn closed_forms() -> Vec<Target> {
                 )
             },
         ),
+    ]
+}
+
+/// The Hertz contact of the 30 mm steel sphere with the other partners of D Sect. 4.2 (the
+/// notes' evaluation of D Eq. 4.8).
+fn hertz_partners() -> Vec<Target> {
+    vec![
         closed_form(
             "ch4.eq4_8.te_steel_al",
             CH,
