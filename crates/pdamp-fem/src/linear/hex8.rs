@@ -8,21 +8,11 @@
 //! (+,+,+), (−,+,+).
 
 use super::FeError;
+use crate::solid::hex8::{CORNERS, shape};
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
 /// 24 × 24 element matrix.
 pub type Mat24 = SMatrix<f64, 24, 24>;
-
-const SIGNS: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
 
 /// Isotropic material of a solid element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,21 +36,6 @@ fn elasticity(mat: &SolidMaterial) -> SMatrix<f64, 6, 6> {
         d[(i + 3, i + 3)] = c * (1.0 - 2.0 * nu) / 2.0;
     }
     d
-}
-
-fn shape(xi: [f64; 3]) -> ([f64; 8], [[f64; 3]; 8]) {
-    let mut n = [0.0; 8];
-    let mut dn = [[0.0; 3]; 8];
-    for (a, s) in SIGNS.iter().enumerate() {
-        let f = [1.0 + s[0] * xi[0], 1.0 + s[1] * xi[1], 1.0 + s[2] * xi[2]];
-        n[a] = f[0] * f[1] * f[2] / 8.0;
-        dn[a] = [
-            s[0] * f[1] * f[2] / 8.0,
-            s[1] * f[0] * f[2] / 8.0,
-            s[2] * f[0] * f[1] / 8.0,
-        ];
-    }
-    (n, dn)
 }
 
 fn jacobian(x: &[[f64; 3]; 8], dn: &[[f64; 3]; 8]) -> Matrix3<f64> {
@@ -110,7 +85,7 @@ pub fn matrices(
     let j0 = jacobian(x, &dn0);
     let det0 = j0.determinant();
     let j0_inv = j0.try_inverse().ok_or(FeError::SingularCentreJacobian)?;
-    for gp in SIGNS.iter() {
+    for gp in CORNERS.iter() {
         let xi = [gp[0] * g, gp[1] * g, gp[2] * g];
         let (n, dn) = shape(xi);
         let j = jacobian(x, &dn);
@@ -173,7 +148,7 @@ mod tests {
 
     fn brick(a: f64, b: f64, c: f64) -> [[f64; 3]; 8] {
         let mut x = [[0.0; 3]; 8];
-        for (i, s) in SIGNS.iter().enumerate() {
+        for (i, s) in CORNERS.iter().enumerate() {
             x[i] = [
                 (s[0] + 1.0) * a / 2.0,
                 (s[1] + 1.0) * b / 2.0,

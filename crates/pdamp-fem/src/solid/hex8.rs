@@ -2,7 +2,9 @@
 //! points and the material gradients $\partial N_a/\partial X$ at them (used by the mesh for
 //! volumes and Jacobians and by the Saint Venant–Kirchhoff element).
 
-const SIGNS: [[f64; 3]; 8] = [
+/// Parametric coordinates of the corners in node order (also the signs of the shape
+/// functions); the linear hex8 of [`crate::linear`] and the meshes share them.
+pub(crate) const CORNERS: [[f64; 3]; 8] = [
     [-1.0, -1.0, -1.0],
     [1.0, -1.0, -1.0],
     [1.0, 1.0, -1.0],
@@ -17,7 +19,7 @@ const SIGNS: [[f64; 3]; 8] = [
 pub fn shape(xi: [f64; 3]) -> ([f64; 8], [[f64; 3]; 8]) {
     let mut n = [0.0; 8];
     let mut dn = [[0.0; 3]; 8];
-    for (a, s) in SIGNS.iter().enumerate() {
+    for (a, s) in CORNERS.iter().enumerate() {
         let f = [1.0 + s[0] * xi[0], 1.0 + s[1] * xi[1], 1.0 + s[2] * xi[2]];
         n[a] = f[0] * f[1] * f[2] / 8.0;
         dn[a] = [
@@ -79,7 +81,7 @@ pub fn element_gauss_points(nodes: &[[f64; 3]], el: &[usize; 8]) -> [GaussPoint;
         wdet: 0.0,
         n: [0.0; 8],
     }; 8];
-    for (q, s) in SIGNS.iter().enumerate() {
+    for (q, s) in CORNERS.iter().enumerate() {
         let (n, dxi) = shape([s[0] * G, s[1] * G, s[2] * G]);
         let mut j = [[0.0; 3]; 3];
         for a in 0..8 {

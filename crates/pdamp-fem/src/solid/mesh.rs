@@ -5,6 +5,7 @@
 //! Node order of an element: $(\xi,\eta,\zeta)$ = (−,−,−), (+,−,−), (+,+,−), (−,+,−), (−,−,+),
 //! (+,−,+), (+,+,+), (−,+,+) — the Gmsh/Abaqus convention.
 
+use super::hex8::CORNERS;
 use std::collections::HashMap;
 
 /// Local node lists of the six faces of a hex8, ordered so that the normal
@@ -439,18 +440,6 @@ struct RawHex {
     nodes: [i64; 8],
     line: usize,
 }
-
-/// Parametric coordinates of the corners, in node order.
-const CORNERS: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
 
 /// Jacobian determinant of a hex8 with corners `x` at the parametric point `xi`.
 pub fn jacobian_det(x: &[[f64; 3]; 8], xi: [f64; 3]) -> f64 {
