@@ -45,5 +45,5 @@ pub use math::Vec3;
 pub use particles::ParticleSet;
 pub use state::WorldState;
 pub use walls::Geometry;
-pub use world::World;
+pub use world::{AdaptiveSkin, World};
 pub mod impact;

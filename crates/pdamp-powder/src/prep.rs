@@ -217,6 +217,7 @@ impl TryFrom<PreparationData> for Preparation {
         d.law.validate("preparation state: law.")?;
         let mut world = walls_world(&d.cavity, &d.law, d.density_kg_m3, 1.0, d.top_start);
         world.set_particles_of(&d.world)?;
+        world.set_adaptive_skin(Some(world.default_adaptive_skin()));
         let mut p = Self {
             world,
             plate: d.plate,
@@ -329,6 +330,9 @@ impl Preparation {
         for (x, r) in pos {
             world.add_particle(x, r, PARTICLE_MATERIAL);
         }
+        // the grid falls and bounces: a skin sized by the fastest particle saves most of the
+        // neighbour builds (same trajectory, see `pdamp_dem::AdaptiveSkin`)
+        world.set_adaptive_skin(Some(world.default_adaptive_skin()));
         let mtot = world.particles.total_mass();
         // settling: until the mean kinetic energy per particle is below 1e-4 of m g_eff d50
         let e_ref = 1e-4 * mtot * 9.81 * s.settling_gravity_factor * psd.d50_m;
