@@ -16,5 +16,5 @@ pub mod svk;
 
 pub use gen_alpha::{Dynamics, DynamicsError, DynamicsState, GenAlpha, NewtonSettings, Rayleigh};
 pub use mesh::{Aabb, BoxMeshDivisions, Face, HexMesh, MeshError, read_abaqus_inp, read_gmsh};
-pub use structure::{LoadRamp, MassKind, Structure, SurfaceLoad};
+pub use structure::{Kinematics, LoadRamp, MassKind, Structure, SurfaceLoad};
 pub use svk::SvkMaterial;

@@ -55,6 +55,21 @@ pub enum MassKind {
     Lumped,
 }
 
+/// Kinematics of the solid.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Kinematics {
+    /// Finite deformation: total-Lagrangian Saint Venant–Kirchhoff, Green–Lagrange strains
+    /// (P eq. 8–11; the paper's model).
+    #[default]
+    Finite,
+    /// Small deformation: $\mathbf f_{int} = \mathbf K_0\mathbf d$ with the reference
+    /// stiffness, strain energy $\tfrac12\mathbf d^\top\mathbf K_0\mathbf d$ (the first-order
+    /// term of the finite model; the modified-Newton tangent is then exact, so a step needs
+    /// one solve instead of the ≈ 4 that the rotations of a bending beam cost the finite model).
+    Linear,
+}
+
 /// Assembled structure on the free dofs.
 pub struct Structure {
     /// The mesh.
@@ -83,6 +98,10 @@ pub struct Structure {
     elem_free: Vec<[usize; 24]>,
     /// Scratch for element forces.
     scratch: Vec<[f64; 24]>,
+    /// Finite or small deformation ([`Structure::set_kinematics`]).
+    kinematics: Kinematics,
+    /// Scratch of the small-deformation internal force: `d` and `K₀ d` on the free dofs.
+    linear_scratch: (Vec<f64>, Vec<f64>),
 }
 
 impl Structure {
@@ -186,6 +205,8 @@ impl Structure {
             body_force,
             elem_free,
             scratch: Vec::new(),
+            kinematics: Kinematics::Finite,
+            linear_scratch: (Vec::new(), Vec::new()),
         };
         let zero = vec![0.0; ndof];
         s.k0 = s.tangent(&zero);
@@ -239,8 +260,42 @@ impl Structure {
         3 * self.mesh.nodes.len()
     }
 
-    /// Tangent stiffness at displacement `d` (all dofs) on the free dofs.
+    /// Finite or small deformation (default finite, the paper's model).
+    pub fn kinematics(&self) -> Kinematics {
+        self.kinematics
+    }
+
+    /// Chooses finite or small deformation for the internal force and the tangent.
+    pub fn set_kinematics(&mut self, k: Kinematics) {
+        self.kinematics = k;
+    }
+
+    /// `K₀ d` (all dofs, zero at clamped ones) and $\tfrac12\mathbf d^\top\mathbf K_0\mathbf d$
+    /// on the free dofs (same sums in the same order for any thread count).
+    fn linear_internal_force(&mut self, d: &[f64], out: &mut [f64]) -> f64 {
+        let nf = self.free_dofs.len();
+        let (df, kd) = &mut self.linear_scratch;
+        df.resize(nf, 0.0);
+        kd.resize(nf, 0.0);
+        for (x, &g) in df.iter_mut().zip(&self.free_dofs) {
+            *x = d[g];
+        }
+        self.k0.mul(df, kd);
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let mut energy = 0.0;
+        for (k, &g) in self.free_dofs.iter().enumerate() {
+            out[g] = kd[k];
+            energy += df[k] * kd[k];
+        }
+        0.5 * energy
+    }
+
+    /// Tangent stiffness at displacement `d` (all dofs) on the free dofs (with
+    /// [`Kinematics::Linear`] the reference stiffness at every `d`).
     pub fn tangent(&self, d: &[f64]) -> SymmetricCsr {
+        if self.kinematics == Kinematics::Linear && self.k0.n == self.free_dofs.len() {
+            return self.k0.clone();
+        }
         let (lam, mu) = self.material.lame();
         let mut t = Vec::with_capacity(self.mesh.elements.len() * 576);
         for (e, el) in self.mesh.elements.iter().enumerate() {
@@ -266,6 +321,9 @@ impl Structure {
 
     /// Internal forces (all dofs) and strain energy \[J\] at `d`.
     pub fn internal_force(&mut self, d: &[f64], out: &mut [f64]) -> f64 {
+        if self.kinematics == Kinematics::Linear {
+            return self.linear_internal_force(d, out);
+        }
         svk::internal_force(
             &self.mesh,
             &self.gps,

@@ -14,6 +14,7 @@ pub fn build_structure(beam: &BeamSpec, load: &LoadSpec, gravity: [f64; 3]) -> (
     let loaded = HexMesh::faces_on_plane(&faces, &mesh.nodes, 0, 0.0, tol);
     let tip = mesh.nearest_node([0.5 * beam.width_m, 0.5 * beam.width_m, beam.length_m]);
     let mut s = Structure::new(mesh, beam.material, &clamped, beam.mass, gravity);
+    s.set_kinematics(beam.kinematics);
     s.loads.push(SurfaceLoad {
         faces: loaded,
         traction_pa: [load.pressure_pa, 0.0, 0.0],

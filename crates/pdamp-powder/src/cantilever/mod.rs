@@ -33,7 +33,7 @@ use crate::couple::{CoupleError, CoupledEnergy, CouplingSettings};
 use crate::damping::TableOneRatios;
 use crate::error::ParameterError;
 use crate::fe::gen_alpha::DynamicsError;
-use crate::fe::{Aabb, BoxMeshDivisions, HexMesh, MassKind, Rayleigh, SvkMaterial};
+use crate::fe::{Aabb, BoxMeshDivisions, HexMesh, Kinematics, MassKind, Rayleigh, SvkMaterial};
 use crate::health::HealthError;
 use crate::law::PowderLaw;
 use crate::prep::{PrepError, PrepReport, PrepSettings};
@@ -100,6 +100,10 @@ pub struct BeamSpec {
     /// Optional Rayleigh damping (off by default).
     #[serde(default)]
     pub rayleigh: Rayleigh,
+    /// Finite (Saint Venant–Kirchhoff, the paper's model; default) or small deformation
+    /// (`"linear"`: internal force K₀d, one solve per structure step).
+    #[serde(default)]
+    pub kinematics: Kinematics,
 }
 
 fn d_mat() -> SvkMaterial {
