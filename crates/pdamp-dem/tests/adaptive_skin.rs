@@ -36,38 +36,6 @@ fn falling(model: ContactModel, dt: f64, mesh: bool, v_m_s: f64) -> World {
     w
 }
 
-fn assert_same_bits(a: &World, b: &World, what: &str) {
-    let (p, q) = (&a.particles, &b.particles);
-    for i in 0..p.len() {
-        for k in 0..3 {
-            assert_eq!(
-                p.position[i][k].to_bits(),
-                q.position[i][k].to_bits(),
-                "{what}: x[{i}]"
-            );
-            assert_eq!(
-                p.velocity[i][k].to_bits(),
-                q.velocity[i][k].to_bits(),
-                "{what}: v[{i}]"
-            );
-            assert_eq!(
-                p.angular_velocity[i][k].to_bits(),
-                q.angular_velocity[i][k].to_bits(),
-                "{what}: ω[{i}]"
-            );
-        }
-    }
-    let (l, m) = (&a.ledger, &b.ledger);
-    for (x, y, name) in [
-        (l.kinetic_j, m.kinetic_j, "kinetic"),
-        (l.elastic_j, m.elastic_j, "elastic"),
-        (l.wall_work_j, m.wall_work_j, "wall work"),
-        (l.dissipated_j(), m.dissipated_j(), "dissipated"),
-    ] {
-        assert_eq!(x.to_bits(), y.to_bits(), "{what}: ledger {name} {x} vs {y}");
-    }
-}
-
 #[test]
 fn adaptive_skin_keeps_the_trajectory_and_saves_builds() {
     // (law, time step, mesh box, throw speed): with the fixed skin (0.2 mm) the list lasts

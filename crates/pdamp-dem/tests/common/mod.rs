@@ -147,3 +147,49 @@ pub fn patch(side: f64, n: usize) -> TriMesh {
     }
     TriMesh::from_indexed(v, f).unwrap()
 }
+
+/// Asserts that two worlds hold the same bits: time, positions, velocities, spins, forces,
+/// torques and the energy ledger.
+pub fn assert_same_bits(a: &World, b: &World, what: &str) {
+    let (p, q) = (&a.particles, &b.particles);
+    assert_eq!(a.time_s.to_bits(), b.time_s.to_bits(), "{what}: time");
+    for i in 0..p.len() {
+        for k in 0..3 {
+            assert_eq!(
+                p.position[i][k].to_bits(),
+                q.position[i][k].to_bits(),
+                "{what}: x[{i}]"
+            );
+            assert_eq!(
+                p.velocity[i][k].to_bits(),
+                q.velocity[i][k].to_bits(),
+                "{what}: v[{i}]"
+            );
+            assert_eq!(
+                p.angular_velocity[i][k].to_bits(),
+                q.angular_velocity[i][k].to_bits(),
+                "{what}: ω[{i}]"
+            );
+            assert_eq!(
+                p.force[i][k].to_bits(),
+                q.force[i][k].to_bits(),
+                "{what}: F[{i}]"
+            );
+            assert_eq!(
+                p.torque[i][k].to_bits(),
+                q.torque[i][k].to_bits(),
+                "{what}: T[{i}]"
+            );
+        }
+    }
+    let (l, m) = (&a.ledger, &b.ledger);
+    for (x, y, name) in [
+        (l.kinetic_j, m.kinetic_j, "kinetic"),
+        (l.potential_j, m.potential_j, "potential"),
+        (l.elastic_j, m.elastic_j, "elastic"),
+        (l.wall_work_j, m.wall_work_j, "wall work"),
+        (l.dissipated_j(), m.dissipated_j(), "dissipated"),
+    ] {
+        assert_eq!(x.to_bits(), y.to_bits(), "{what}: ledger {name} {x} vs {y}");
+    }
+}
