@@ -21,7 +21,7 @@ fn main() {
         p.scaled_law(),
         p.density_kg_m3,
         sc.run.time_step_s,
-        &p.prep,
+        &p.scaled_prep(),
     );
     if std::env::var("FIXED").is_ok() {
         pr.world_mut().set_adaptive_skin(None);

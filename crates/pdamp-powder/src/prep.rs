@@ -5,7 +5,10 @@
 //! prescribed ϕ; finally relaxed with the plate held. The particles are prepared directly in
 //! the cavity's coordinates, so "extraction and insertion" is removing the box walls and the
 //! plate: the coupled run takes over the particles with their contacts
-//! ([`crate::bed::PowderBed`]).
+//! ([`crate::bed::PowderBed`]). The bed may be made with its own friction and adhesion
+//! ([`PrepSettings::friction`], [`PrepSettings::surface_energy_j_m2`]) and handed over with the
+//! law of the run: a looser settled bed, so that low packing densities fill the cavity as in
+//! the paper ("the cavity is always completely filled", Sect. 3.1) instead of leaving a gap.
 //!
 //! The box is five one-sided planes on a fixed body, the plate a sixth on a body that moves
 //! along a prescribed track (at constant speed while compressing, then held). [`Preparation`]
@@ -44,6 +47,17 @@ pub struct PrepSettings {
     pub relax_time_s: f64,
     /// Longest settling time \[s\].
     pub max_settling_time_s: f64,
+    /// Coefficient of friction while the bed is made (settling, relaxation, compression,
+    /// holding); `None`: the law's. The coupled run always uses the law's. A larger value
+    /// settles a looser bed (frictional random loose packing), so that a low packing density
+    /// fills the cavity instead of leaving a gap under its top (see docs/powder.md, "Loose,
+    /// fully filled cavities").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Surface energy of the DMT adhesion while the bed is made \[J/m²\]; `None`: the
+    /// law's. Cohesion holds a bed looser than friction alone can.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_energy_j_m2: Option<f64>,
 }
 
 impl Default for PrepSettings {
@@ -55,6 +69,20 @@ impl Default for PrepSettings {
             plate_speed_m_s: 0.2,
             relax_time_s: 2e-3,
             max_settling_time_s: 0.5,
+            friction: None,
+            surface_energy_j_m2: None,
+        }
+    }
+}
+
+impl PrepSettings {
+    /// The contact law while the bed is made: `law` with the preparation's friction and
+    /// surface energy where they are set.
+    pub fn law_of_preparation(&self, law: &PowderLaw) -> PowderLaw {
+        PowderLaw {
+            friction: self.friction.unwrap_or(law.friction),
+            surface_energy_j_m2: self.surface_energy_j_m2.unwrap_or(law.surface_energy_j_m2),
+            ..*law
         }
     }
 }
@@ -215,7 +243,9 @@ impl TryFrom<PreparationData> for Preparation {
             return Err(PrepError::StateNotFinite);
         }
         d.law.validate("preparation state: law.")?;
-        let mut world = walls_world(&d.cavity, &d.law, d.density_kg_m3, 1.0, d.top_start);
+        let prep_law = d.settings.law_of_preparation(&d.law);
+        prep_law.validate("preparation state: settings.")?;
+        let mut world = walls_world(&d.cavity, &prep_law, d.density_kg_m3, 1.0, d.top_start);
         world.set_particles_of(&d.world)?;
         world.set_adaptive_skin(Some(world.default_adaptive_skin()));
         let mut p = Self {
@@ -325,7 +355,8 @@ impl Preparation {
             .map(|(x, r)| x.z + r)
             .fold(cavity.max[2], f64::max)
             + spacing;
-        let mut world = walls_world(&cavity, &law, density_kg_m3, dt, top_start);
+        let prep_law = s.law_of_preparation(&law);
+        let mut world = walls_world(&cavity, &prep_law, density_kg_m3, dt, top_start);
         world.gravity_m_s2 = Vec3::new(0.0, 0.0, -9.81 * s.settling_gravity_factor);
         for (x, r) in pos {
             world.add_particle(x, r, PARTICLE_MATERIAL);

@@ -333,6 +333,43 @@ fn every_number_is_validated_with_its_key() {
     }
 }
 
+/// The optional preparation keys (absent from the tiny scenario) are checked like the law's.
+#[test]
+fn preparation_friction_and_surface_energy_are_validated_with_their_keys() {
+    for (key, value) in [
+        ("friction", "-0.1"),
+        ("friction", "nan"),
+        ("surface_energy_j_m2", "inf"),
+        ("surface_energy_j_m2", "-1.0"),
+    ] {
+        let text = tiny_text().replace(
+            "[powder.prep]\n",
+            &format!("[powder.prep]\n{key} = {value}\n"),
+        );
+        assert!(
+            text.contains(&format!("{key} = {value}")),
+            "no [powder.prep] section"
+        );
+        let e = CantileverScenario::from_toml(&text)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("powder.prep.{key}")),
+            "powder.prep.{key} = {value}: {e}"
+        );
+    }
+    let ok = tiny_text().replace(
+        "[powder.prep]\n",
+        "[powder.prep]\nfriction = 1.0\nsurface_energy_j_m2 = 2.0\n",
+    );
+    let sc = CantileverScenario::from_toml(&ok).unwrap();
+    let p = sc.powder.unwrap();
+    assert_eq!(p.prep.friction, Some(1.0));
+    // coarse-grained like the law's surface energy: γ' = f² γ
+    let f = p.d50_m / p.reference_d50_m;
+    assert_eq!(p.scaled_prep().surface_energy_j_m2, Some(2.0 * f * f));
+}
+
 #[test]
 fn sizes_are_bounded_with_a_cost_estimate() {
     // elements: 1 µm walls

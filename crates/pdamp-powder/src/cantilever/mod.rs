@@ -223,6 +223,15 @@ impl PowderSpec {
     pub fn scaled_law(&self) -> PowderLaw {
         self.law.coarse_grained(self.d50_m / self.reference_d50_m)
     }
+    /// Preparation settings of the simulated particles: a preparation surface energy is given
+    /// like `law.surface_energy_j_m2` (for `reference_d50_m`) and coarse-grained the same way.
+    pub fn scaled_prep(&self) -> PrepSettings {
+        let f = self.d50_m / self.reference_d50_m;
+        PrepSettings {
+            surface_energy_j_m2: self.prep.surface_energy_j_m2.map(|g| g * f * f),
+            ..self.prep
+        }
+    }
 }
 
 fn d_grav() -> [f64; 3] {

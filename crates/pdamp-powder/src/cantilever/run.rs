@@ -162,7 +162,7 @@ fn prepare_powder(
             p.scaled_law(),
             p.density_kg_m3,
             dt,
-            &p.prep,
+            &p.scaled_prep(),
         )
     });
     let mut err = None;

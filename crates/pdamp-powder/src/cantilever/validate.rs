@@ -252,6 +252,8 @@ impl CantileverScenario {
                 )
                 .into());
             }
+            // the preparation's friction and surface energy, checked like the law's
+            s.law_of_preparation(&p.law).validate("powder.prep.")?;
             if !(s.max_settling_time_s > 0.0 && s.max_settling_time_s <= 1e3) {
                 return Err(ParameterError::out_of_range(
                     "powder.prep.max_settling_time_s",
