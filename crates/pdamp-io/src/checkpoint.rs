@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 
 /// Format version of the checkpoint file; bumped when the layout changes.
-pub const CHECKPOINT_FORMAT: u32 = 3;
+pub const CHECKPOINT_FORMAT: u32 = 4;
 
 /// Error text prefix of a run stopped on request after its checkpoint was written.
 pub const INTERRUPTED: &str = "interrupted";

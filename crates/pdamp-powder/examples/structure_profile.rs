@@ -167,4 +167,9 @@ fn main() {
         t0.elapsed().as_secs_f64() / steps as f64 * 1e3,
         its as f64 / steps as f64
     );
+    // the final state, to compare Newton tolerances (GA_TOL)
+    let (dmax, dsum) =
+        dy.d.iter()
+            .fold((0.0f64, 0.0f64), |(m, s), x| (m.max(x.abs()), s + x));
+    println!("final max |d| = {dmax:.12e} m, sum d = {dsum:.12e} m");
 }

@@ -73,6 +73,12 @@ pub struct CouplingSettings {
     pub aitken: bool,
     /// First relaxation factor of each step.
     pub initial_relaxation: f64,
+    /// Newton tolerance of the structure's step inside each coupling iteration: largest
+    /// residual entry over the largest force term; `None`: that of
+    /// [`pdamp_fem::solid::NewtonSettings`] (1e-10). (An option, so that a scenario without it
+    /// keeps its digest: TOML leaves `None` out.)
+    #[serde(default)]
+    pub structure_tolerance: Option<f64>,
 }
 
 impl Default for CouplingSettings {
@@ -82,6 +88,7 @@ impl Default for CouplingSettings {
             max_iterations: 50,
             aitken: true,
             initial_relaxation: 1.0,
+            structure_tolerance: None,
         }
     }
 }
@@ -342,6 +349,9 @@ impl Coupled {
             interface,
         );
         c.settings = settings;
+        if let Some(t) = settings.structure_tolerance {
+            c.dynamics.newton.tolerance = t;
+        }
         c.vertex_node = vertex_node;
         c.vertices = c.reference_vertices();
         Ok(c)
@@ -482,6 +492,9 @@ impl Coupled {
         );
         let [last, total, max, steps] = st.counters;
         c.settings = settings;
+        if let Some(t) = settings.structure_tolerance {
+            c.dynamics.newton.tolerance = t;
+        }
         c.vertex_node = vertex_node;
         c.vertices = vertices;
         c.last_iterations = last as usize;

@@ -52,11 +52,11 @@ pub struct PrepSettings {
     /// settles a looser bed (frictional random loose packing), so that a low packing density
     /// fills the cavity instead of leaving a gap under its top (see docs/powder.md, "Loose,
     /// fully filled cavities").
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub friction: Option<f64>,
     /// Surface energy of the DMT adhesion while the bed is made \[J/m²\]; `None`: the
     /// law's. Cohesion holds a bed looser than friction alone can.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub surface_energy_j_m2: Option<f64>,
 }
 

@@ -50,10 +50,14 @@ fn preparation_continued_from_checkpoints_is_bit_identical() {
     let psd = LogNormal::paper(2e-3);
     let law = PowderLaw::PAPER.coarse_grained(2.0);
     let dt = 5e-6;
+    // with the preparation's own friction and adhesion: a restored preparation must rebuild
+    // its world with them (and hand the bed over with the law)
     let s = PrepSettings {
         packing_density: 0.5,
         max_settling_time_s: 0.01,
         relax_time_s: 5e-4,
+        friction: Some(0.8),
+        surface_energy_j_m2: Some(1.0),
         ..PrepSettings::default()
     };
     let (p_ref, mut rep_ref) =

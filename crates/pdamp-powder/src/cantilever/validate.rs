@@ -186,6 +186,16 @@ impl CantileverScenario {
             )
             .into());
         }
+        if let Some(t) = c.structure_tolerance
+            && !(1e-14..=1e-4).contains(&t)
+        {
+            return Err(ParameterError::out_of_range(
+                "run.coupling.structure_tolerance",
+                t,
+                "must be in [1e-14, 1e-4] (relative Newton residual of the structure step; default 1e-10)",
+            )
+            .into());
+        }
         if !(c.initial_relaxation > 0.0 && c.initial_relaxation <= 2.0) {
             return Err(ParameterError::out_of_range(
                 "run.coupling.initial_relaxation",
