@@ -200,6 +200,9 @@ impl Evidence {
     }
 }
 
+/// The stage name of the preparation's plate compression (see [`crate::prep`]).
+pub const COMPRESSION_STAGE: &str = "preparation: plate compression";
+
 /// A failed health check (see the module docs).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("numerical failure at t = {time_s:.6e} s ({stage}): {symptom}; likely cause: {cause}")]
@@ -234,7 +237,19 @@ impl HealthError {
         symptom: Symptom,
         evidence: Evidence,
     ) -> Self {
-        let cause = evidence.likely_cause(&symptom);
+        let cause = match symptom {
+            // the plate drives the bed into the side walls: the bed is too stiff or too
+            // dense for the packing density asked
+            Symptom::Escaped { .. } if stage == COMPRESSION_STAGE => format!(
+                "the bed resists the plate and is pressed through a side wall (largest overlap \
+                 {:.2} of the smaller diameter): the settled bed is too far below the packing \
+                 density asked; lower powder.prep.packing_density, make the bed less loose \
+                 (a smaller powder.prep.friction or surface_energy_j_m2) or raise \
+                 powder.law.normal_stiffness_n_m",
+                evidence.max_relative_overlap
+            ),
+            _ => evidence.likely_cause(&symptom),
+        };
         Self {
             time_s,
             stage,

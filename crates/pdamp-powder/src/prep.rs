@@ -453,7 +453,7 @@ impl Preparation {
         match self.stage {
             Stage::Settling { .. } => "preparation: settling",
             Stage::Relaxing { .. } => "preparation: relaxing under 1 g",
-            Stage::Compressing { .. } => "preparation: plate compression",
+            Stage::Compressing { .. } => health::COMPRESSION_STAGE,
             Stage::Holding { .. } => "preparation: relaxing with the plate held",
             Stage::Done => "preparation: done",
         }

@@ -864,3 +864,33 @@ fn neighbor_list_survives_non_finite_positions() {
     assert_eq!(nl.num_pairs(), 1, "only the finite pair 0–3");
     assert_eq!((nl.first[0], nl.second[0]), (0, 3));
 }
+
+/// A particle pressed out of the cavity during the plate compression is blamed on the bed
+/// resisting the plate (a too loose or too stiff bed for the packing density asked), not on
+/// the load or the time step of the coupled run.
+#[test]
+fn particle_pressed_out_by_the_plate_names_the_preparation_keys() {
+    use pdamp_powder::health::{COMPRESSION_STAGE, HealthError, Symptom};
+    let law = PowderLaw::PAPER;
+    let w = pdamp_powder::bed::powder_world(&law, 8000.0, [0.0, 0.0, -9.81], 2.5e-6);
+    let escaped = Symptom::Escaped {
+        particle: 3,
+        position: [0.0; 3],
+        distance_m: 5e-6,
+    };
+    let e = HealthError::of_world(0.26, COMPRESSION_STAGE, escaped.clone(), &w, &law);
+    assert!(
+        e.cause.starts_with("the bed resists the plate")
+            && e.cause.contains("powder.prep.packing_density")
+            && e.cause.contains("powder.prep.friction"),
+        "{}",
+        e.cause
+    );
+    let e = HealthError::of_world(0.01, "coupled run", escaped, &w, &law);
+    assert!(
+        e.cause
+            .starts_with("a particle passed through a cavity wall"),
+        "{}",
+        e.cause
+    );
+}
