@@ -11,24 +11,29 @@ use pdamp_powder::law::PowderLaw;
 use pdamp_powder::prep::{self, PrepSettings};
 use pdamp_powder::psd::LogNormal;
 
-#[test]
-fn prepared_bed_is_at_rest_under_one_g() {
-    // ≈ 300 coarse particles (D50 = 2 mm) in an 8 × 8 × 60 mm cavity, ϕ = 0.40: the settled bed
-    // stays below the cavity top (no compression), settled under 20 g
+/// ≈ 300 coarse particles (D50 = 2 mm) in an 8 × 8 × 60 mm cavity at ϕ = 0.40, so that the
+/// settled bed stays below the cavity top (no compression): cavity, sizes, law (coarse-grained
+/// to 2 mm), time step and settings with settling under `g_factor` g.
+fn small_bed(g_factor: f64) -> (Aabb, LogNormal, PowderLaw, f64, PrepSettings) {
     let cavity = Aabb {
         min: [0.0; 3],
         max: [0.008, 0.008, 0.060],
     };
-    let psd = LogNormal::paper(2e-3);
-    let law = PowderLaw::PAPER.coarse_grained(2.0);
-    let dt = 5e-6;
     let s = PrepSettings {
         packing_density: 0.40,
-        settling_gravity_factor: 20.0,
+        settling_gravity_factor: g_factor,
         max_settling_time_s: 0.2,
         relax_time_s: 2e-3,
         ..PrepSettings::default()
     };
+    let law = PowderLaw::PAPER.coarse_grained(2.0);
+    (cavity, LogNormal::paper(2e-3), law, 5e-6, s)
+}
+
+#[test]
+fn prepared_bed_is_at_rest_under_one_g() {
+    // settled under 20 g
+    let (cavity, psd, law, dt, s) = small_bed(20.0);
     let (bed, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
     assert!(!rep.compressed, "the bed must stay below the cavity top");
     let n = bed.len();
@@ -84,21 +89,8 @@ fn prepared_bed_is_at_rest_under_one_g() {
 #[test]
 fn preparation_friction_and_adhesion_make_a_looser_bed_for_the_law_of_the_run() {
     use pdamp_dem::FrictionLaw;
-    // ≈ 300 coarse particles (D50 = 2 mm) in an 8 × 8 × 60 mm cavity, ϕ = 0.40: no compression
-    let cavity = Aabb {
-        min: [0.0; 3],
-        max: [0.008, 0.008, 0.060],
-    };
-    let psd = LogNormal::paper(2e-3);
-    let law = PowderLaw::PAPER.coarse_grained(2.0);
-    let dt = 5e-6;
-    let base = PrepSettings {
-        packing_density: 0.40,
-        settling_gravity_factor: 2.0,
-        max_settling_time_s: 0.2,
-        relax_time_s: 2e-3,
-        ..PrepSettings::default()
-    };
+    // settled under 2 g (adhesion against a weight not magnified much)
+    let (cavity, psd, law, dt, base) = small_bed(2.0);
     let prep = |s: &PrepSettings| prep::prepare(cavity, &psd, law, 8000.0, dt, s, &mut |_, _| {});
     let (bed0, rep0) = prep(&base).unwrap();
     // the law's friction given explicitly: the same bed, bit for bit
