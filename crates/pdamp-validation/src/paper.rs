@@ -138,7 +138,7 @@ pub fn targets() -> Vec<Target> {
 /// Why the Table 1 row differs (measured 2026-12-07, docs/powder.md "Table 1 on the one
 /// engine").
 const TABLE_ONE_CAUSE: &str = "the damping is set by how hard the plate compresses the \
-    settled bed, which the paper does not state: our beds settle at ϕ = 0.578–0.580, so at 58 % \
+    settled bed, which the paper does not state: our beds settle at ϕ = 0.576–0.580, so at 58 % \
     the plate just touches (0 N, ζ̄5 0.013), at 59 % it presses with 2–7 N (ζ̄5 0.033–0.066, ζ1 up \
     to 0.153), at 60 % with 41 N (ζ̄5 0.048, overlaps 10–13 % of D, above Table A.2's \
     c_g = 5.5 %), at 61 % with 97–104 N 0.022: the paper's curve, shifted by 1–2 % of ϕ and lower";
