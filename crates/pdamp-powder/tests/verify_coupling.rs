@@ -167,14 +167,19 @@ fn resting_particle_carries_its_weight() {
     assert!((fs[2] / mg + 1.0).abs() < 1e-3);
 }
 
-#[test]
-fn coupled_energy_balance_closes() {
-    // elastic, frictionless particle on a soft plate (E = 1 GPa): the plate takes up energy
-    let law = PowderLaw {
+/// The paper's law made elastic and frictionless (nothing dissipated in the contacts).
+fn elastic_frictionless() -> PowderLaw {
+    PowderLaw {
         restitution: 1.0,
         friction: 0.0,
         ..PowderLaw::PAPER
-    };
+    }
+}
+
+#[test]
+fn coupled_energy_balance_closes() {
+    // elastic, frictionless particle on a soft plate (E = 1 GPa): the plate takes up energy
+    let law = elastic_frictionless();
     let dt = 5e-7;
     let mut c = coupled(1e9, law, 1.0, dt);
     let e0 = c.energy();
@@ -201,11 +206,7 @@ fn coupled_energy_balance_closes() {
 /// particle on the soft plate of `coupled_energy_balance_closes`.
 #[test]
 fn looser_structure_tolerance_keeps_the_coupled_result() {
-    let law = PowderLaw {
-        restitution: 1.0,
-        friction: 0.0,
-        ..PowderLaw::PAPER
-    };
+    let law = elastic_frictionless();
     let dt = 5e-7;
     let run = |structure_tolerance: f64| {
         let settings = CouplingSettings {

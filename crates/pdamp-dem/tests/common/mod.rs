@@ -153,33 +153,18 @@ pub fn patch(side: f64, n: usize) -> TriMesh {
 pub fn assert_same_bits(a: &World, b: &World, what: &str) {
     let (p, q) = (&a.particles, &b.particles);
     assert_eq!(a.time_s.to_bits(), b.time_s.to_bits(), "{what}: time");
-    for i in 0..p.len() {
-        for k in 0..3 {
-            assert_eq!(
-                p.position[i][k].to_bits(),
-                q.position[i][k].to_bits(),
-                "{what}: x[{i}]"
-            );
-            assert_eq!(
-                p.velocity[i][k].to_bits(),
-                q.velocity[i][k].to_bits(),
-                "{what}: v[{i}]"
-            );
-            assert_eq!(
-                p.angular_velocity[i][k].to_bits(),
-                q.angular_velocity[i][k].to_bits(),
-                "{what}: ω[{i}]"
-            );
-            assert_eq!(
-                p.force[i][k].to_bits(),
-                q.force[i][k].to_bits(),
-                "{what}: F[{i}]"
-            );
-            assert_eq!(
-                p.torque[i][k].to_bits(),
-                q.torque[i][k].to_bits(),
-                "{what}: T[{i}]"
-            );
+    let fields = [
+        ("x", &p.position, &q.position),
+        ("v", &p.velocity, &q.velocity),
+        ("ω", &p.angular_velocity, &q.angular_velocity),
+        ("F", &p.force, &q.force),
+        ("T", &p.torque, &q.torque),
+    ];
+    for (name, u, w) in fields {
+        for i in 0..p.len() {
+            for k in 0..3 {
+                assert_eq!(u[i][k].to_bits(), w[i][k].to_bits(), "{what}: {name}[{i}]");
+            }
         }
     }
     let (l, m) = (&a.ledger, &b.ledger);
