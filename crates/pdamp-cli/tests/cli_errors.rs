@@ -262,7 +262,7 @@ fn gpu_fields_refuse_unsupported_scenarios_up_front() {
     assert!(!o.status.success());
     assert!(
         err.contains("triangle-mesh wall")
-            && err.contains("cross1_arm_y")
+            && err.contains("'cross'")
             && err.contains("--device gpu"),
         "{err}"
     );
