@@ -87,3 +87,42 @@ fn inner_structure_meshes_are_closed_unions_of_the_bars() {
         assert!((v / volume_mm3 - 1.0).abs() < 1e-7, "{file}: {v} mm³");
     }
 }
+
+/// Why the crosses are one mesh: a sphere pressed onto the face of the single cross where its
+/// two arms cross (x = 23.7 mm, y = z = 0) touches the union mesh once; as two `box_outside`
+/// bars, each bar reports its own contact at the same point (twice the force). Beside the
+/// crossing (y = 10 mm) both give one contact.
+#[test]
+fn the_union_mesh_of_a_cross_presents_the_crossing_once() {
+    use pdamp_dem::Vec3;
+    use pdamp_dem::walls::{Geometry, TriMesh};
+    let (_, world) =
+        Scenario::load_and_build(&examples().join("damper_ch8_single_cross.toml")).unwrap();
+    let union = world
+        .bodies
+        .iter()
+        .flat_map(|b| &b.walls)
+        .find(|w| w.name == "cross")
+        .map(|w| w.geometry.clone())
+        .unwrap();
+    let bar = |half: [f64; 3]| {
+        let mut m = TriMesh::box_inside(Vec3::new(0.0262, 0.0, 0.0), Vec3::from(half));
+        m.flip_normals();
+        Geometry::Mesh(m)
+    };
+    let bars = [bar([0.0025, 0.02, 0.0025]), bar([0.0025, 0.0025, 0.02])];
+    let r = 1.25e-3;
+    for (y, bars_expected) in [(0.0, 2), (0.01, 1)] {
+        // 10 µm into the face x = 26.2 − 2.5 mm
+        let x = Vec3::new(0.0262 - 0.0025 - r + 1e-5, y, 0.0);
+        let mut out = Vec::new();
+        union.sphere_contacts(&x, r, 0.0, &mut out);
+        assert_eq!(out.len(), 1, "union at y = {y}: {out:?}");
+        assert!((out[0].overlap_m - 1e-5).abs() < 1e-9);
+        out.clear();
+        for b in &bars {
+            b.sphere_contacts(&x, r, 0.0, &mut out);
+        }
+        assert_eq!(out.len(), bars_expected, "two bars at y = {y}: {out:?}");
+    }
+}
