@@ -44,7 +44,38 @@ fn reduced_cantilever_runs_and_damps() {
     assert!(r.max_tip_before_release_m > 0.07e-3 && r.max_tip_before_release_m < 0.13e-3);
     assert!(r.mean_iterations < 5.0);
     let z1 = r.damping.zeta_1.expect("two minima after release");
-    assert!(z1 > 0.0 && z1 < 0.5, "{z1}");
+    // ζ is read from the tip alone; the structure's energy must decay with it: from the first
+    // minimum after release to the n-th, a single mode keeps the share (x_n/x_0)² of its energy
+    // (at a minimum the structure is at rest and holds strain energy only). Measured 2026-12-07:
+    // 0.630 / 0.419 from the tip against 0.640 / 0.437 of the structure's energy (n = 1, 2).
+    // (The contacts dissipate more than the structure loses — 5.1 against 1.1 mJ over the first
+    // period — because the bed compressed to 0.58 relaxes after release; the ledger's closure
+    // below accounts for both.)
+    let t_release = sc.load.rise_s + sc.load.hold_s;
+    let minima = pdamp_powder::damping::local_minima(&r.time_s, &r.tip_m, t_release);
+    assert!(minima.len() >= 3, "{} minima after release", minima.len());
+    let structure_energy_at = |t: f64| {
+        let e = &r
+            .energy
+            .iter()
+            .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+            .unwrap()
+            .1;
+        e.structure_strain_j + e.structure_kinetic_j
+    };
+    let e0 = structure_energy_at(r.time_s[minima[0]]);
+    for &m in &minima[1..3] {
+        let kept_tip = (r.tip_m[m] / r.tip_m[minima[0]]).powi(2);
+        let kept_energy = structure_energy_at(r.time_s[m]) / e0;
+        eprintln!("energy kept: {kept_tip:.4} from the tip, {kept_energy:.4} of the structure");
+        assert!(
+            (kept_energy / kept_tip - 1.0).abs() < 0.1,
+            "{kept_energy} vs {kept_tip}"
+        );
+    }
+    // the powder damps: the empty paper beam decays with ζ1 ≈ 0.004 (numerical damping of
+    // generalized-α, ρ∞ = 0.8; docs/powder.md)
+    assert!(z1 > 0.01 && z1 < 0.5, "{z1}");
     // dissipative run: stored + dissipated − load work stays constant (1.2e-3 of the largest
     // stored energy measured; the elastic coupled closure is checked in verify_coupling.rs)
     assert!(r.energy_closure < 5e-3, "{}", r.energy_closure);
