@@ -67,7 +67,8 @@ pub struct BedStatistics {
     pub direction: Option<[f64; 3]>,
     /// Span of the bed along the direction [lowest, highest] of x·e ∓ r, m.
     pub bed_span_along_direction_m: Option<[f64; 2]>,
-    /// Free length of the container through the bed's centroid along the direction, m.
+    /// Free length of the container through the bed's centroid along the direction (beside an
+    /// inner structure that blocks that line: the longest free line through a particle), m.
     pub container_length_along_direction_m: Option<f64>,
     /// Clearance h = free length − bed span along the direction (from the highest particle), m.
     pub clearance_m: Option<f64>,
@@ -270,7 +271,10 @@ fn packing_fractions(
 
 /// The clearance along the unit direction `e`: the bed's span along it, the container's free
 /// length through the bed's centroid (marched and bisected to the walls) and their difference
-/// (also to the surface when `e` is vertical).
+/// (also to the surface when `e` is vertical). Where an inner structure (a cross, a rod) holds
+/// the centroid or blocks its line, the length is the longest free line through a particle
+/// centre (at most 64 particles, evenly spaced), i.e. the container's length beside the
+/// structure.
 fn clearance_along(
     world: &World,
     e: Vec3,
@@ -292,12 +296,12 @@ fn clearance_along(
     }
     centroid /= n as f64;
     let reach = 10.0 * ((hi - lo).norm() + 2.0 * r_max);
-    let free_to = |sign: f64, scratch: &mut Vec<_>| -> f64 {
+    let free_to = |origin: &Vec3, sign: f64, scratch: &mut Vec<_>| -> f64 {
         // March in steps of a quarter radius, then bisect the wall crossing.
         let step = 0.25 * r_max.max(1e-12);
         let is_free = |t: f64, sc: &mut Vec<_>| {
             world
-                .wall_overlap(&(centroid + e * (sign * t)), 0.0, sc)
+                .wall_overlap(&(origin + e * (sign * t)), 0.0, sc)
                 .is_none()
         };
         let mut t = 0.0;
@@ -318,11 +322,24 @@ fn clearance_along(
         }
         a
     };
-    let length = if world.wall_overlap(&centroid, 0.0, &mut scratch).is_none() {
-        free_to(1.0, &mut scratch) + free_to(-1.0, &mut scratch)
-    } else {
-        f64::NAN
+    let free_length = |origin: &Vec3, scratch: &mut Vec<_>| {
+        if world.wall_overlap(origin, 0.0, scratch).is_none() {
+            free_to(origin, 1.0, scratch) + free_to(origin, -1.0, scratch)
+        } else {
+            f64::NAN
+        }
     };
+    let mut length = free_length(&centroid, &mut scratch);
+    // The centroid's line reaches the bed's ends (less a particle radius for a bed pressed
+    // against both ends); otherwise a structure stands in it.
+    if !(length >= s_hi - s_lo - r_max) {
+        let stride = n.div_ceil(64).max(1);
+        length = (0..n)
+            .step_by(stride)
+            .map(|i| free_length(&p.position[i], &mut scratch))
+            .filter(|l| l.is_finite())
+            .fold(length, |a, b| if a.is_nan() || b > a { b } else { a });
+    }
     s.direction = Some([e.x, e.y, e.z]);
     s.bed_span_along_direction_m = Some([s_lo, s_hi]);
     s.container_length_along_direction_m = Some(length);

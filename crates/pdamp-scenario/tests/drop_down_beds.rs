@@ -185,6 +185,13 @@ fn drop_down_around_inner_rod() {
         s.packing_fraction_bulk
     );
     assert!((4.0..=7.0).contains(&s.mean_coordination_number));
+    // The rod holds the bed's centroid: the clearance is measured along the free lines beside
+    // it, the can's 60 mm.
+    let s = bed_statistics(&bed.world, Some(Vec3::z()));
+    let length = s.container_length_along_direction_m.unwrap();
+    assert!((length - 0.06).abs() < 1e-9, "container length {length}");
+    let h = s.clearance_to_surface_m.unwrap();
+    assert!((h - (0.06 - s.bed_height_m)).abs() < 1e-9 && h > 0.0, "{h}");
 }
 
 /// A closed inner obstacle (`box_outside`, a closed mesh): no sphere starts inside it, also
