@@ -332,7 +332,7 @@ fn clearance_along(
     let mut length = free_length(&centroid, &mut scratch);
     // The centroid's line reaches the bed's ends (less a particle radius for a bed pressed
     // against both ends); otherwise a structure stands in it.
-    if !(length >= s_hi - s_lo - r_max) {
+    if length.is_nan() || length < s_hi - s_lo - r_max {
         let stride = n.div_ceil(64).max(1);
         length = (0..n)
             .step_by(stride)
