@@ -9,6 +9,11 @@
 //! ([`PrepSettings::friction`], [`PrepSettings::surface_energy_j_m2`]) and handed over with the
 //! law of the run: a looser settled bed, so that low packing densities fill the cavity as in
 //! the paper ("the cavity is always completely filled", Sect. 3.1) instead of leaving a gap.
+//! Such a bed is then handed over: with the plate still held, the contacts take the run's law
+//! and the bed relaxes under it until it is at rest again, so that the coupled run starts from
+//! a bed in equilibrium under its own law (a bed compressed under μ = 1 and adhesion otherwise
+//! unloads its pre-stress in the first milliseconds of the run, where that release would be
+//! counted as damping and the integrator's error on it spoils the energy closure).
 //!
 //! The box is five one-sided planes on a fixed body, the plate a sixth on a body that moves
 //! along a prescribed track (at constant speed while compressing, then held). [`Preparation`]
@@ -108,6 +113,18 @@ pub struct PrepReport {
     pub steps: u64,
     /// Wall time \[s\].
     pub wall_time_s: f64,
+    /// Force on the plate at the end of the hold under the preparation's law \[N\] (equal to
+    /// `plate_force_n` when the bed was made with the run's law).
+    #[serde(default)]
+    pub plate_force_before_handover_n: f64,
+    /// Simulated time of the handover to the run's law \[s\] (0 when the bed was made with
+    /// the run's law).
+    #[serde(default)]
+    pub handover_time_s: f64,
+    /// Height between the cavity top and the highest particle top at the end \[m\] (0 for a
+    /// filled cavity; what the bed leaves empty).
+    #[serde(default)]
+    pub top_gap_m: f64,
 }
 
 /// Gravity of the relaxation, compression and of the prepared bed [m/s²].
@@ -129,6 +146,9 @@ enum Stage {
     Compressing { q: u64, nsteps: u64, dz: f64 },
     /// Relaxation with the plate held at the cavity top; `q` steps.
     Holding { q: u64 },
+    /// Handover of a bed made with its own law: the run's law, the plate held, until at rest
+    /// again; `done` steps.
+    Handover { done: u64 },
     /// Finished.
     Done,
 }
@@ -164,6 +184,10 @@ pub struct Preparation {
     compressed: bool,
     bed_top: f64,
     plate_force: f64,
+    /// Plate force at the end of the hold, before the handover \[N\].
+    plate_force_held: f64,
+    /// Steps of the handover so far.
+    handover_steps: u64,
     wall_time_s: f64,
     segment_start: Option<Instant>,
 }
@@ -187,6 +211,8 @@ struct PreparationData {
     compressed: bool,
     bed_top: f64,
     plate_force: f64,
+    plate_force_held: f64,
+    handover_steps: u64,
     wall_time_s: f64,
 }
 
@@ -209,6 +235,8 @@ impl From<Preparation> for PreparationData {
             compressed: p.compressed,
             bed_top: p.bed_top,
             plate_force: p.plate_force,
+            plate_force_held: p.plate_force_held,
+            handover_steps: p.handover_steps,
             wall_time_s: p.wall_time_s(),
         }
     }
@@ -265,13 +293,27 @@ impl TryFrom<PreparationData> for Preparation {
             compressed: d.compressed,
             bed_top: d.bed_top,
             plate_force: d.plate_force,
+            plate_force_held: d.plate_force_held,
+            handover_steps: d.handover_steps,
             wall_time_s: d.wall_time_s,
             segment_start: None,
         };
+        if matches!(p.stage, Stage::Handover { .. } | Stage::Done) {
+            p.use_law_of_run();
+        }
         p.set_plate_track(p.plate, false);
         p.world.restore_state(d.world)?;
         Ok(p)
     }
+}
+
+/// Height of the highest particle top \[m\].
+fn bed_top(p: &pdamp_dem::ParticleSet) -> f64 {
+    p.position
+        .iter()
+        .zip(&p.radius)
+        .map(|(x, r)| x.z + r)
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 /// A world of the powder inside `cavity`: the five box walls on a fixed body, the plate at
@@ -385,6 +427,8 @@ impl Preparation {
             compressed: false,
             bed_top: 0.0,
             plate_force: 0.0,
+            plate_force_held: 0.0,
+            handover_steps: 0,
             wall_time_s: 0.0,
             segment_start: None,
         };
@@ -455,6 +499,7 @@ impl Preparation {
             Stage::Relaxing { .. } => "preparation: relaxing under 1 g",
             Stage::Compressing { .. } => health::COMPRESSION_STAGE,
             Stage::Holding { .. } => "preparation: relaxing with the plate held",
+            Stage::Handover { .. } => "preparation: handover to the run's law",
             Stage::Done => "preparation: done",
         }
     }
@@ -526,12 +571,7 @@ impl Preparation {
     fn start_compression(&mut self) {
         let (cavity, s) = (self.cavity, self.settings);
         let p = &self.world.particles;
-        let bed_top = p
-            .position
-            .iter()
-            .zip(&p.radius)
-            .map(|(x, r)| x.z + r)
-            .fold(f64::NEG_INFINITY, f64::max);
+        let bed_top = bed_top(p);
         let volume: f64 = p
             .radius
             .iter()
@@ -553,6 +593,17 @@ impl Preparation {
         let t0 = self.world.time_s;
         self.set_plate_track((t0, bed_top - self.top_start, -dz / dt), true);
         self.stage = Stage::Compressing { q: 0, nsteps, dz };
+    }
+
+    /// Gives every contact the run's law (particle–particle and particle–wall); the contact
+    /// histories are kept (the tangential springs are mapped onto the new Coulomb limit at the
+    /// next force evaluation).
+    fn use_law_of_run(&mut self) {
+        let model = crate::bed::contact_model(&self.law);
+        self.world
+            .set_contact_model(PARTICLE_MATERIAL, PARTICLE_MATERIAL, model.clone());
+        self.world
+            .set_contact_model(PARTICLE_MATERIAL, WALL_MATERIAL, model);
     }
 
     fn start_holding(&mut self) {
@@ -641,9 +692,38 @@ impl Preparation {
                         progress("relaxing", q as f64 / self.relax_steps as f64);
                     }
                     self.stage = Stage::Holding { q: q + 1 };
+                } else if self.settings.law_of_preparation(&self.law) != self.law {
+                    self.plate_force_held = self.plate_force;
+                    self.use_law_of_run();
+                    self.stage = Stage::Handover { done: 0 };
                 } else {
+                    self.plate_force_held = self.plate_force;
                     self.stage = Stage::Done;
                 }
+            }
+            Stage::Handover { done } => {
+                // at least `relax_time_s`, then until the bed is at rest under 1 g again, or
+                // `max_settling_time_s` more
+                let t_max = self.relax_steps
+                    + (self.settings.max_settling_time_s / self.world.dt_s).ceil() as u64;
+                let chunk = SETTLE_CHUNK as u64;
+                let at_rest = done >= self.relax_steps
+                    && done.is_multiple_of(chunk)
+                    && self.world.ledger.kinetic_j < self.e_ref_1g;
+                if done >= t_max || at_rest {
+                    self.handover_steps = done;
+                    self.stage = Stage::Done;
+                    return Ok(true);
+                }
+                self.step()?;
+                self.plate_force = self.world.body_load(PLATE).0.z;
+                if (done + 1) % (50 * chunk) == 0 {
+                    progress(
+                        "handover to the run's law",
+                        (done + 1) as f64 / t_max as f64,
+                    );
+                }
+                self.stage = Stage::Handover { done: done + 1 };
             }
             Stage::Done => return Ok(false),
         }
@@ -698,6 +778,9 @@ impl Preparation {
             simulated_time_s: w.time_s,
             steps: self.steps,
             wall_time_s,
+            plate_force_before_handover_n: self.plate_force_held,
+            handover_time_s: self.handover_steps as f64 * w.dt_s,
+            top_gap_m: (self.cavity.max[2] - bed_top(&w.particles)).max(0.0),
         };
         let mut bed = PowderBed::at_rest(self.law, &[], &[], self.density_kg_m3, G0, w.dt_s);
         bed.world

@@ -171,7 +171,7 @@ impl StudyRow {
 }
 
 /// Columns of `table.csv` (units in the names; `compressed` is 1 or 0).
-pub const TABLE_COLUMNS: [&str; 15] = [
+pub const TABLE_COLUMNS: [&str; 17] = [
     "zeta_1",
     "zeta_2",
     "zeta_5",
@@ -181,6 +181,8 @@ pub const TABLE_COLUMNS: [&str; 15] = [
     "packing_density",
     "compressed",
     "plate_force_n",
+    "plate_force_before_handover_n",
+    "top_gap_m",
     "max_relative_overlap",
     "energy_closure",
     "mean_coupling_iterations",
@@ -191,7 +193,7 @@ pub const TABLE_COLUMNS: [&str; 15] = [
 
 /// One line of `table.csv`: the parameter value (or, in an ensemble, the packing), then
 /// [`TABLE_COLUMNS`].
-fn table_line(first: f64, r: &StudyRow) -> [f64; 16] {
+fn table_line(first: f64, r: &StudyRow) -> [f64; 18] {
     let nan = f64::NAN;
     let prep = r.prep.as_ref();
     let prep_wall = prep.map_or(0.0, |p| p.wall_time_s);
@@ -206,6 +208,8 @@ fn table_line(first: f64, r: &StudyRow) -> [f64; 16] {
         prep.map_or(nan, |p| p.packing_density),
         prep.map_or(nan, |p| f64::from(u8::from(p.compressed))),
         prep.map_or(nan, |p| p.plate_force_n),
+        prep.map_or(nan, |p| p.plate_force_before_handover_n),
+        prep.map_or(nan, |p| p.top_gap_m),
         prep.map_or(nan, |p| p.max_relative_overlap),
         r.energy_closure,
         r.mean_iterations,

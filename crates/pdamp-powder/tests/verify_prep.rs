@@ -136,3 +136,72 @@ fn preparation_friction_and_adhesion_make_a_looser_bed_for_the_law_of_the_run() 
         }
     }
 }
+
+/// A bed made with its own friction and adhesion and compressed by the plate is handed over to
+/// the run's law before the run: with the plate held, the contacts take the law (μ = 0.4, no
+/// adhesion) and the bed relaxes until it is at rest. The prepared bed, closed in by the cavity
+/// walls, then stays at rest under the run's law: it does not unload a pre-stress in the
+/// coupled run's first milliseconds (where the release would be counted as damping).
+#[test]
+fn a_bed_made_with_its_own_law_is_handed_over_at_rest_under_the_run_law() {
+    // 8 × 8 × 16 mm cavity at ϕ = 0.45: the loose bed settles above the cavity top and the
+    // plate compresses it
+    let (_, psd, law, dt, base) = small_bed(2.0);
+    let cavity = Aabb {
+        min: [0.0; 3],
+        max: [0.008, 0.008, 0.016],
+    };
+    let loose = PrepSettings {
+        packing_density: 0.45,
+        friction: Some(1.0),
+        surface_energy_j_m2: Some(8.0),
+        ..base
+    };
+    let (bed, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &loose, &mut |_, _| {}).unwrap();
+    assert!(rep.compressed, "the test must cover a compressed bed");
+    assert!(rep.handover_time_s >= loose.relax_time_s, "{rep:?}");
+    assert!(
+        rep.top_gap_m >= 0.0 && rep.top_gap_m < 0.5 * psd.d50_m,
+        "{rep:?}"
+    );
+    let n = bed.len();
+    let mass = bed.world.particles.total_mass();
+    let mut p = bed.world;
+    let (lo, hi) = (Vec3::from(cavity.min), Vec3::from(cavity.max));
+    p.add_body(
+        RigidBody::new("cavity", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
+            "box",
+            Geometry::BoxInside(BoxInside::new(0.5 * (lo + hi), 0.5 * (hi - lo))),
+            WALL_MATERIAL,
+        ),
+    );
+    p.initialize();
+    let el0 = p.ledger.elastic_j;
+    let mut ke_max = 0.0f64;
+    for _ in 0..(0.01 / dt) as usize {
+        p.step();
+        ke_max = ke_max.max(p.ledger.kinetic_j);
+    }
+    let w_d = mass * 9.81 * psd.d50_m;
+    eprintln!(
+        "{n} particles, settled ϕ {:.3}, plate force {:.3} N under the preparation's law, {:.3} \
+         N after a {:.1} ms handover, top gap {:.2e} m; over 10 ms in the closed cavity: contact \
+         elastic energy {el0:.3e} → {:.3e} J, peak kinetic energy {ke_max:.3e} J; M g D50 = \
+         {w_d:.3e} J",
+        rep.settled_packing_density,
+        rep.plate_force_before_handover_n,
+        rep.plate_force_n,
+        1e3 * rep.handover_time_s,
+        rep.top_gap_m,
+        p.ledger.elastic_j
+    );
+    assert!(
+        (el0 - p.ledger.elastic_j).abs() < 0.1 * el0,
+        "stored contact energy released: {el0:e} → {:e} J",
+        p.ledger.elastic_j
+    );
+    assert!(
+        ke_max < 5e-3 * w_d,
+        "bed moves: peak kinetic energy {ke_max:e} J"
+    );
+}

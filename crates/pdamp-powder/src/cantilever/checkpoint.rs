@@ -11,8 +11,9 @@ use crate::prep::{PrepReport, Preparation};
 
 /// Kind tag of `pdamp powder run` checkpoints (`-2`: the coupled run's particles are a
 /// pdamp-dem world; `-3`: the structure state says which precision its tangent factor has;
+/// `-4`: the preparation hands a bed made with its own law over to the run's law;
 /// checkpoints of earlier layouts are refused by name).
-pub const CHECKPOINT_KIND: &str = "powder-run-3";
+pub const CHECKPOINT_KIND: &str = "powder-run-4";
 
 /// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
 pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, CantileverError> {
