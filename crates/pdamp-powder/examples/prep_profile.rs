@@ -50,12 +50,13 @@ fn main() {
                     let b = pr.world().counters.neighbor_builds;
                     let w = t0.elapsed().as_secs_f64();
                     println!(
-                        "t {:.3} s wall {:.1} s (+{:.1}) builds +{} ke {:.3e}",
+                        "t {:.3} s wall {:.1} s (+{:.1}) builds +{} ke {:.3e} plate {:.4} N",
                         t,
                         w,
                         w - t_last,
                         b - b_last,
-                        pr.world().ledger.kinetic_j
+                        pr.world().ledger.kinetic_j,
+                        pr.world().body_load(1).0.z
                     );
                     t_last = w;
                     b_last = b;

@@ -147,8 +147,8 @@ enum Stage {
     /// Relaxation with the plate held at the cavity top; `q` steps.
     Holding { q: u64 },
     /// Handover of a bed made with its own law: the run's law, the plate held, until at rest
-    /// again; `done` steps.
-    Handover { done: u64 },
+    /// again; `done` steps; `force_mark`: the plate force at the last check \[N\].
+    Handover { done: u64, force_mark: f64 },
     /// Finished.
     Done,
 }
@@ -695,35 +695,56 @@ impl Preparation {
                 } else if self.settings.law_of_preparation(&self.law) != self.law {
                     self.plate_force_held = self.plate_force;
                     self.use_law_of_run();
-                    self.stage = Stage::Handover { done: 0 };
+                    self.stage = Stage::Handover {
+                        done: 0,
+                        force_mark: f64::NAN,
+                    };
                 } else {
                     self.plate_force_held = self.plate_force;
                     self.stage = Stage::Done;
                 }
             }
-            Stage::Handover { done } => {
-                // at least `relax_time_s`, then until the bed is at rest under 1 g again, or
-                // `max_settling_time_s` more
+            Stage::Handover { done, force_mark } => {
+                // At least `relax_time_s`; then, every `relax_time_s`, done when the bed is at
+                // rest under 1 g (the relaxation's criterion) or when the bed presses the plate
+                // with more than its weight and that force has settled (changed by less than
+                // 1e-3 of itself since the last check: a pre-stressed bed keeps a small creep,
+                // whose kinetic energy stays above the rest limit), or after
+                // `max_settling_time_s` more.
+                let window = self.relax_steps.max(SETTLE_CHUNK as u64);
                 let t_max = self.relax_steps
                     + (self.settings.max_settling_time_s / self.world.dt_s).ceil() as u64;
-                let chunk = SETTLE_CHUNK as u64;
-                let at_rest = done >= self.relax_steps
-                    && done.is_multiple_of(chunk)
-                    && self.world.ledger.kinetic_j < self.e_ref_1g;
-                if done >= t_max || at_rest {
+                let mut force_mark = force_mark;
+                if done >= self.relax_steps && done.is_multiple_of(window) {
+                    let f = self.plate_force;
+                    let weight = self.world.particles.total_mass() * 9.81;
+                    // (a plate without force says nothing: the bed may be falling away)
+                    let steady =
+                        f.abs() > weight && (f - force_mark).abs() <= 1e-3 * f.abs().max(weight);
+                    if steady || self.world.ledger.kinetic_j < self.e_ref_1g {
+                        self.handover_steps = done;
+                        self.stage = Stage::Done;
+                        return Ok(true);
+                    }
+                    force_mark = f;
+                }
+                if done >= t_max {
                     self.handover_steps = done;
                     self.stage = Stage::Done;
                     return Ok(true);
                 }
                 self.step()?;
                 self.plate_force = self.world.body_load(PLATE).0.z;
-                if (done + 1) % (50 * chunk) == 0 {
+                if (done + 1) % (50 * SETTLE_CHUNK as u64) == 0 {
                     progress(
                         "handover to the run's law",
                         (done + 1) as f64 / t_max as f64,
                     );
                 }
-                self.stage = Stage::Handover { done: done + 1 };
+                self.stage = Stage::Handover {
+                    done: done + 1,
+                    force_mark,
+                };
             }
             Stage::Done => return Ok(false),
         }

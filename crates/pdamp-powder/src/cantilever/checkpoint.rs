@@ -11,9 +11,10 @@ use crate::prep::{PrepReport, Preparation};
 
 /// Kind tag of `pdamp powder run` checkpoints (`-2`: the coupled run's particles are a
 /// pdamp-dem world; `-3`: the structure state says which precision its tangent factor has;
-/// `-4`: the preparation hands a bed made with its own law over to the run's law;
+/// `-5`: the preparation hands a bed made with its own law over to the run's law (`-4`
+/// was an intermediate layout of that stage);
 /// checkpoints of earlier layouts are refused by name).
-pub const CHECKPOINT_KIND: &str = "powder-run-4";
+pub const CHECKPOINT_KIND: &str = "powder-run-5";
 
 /// Digest identifying a scenario in checkpoints (FNV-1a 64 of its canonical TOML).
 pub fn scenario_digest(sc: &CantileverScenario) -> Result<String, CantileverError> {
