@@ -30,16 +30,9 @@ fn small_bed(g_factor: f64) -> (Aabb, LogNormal, PowderLaw, f64, PrepSettings) {
     (cavity, LogNormal::paper(2e-3), law, 5e-6, s)
 }
 
-#[test]
-fn prepared_bed_is_at_rest_under_one_g() {
-    // settled under 20 g
-    let (cavity, psd, law, dt, s) = small_bed(20.0);
-    let (bed, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
-    assert!(!rep.compressed, "the bed must stay below the cavity top");
-    let n = bed.len();
-    let mass = bed.world.particles.total_mass();
-    // the prepared bed, left alone in the rigid cavity under 1 g for 20 ms
-    let mut p = bed.world;
+/// The prepared bed's world closed in by the rigid cavity (a box wall on a fixed body),
+/// initialized.
+fn closed_in(mut p: pdamp_dem::World, cavity: &Aabb) -> pdamp_dem::World {
     let (lo, hi) = (Vec3::from(cavity.min), Vec3::from(cavity.max));
     p.add_body(
         RigidBody::new("cavity", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
@@ -49,6 +42,19 @@ fn prepared_bed_is_at_rest_under_one_g() {
         ),
     );
     p.initialize();
+    p
+}
+
+#[test]
+fn prepared_bed_is_at_rest_under_one_g() {
+    // settled under 20 g
+    let (cavity, psd, law, dt, s) = small_bed(20.0);
+    let (bed, rep) = prep::prepare(cavity, &psd, law, 8000.0, dt, &s, &mut |_, _| {}).unwrap();
+    assert!(!rep.compressed, "the bed must stay below the cavity top");
+    let n = bed.len();
+    let mass = bed.world.particles.total_mass();
+    // the prepared bed, left alone in the rigid cavity under 1 g for 20 ms
+    let mut p = closed_in(bed.world, &cavity);
     let e_pot0 = p.ledger.potential_j;
     let el0 = p.ledger.elastic_j;
     let mut ke_max = 0.0f64;
@@ -166,16 +172,7 @@ fn a_bed_made_with_its_own_law_is_handed_over_at_rest_under_the_run_law() {
     );
     let n = bed.len();
     let mass = bed.world.particles.total_mass();
-    let mut p = bed.world;
-    let (lo, hi) = (Vec3::from(cavity.min), Vec3::from(cavity.max));
-    p.add_body(
-        RigidBody::new("cavity", BodyState::at_rest(Vec3::zeros()), Motion::Fixed).with_wall(
-            "box",
-            Geometry::BoxInside(BoxInside::new(0.5 * (lo + hi), 0.5 * (hi - lo))),
-            WALL_MATERIAL,
-        ),
-    );
-    p.initialize();
+    let mut p = closed_in(bed.world, &cavity);
     let el0 = p.ledger.elastic_j;
     let mut ke_max = 0.0f64;
     for _ in 0..(0.01 / dt) as usize {

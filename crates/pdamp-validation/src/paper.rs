@@ -135,15 +135,18 @@ pub fn targets() -> Vec<Target> {
     ]
 }
 
-/// Why the Table 1 row differs (measured 2026-12-07, docs/powder.md "Table 1 on the one
-/// engine").
+/// Why the Table 1 row differs (measured 2026-12-07/08, docs/powder.md "Table 1 on the one
+/// engine", "Handing a loose bed over to the run's law").
 const TABLE_ONE_CAUSE: &str = "the damping is set by how hard the plate compresses the \
     settled bed, which the paper does not state: our beds settle at ϕ = 0.576–0.580, so at 58 % \
     the plate just touches (0 N, ζ̄5 0.013), at 59 % it presses with 2–7 N (ζ̄5 0.033–0.066, ζ1 up \
     to 0.153), at 60 % with 41 N (ζ̄5 0.048, overlaps 10–13 % of D, above Table A.2's \
-    c_g = 5.5 %), at 61 % with 97–104 N 0.022, at 62 % with 154–157 N 0.012; cavities filled \
-    at 54–56 % by a looser preparation leave the plate without force and do not damp (ζ̄5 \
-    0.003): the paper's curve, shifted by 1–2 % of ϕ and lower";
+    c_g = 5.5 %), at 61 % with 97–104 N 0.022, at 62 % with 154–157 N 0.012; a cavity filled \
+    at 56–57 % by a looser preparation (μ = 1, adhesion) collapses under the paper's law when \
+    handed over (57 %: 60 N → 0 N) and leaves a 1–3 mm gap at the law's density 0.576 (ζ̄5 \
+    0.010): a completely filled cavity below ≈ 0.576 is not a state of Table A.2's law; the \
+    paper's 1 mm mesh changes ζ̄5 at 60 % by −4 % (inside the packing CI): the paper's curve, \
+    shifted by 1–2 % of ϕ and lower";
 
 /// Table 1, D50 = 1 mm at Φ = 58 %: the shipped example on three packings
 /// (`pdamp powder run examples/powder_cantilever_paper.toml --packings 3`); finished packings

@@ -245,6 +245,13 @@ impl Target {
             note: None,
         };
         if !run {
+            // a row of the other tier still says what its last measurement found
+            row.note = self.known_cause.map(|c| {
+                format!(
+                    "a simulation row: run by `pdamp validate --full` (docs/validation-full.md); \
+                     where it differs from the reference, the measured cause: {c}"
+                )
+            });
             return row;
         }
         // Every target runs in a folder of its own (targets run in parallel).
@@ -344,7 +351,14 @@ mod tests {
         assert_eq!(r.status, Status::NotReproduced);
         assert_eq!(r.note.as_deref(), Some("because"));
         assert_eq!(r.deviation, Some(1.0));
-        assert_eq!(t.evaluate(&ctx, false).status, Status::NotRun);
+        let not_run = t.evaluate(&ctx, false);
+        assert_eq!(not_run.status, Status::NotRun);
+        assert!(
+            not_run
+                .note
+                .unwrap()
+                .ends_with("where it differs from the reference, the measured cause: because")
+        );
         let e = Target {
             compute: |_| Err(ComputeError::new("no")),
             ..t
