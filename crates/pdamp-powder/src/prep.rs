@@ -692,16 +692,17 @@ impl Preparation {
                         progress("relaxing", q as f64 / self.relax_steps as f64);
                     }
                     self.stage = Stage::Holding { q: q + 1 };
-                } else if self.settings.law_of_preparation(&self.law) != self.law {
-                    self.plate_force_held = self.plate_force;
-                    self.use_law_of_run();
-                    self.stage = Stage::Handover {
-                        done: 0,
-                        force_mark: f64::NAN,
-                    };
                 } else {
                     self.plate_force_held = self.plate_force;
-                    self.stage = Stage::Done;
+                    self.stage = if self.settings.law_of_preparation(&self.law) != self.law {
+                        self.use_law_of_run();
+                        Stage::Handover {
+                            done: 0,
+                            force_mark: f64::NAN,
+                        }
+                    } else {
+                        Stage::Done
+                    };
                 }
             }
             Stage::Handover { done, force_mark } => {
@@ -714,25 +715,19 @@ impl Preparation {
                 let window = self.relax_steps.max(SETTLE_CHUNK as u64);
                 let t_max = self.relax_steps
                     + (self.settings.max_settling_time_s / self.world.dt_s).ceil() as u64;
-                let mut force_mark = force_mark;
-                if done >= self.relax_steps && done.is_multiple_of(window) {
-                    let f = self.plate_force;
-                    let weight = self.world.particles.total_mass() * 9.81;
-                    // (a plate without force says nothing: the bed may be falling away)
-                    let steady =
-                        f.abs() > weight && (f - force_mark).abs() <= 1e-3 * f.abs().max(weight);
-                    if steady || self.world.ledger.kinetic_j < self.e_ref_1g {
-                        self.handover_steps = done;
-                        self.stage = Stage::Done;
-                        return Ok(true);
-                    }
-                    force_mark = f;
-                }
-                if done >= t_max {
+                let check = done >= self.relax_steps && done.is_multiple_of(window);
+                let f = self.plate_force;
+                let weight = self.world.particles.total_mass() * G0[2].abs();
+                // (a plate without force says nothing: the bed may be falling away)
+                let steady =
+                    f.abs() > weight && (f - force_mark).abs() <= 1e-3 * f.abs().max(weight);
+                let at_rest = self.world.ledger.kinetic_j < self.e_ref_1g;
+                if (check && (steady || at_rest)) || done >= t_max {
                     self.handover_steps = done;
                     self.stage = Stage::Done;
                     return Ok(true);
                 }
+                let force_mark = if check { f } else { force_mark };
                 self.step()?;
                 self.plate_force = self.world.body_load(PLATE).0.z;
                 if (done + 1) % (50 * SETTLE_CHUNK as u64) == 0 {
